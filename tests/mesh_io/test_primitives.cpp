@@ -1,0 +1,89 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <map>
+#include <utility>
+
+#include "mesh/io/error.hpp"
+#include "mesh/io/primitives.hpp"
+
+namespace icd {
+namespace {
+
+// Total signed volume enclosed by a closed, outward-oriented surface
+// (divergence theorem), independent of any tet decomposition.
+double enclosed_volume(const MatX3d& V, const MatX3i& F) {
+  double vol = 0.0;
+  for (int f = 0; f < F.rows(); ++f)
+    vol += V.row(F(f, 0)).dot(V.row(F(f, 1)).cross(V.row(F(f, 2)))) / 6.0;
+  return vol;
+}
+
+// Every directed edge appears once and its reverse once: closed, consistently oriented.
+bool closed_and_oriented(const MatX3i& F) {
+  std::map<std::pair<int, int>, int> directed;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ++directed[{F(f, k), F(f, (k + 1) % 3)}];
+  for (const auto& [e, n] : directed) {
+    if (n != 1) return false;
+    auto it = directed.find({e.second, e.first});
+    if (it == directed.end() || it->second != 1) return false;
+  }
+  return true;
+}
+
+TEST(Primitives, BoxTetMeshVolumesAndBoundary) {
+  BoxMeshOptions o;
+  o.size = {1.0, 0.1, 0.2};
+  o.nx = 7;
+  o.ny = 2;
+  o.nz = 3;
+  const TetMesh m = make_box_tet_mesh(o);
+  EXPECT_EQ(m.V.rows(), 8 * 3 * 4);
+  EXPECT_EQ(m.T.rows(), 6 * 7 * 2 * 3);
+  const Eigen::VectorXd vol = signed_tet_volumes(m.V, m.T);
+  EXPECT_GT(vol.minCoeff(), 0.0);
+  EXPECT_NEAR(vol.sum(), 0.02, 1e-14);
+  // Boundary: 2 triangles per boundary quad.
+  EXPECT_EQ(m.F.rows(), 2 * 2 * (7 * 2 + 7 * 3 + 2 * 3));
+  EXPECT_TRUE(closed_and_oriented(m.F));
+  EXPECT_NEAR(enclosed_volume(m.V, m.F), 0.02, 1e-14);
+}
+
+TEST(Primitives, IcosphereIsClosedAndConvergesToSphereVolume) {
+  double prev_err = 1e9;
+  for (int s = 0; s <= 4; ++s) {
+    const SurfaceMesh m = make_icosphere(s, 2.0);
+    EXPECT_EQ(m.F.rows(), 20 << (2 * s));
+    EXPECT_TRUE(closed_and_oriented(m.F));
+    const double err = std::abs(enclosed_volume(m.V, m.F) - 4.0 / 3.0 * M_PI * 8.0);
+    EXPECT_LT(err, prev_err);
+    prev_err = err;
+  }
+  EXPECT_LT(prev_err / (4.0 / 3.0 * M_PI * 8.0), 0.01);
+}
+
+TEST(Primitives, BoxSurfaceAndTorus) {
+  const SurfaceMesh box = make_box_surface({0, 0, 0}, {1, 2, 3});
+  EXPECT_TRUE(closed_and_oriented(box.F));
+  EXPECT_NEAR(enclosed_volume(box.V, box.F), 6.0, 1e-14);
+  const SurfaceMesh torus = make_torus(2.0, 0.5, 64, 32);
+  EXPECT_TRUE(closed_and_oriented(torus.F));
+  const double exact = 2 * M_PI * M_PI * 2.0 * 0.25;
+  EXPECT_NEAR(enclosed_volume(torus.V, torus.F), exact, 0.01 * exact);
+}
+
+TEST(Primitives, BadParametersThrow) {
+  BoxMeshOptions o;
+  o.nx = 0;
+  EXPECT_THROW(make_box_tet_mesh(o), ParameterError);
+  o.nx = 1;
+  o.size = {1, -1, 1};
+  EXPECT_THROW(make_box_tet_mesh(o), ParameterError);
+  EXPECT_THROW(make_torus(1.0, 2.0, 8, 8), ParameterError);
+  EXPECT_THROW(make_icosphere(-1), ParameterError);
+}
+
+}  // namespace
+}  // namespace icd
