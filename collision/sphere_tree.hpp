@@ -1,0 +1,49 @@
+#pragma once
+/// The runtime sphere tree: a flat, pointer-free, breadth-first array layout.
+///
+/// A *wrapped* hierarchy (paper 4.1): each level covers the object's surface;
+/// a child need not lie inside its parent. Nodes are stored level by level
+/// (breadth-first), the children of a node contiguous, so a node is an index.
+/// The rest data that the BD-tree style update (paper 4.4) needs is stored
+/// alongside: each node's associated coarse nodes V_i (CSR) and their rest
+/// distances to the node's rest centre.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace icd::collision {
+
+/// One sphere: centre (x, y, z) and radius r, in model units.
+struct Sphere {
+  double x = 0, y = 0, z = 0, r = 0;
+  Eigen::Vector3d center() const { return {x, y, z}; }
+};
+
+/// Sphere tree in breadth-first order. Node 0 is the root.
+/// Invariants (checked by validate()):
+///  - spheres, rest_spheres, first_child, child_count, level have one entry per node;
+///  - children of node i are first_child[i] .. first_child[i] + child_count[i] - 1,
+///    all at level level[i] + 1; a leaf has child_count 0 (first_child -1);
+///  - level_offset[l] is the index of the first node of level l, level_offset.back() == #nodes;
+///  - assoc_offset has #nodes + 1 entries; node i's coarse nodes are
+///    assoc_nodes[assoc_offset[i] .. assoc_offset[i+1]) with rest distances
+///    assoc_rest_dist[...] (distance from the rest centre to the rest node position).
+struct SphereTree {
+  std::vector<Sphere> spheres;       ///< current spheres (updated each frame)
+  std::vector<Sphere> rest_spheres;  ///< spheres in the undeformed configuration
+  std::vector<int32_t> first_child;  ///< index of first child, -1 for leaves
+  std::vector<int32_t> child_count;  ///< number of children (0 for leaves)
+  std::vector<int32_t> level;        ///< depth of each node (root = 0)
+  std::vector<int32_t> level_offset; ///< first node of each level, plus #nodes at the end
+
+  std::vector<int32_t> assoc_offset;   ///< CSR offsets into assoc_nodes (#nodes + 1), may be empty
+  std::vector<int32_t> assoc_nodes;    ///< coarse node indices V_i of each sphere
+  std::vector<double> assoc_rest_dist; ///< rest distance from sphere centre to each assoc node
+
+  int num_nodes() const { return static_cast<int>(spheres.size()); }
+  int num_levels() const { return static_cast<int>(level_offset.size()) - 1; }
+  bool is_leaf(int i) const { return child_count[i] == 0; }
+};
+
+}  // namespace icd::collision
