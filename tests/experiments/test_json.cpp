@@ -1,0 +1,68 @@
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "experiments/runner/json.hpp"
+#include "mesh/io/error.hpp"
+
+namespace icd::runner {
+namespace {
+
+TEST(Json, ParsesNestedDocument) {
+  const Json j = parse_json(R"({"a": [1, -2.5e3, true, null], "b": {"c": "x\"y\u00e9"}})", "t");
+  ASSERT_TRUE(j.is_object());
+  const auto& a = j.as_object().at("a").as_array();
+  ASSERT_EQ(a.size(), 4u);
+  EXPECT_EQ(a[0].as_number(), 1.0);
+  EXPECT_EQ(a[1].as_number(), -2500.0);
+  EXPECT_TRUE(a[2].as_bool());
+  EXPECT_TRUE(a[3].is_null());
+  EXPECT_EQ(j.as_object().at("b").as_object().at("c").as_string(), "x\"y\xc3\xa9");
+}
+
+// Each malformed document must raise InputError naming source, line and column.
+TEST(Json, MalformedInputsGiveLocatedErrors) {
+  const struct {
+    const char* text;
+    const char* expect;
+  } cases[] = {
+      {"{\"a\": 1,}", "expected a string key"},
+      {"{\"a\" 1}", "expected ':'"},
+      {"[1, 2", "expected ',' or ']'"},
+      {"\"abc", "unterminated string"},
+      {"01", "unexpected characters"},
+      {"1.", "digits expected after '.'"},
+      {"{\"a\":1, \"a\":2}", "duplicate key"},
+      {"nul", "unexpected character"},
+      {"1e999", "out of range"},
+      {"", "unexpected end of input"},
+      {"\n\n  ]", "t:3:3"},
+  };
+  for (const auto& c : cases) {
+    try {
+      parse_json(c.text, "t");
+      ADD_FAILURE() << "no error for: " << c.text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos)
+          << c.text << " -> " << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("t:", 0), 0u) << e.what();
+    }
+  }
+}
+
+TEST(Json, DeepNestingIsRejectedNotOverflowed) {
+  const std::string deep(100000, '[');
+  EXPECT_THROW(parse_json(deep, "deep"), InputError);
+}
+
+TEST(Json, MissingFileNamesThePath) {
+  try {
+    read_json_file("/nonexistent/scene.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.json"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace icd::runner
