@@ -46,4 +46,26 @@ struct SphereTree {
   bool is_leaf(int i) const { return child_count[i] == 0; }
 };
 
+/// True when the closed balls a and b intersect: |c_a - c_b| <= r_a + r_b.
+inline bool overlap(const Sphere& a, const Sphere& b) {
+  const double dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z, rr = a.r + b.r;
+  return dx * dx + dy * dy + dz * dz <= rr * rr;
+}
+
+/// Checks every invariant listed at SphereTree (sizes, breadth-first order,
+/// contiguous children one level deeper, level_offset, finite spheres with
+/// r >= 0, CSR association data when present).
+/// Throws icd::InputError naming the first offending node or field.
+void validate(const SphereTree& tree);
+
+/// Fills first_child, child_count, level and level_offset of `tree` from the
+/// parent index of every node (parent[0] == -1; nodes listed breadth-first, so
+/// parent[i] < i and parents do not decrease). `tree.spheres` must already hold
+/// one sphere per node; rest_spheres is set to spheres if its size differs.
+/// Throws icd::ParameterError when `parent` is not a breadth-first listing.
+void build_topology(SphereTree& tree, const std::vector<int32_t>& parent);
+
+/// Parent index of every node (-1 for the root), the inverse of build_topology.
+std::vector<int32_t> parents(const SphereTree& tree);
+
 }  // namespace icd::collision
