@@ -1,0 +1,86 @@
+#include "collision/sphere_update.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <string>
+
+#include "mesh/io/error.hpp"
+
+namespace icd::collision {
+
+void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_rest,
+                    const Eigen::Ref<const MatX3d>& coarse_positions, const SphereUpdateOptions& options) {
+  const int n = tree.num_nodes();
+  if (tree.assoc_offset.size() != static_cast<std::size_t>(n) + 1)
+    throw ParameterError("update_spheres: the tree has no coarse-node association (call associate_*_nodes first)");
+  if (coarse_rest.rows() != coarse_positions.rows())
+    throw ParameterError("update_spheres: coarse_rest has " + std::to_string(coarse_rest.rows()) +
+                         " rows, coarse_positions " + std::to_string(coarse_positions.rows()));
+  if (!(options.margin >= 0.0)) throw ParameterError("SphereUpdateOptions::margin must be >= 0");
+  const double* X = coarse_rest.data();
+  const double* x = coarse_positions.data();
+  const int32_t* off = tree.assoc_offset.data();
+  const int32_t* nodes = tree.assoc_nodes.data();
+  const double* rest_dist = tree.assoc_rest_dist.data();
+  const bool ratio = options.mode == SphereUpdateMode::PaperRatio;
+  double check = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const int32_t b = off[i], e = off[i + 1];
+    const Sphere& rs = tree.rest_spheres[i];
+    Sphere& s = tree.spheres[i];
+    if (b == e) {  // no associated node: nothing to follow (validate-time precondition)
+      s = rs;
+      s.r += options.margin;
+      continue;
+    }
+    double ux = 0, uy = 0, uz = 0;
+    for (int32_t k = b; k < e; ++k) {
+      const int32_t j = nodes[k];
+      assert(j >= 0 && j < coarse_rest.rows());
+      ux += x[3 * j] - X[3 * j];
+      uy += x[3 * j + 1] - X[3 * j + 1];
+      uz += x[3 * j + 2] - X[3 * j + 2];
+    }
+    const double inv = 1.0 / (e - b);
+    ux *= inv;
+    uy *= inv;
+    uz *= inv;
+    s.x = rs.x + ux;
+    s.y = rs.y + uy;
+    s.z = rs.z + uz;
+    if (ratio) {
+      double lambda2 = 0.0;
+      bool any = false;
+      for (int32_t k = b; k < e; ++k) {
+        const int32_t j = nodes[k];
+        const double d0 = rest_dist[k];
+        if (d0 <= 1e-12 * (rs.r + 1e-300)) continue;  // node at the centre: no ratio
+        const double dx = x[3 * j] - s.x, dy = x[3 * j + 1] - s.y, dz = x[3 * j + 2] - s.z;
+        lambda2 = std::max(lambda2, (dx * dx + dy * dy + dz * dz) / (d0 * d0));
+        any = true;
+      }
+      s.r = (any ? std::sqrt(lambda2) : 1.0) * rs.r + options.margin;
+    } else {
+      double dev2 = 0.0;
+      for (int32_t k = b; k < e; ++k) {
+        const int32_t j = nodes[k];
+        const double dx = x[3 * j] - X[3 * j] - ux, dy = x[3 * j + 1] - X[3 * j + 1] - uy,
+                     dz = x[3 * j + 2] - X[3 * j + 2] - uz;
+        dev2 = std::max(dev2, dx * dx + dy * dy + dz * dz);
+      }
+      s.r = rs.r + std::sqrt(dev2) + options.margin;
+    }
+    check += s.x + s.y + s.z + s.r;
+  }
+  if (!std::isfinite(check)) {
+    for (int i = 0; i < n; ++i) {
+      const Sphere& s = tree.spheres[i];
+      if (!std::isfinite(s.x + s.y + s.z + s.r))
+        throw NumericalError("update_spheres: sphere " + std::to_string(i) +
+                             " is not finite after the update (non-finite coarse node positions?)");
+    }
+  }
+}
+
+}  // namespace icd::collision
