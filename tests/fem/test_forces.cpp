@@ -1,0 +1,164 @@
+// Internal forces against independent oracles: finite differences of the
+// energy, rigid motions, and the affine patch test.
+#include "fem/forces.hpp"
+
+#include <Eigen/SVD>
+#include <gtest/gtest.h>
+
+#include "fem/constitutive.hpp"
+#include "fem_test_utils.hpp"
+#include "mesh/io/error.hpp"
+
+namespace icd::fem {
+namespace {
+
+class ForcesPerModel : public ::testing::TestWithParam<MaterialModel> {};
+
+// A moderately deformed state (|F - I| ~ 0.2) of a 2x1x1-cell box of 0.1 m cells.
+MatX3d deformed(const TetMeshData& d, unsigned seed, double amplitude = 0.02) {
+  return d.rest_positions + amplitude * test::random_field(d.num_nodes, seed);
+}
+
+TEST_P(ForcesPerModel, ForcesAreMinusTheFiniteDifferenceGradientOfTheEnergy) {
+  const TetMeshData d = test::box_data(2, 1, 1, {0.2, 0.1, 0.1});
+  ElasticForces forces(d, test::material(GetParam()));
+  MatX3d x = deformed(d, 1);
+  MatX3d f(d.num_nodes, 3);
+  const double W = forces.compute_with_energy(x, f);
+  EXPECT_NEAR(W, forces.energy(x), 1e-12 * std::abs(W));
+  // Central differences: truncation ~ h^2 W''' and round-off ~ eps W / h; with
+  // h = 1e-7 m on 0.1 m elements both are ~1e-7 relative to the force scale.
+  const double h = 1e-7;
+  const double scale = f.norm();
+  for (int i = 0; i < d.num_nodes; ++i)
+    for (int c = 0; c < 3; ++c) {
+      MatX3d xp = x, xm = x;
+      xp(i, c) += h;
+      xm(i, c) -= h;
+      const double fd = -(forces.energy(xp) - forces.energy(xm)) / (2 * h);
+      EXPECT_NEAR(f(i, c), fd, 1e-6 * scale) << "node " << i << " axis " << c;
+    }
+}
+
+TEST_P(ForcesPerModel, StiffnessIsTheFiniteDifferenceJacobianAndDifferentialMatchesIt) {
+  const TetMeshData d = test::box_data(2, 1, 1, {0.2, 0.1, 0.1});
+  ElasticForces forces(d, test::material(GetParam()));
+  const MatX3d x = deformed(d, 2);
+  const Eigen::MatrixXd K = Eigen::MatrixXd(forces.stiffness(x));
+  const int n = 3 * d.num_nodes;
+  EXPECT_LT((K - K.transpose()).norm(), 1e-10 * K.norm());
+  const double h = 1e-7;
+  MatX3d fp(d.num_nodes, 3), fm(d.num_nodes, 3);
+  for (int j = 0; j < n; ++j) {
+    MatX3d xp = x, xm = x;
+    xp(j / 3, j % 3) += h;
+    xm(j / 3, j % 3) -= h;
+    forces.compute(xp, fp);
+    forces.compute(xm, fm);
+    const Eigen::VectorXd col = -(Eigen::Map<const Eigen::VectorXd>(fp.data(), n) -
+                                  Eigen::Map<const Eigen::VectorXd>(fm.data(), n)) / (2 * h);
+    EXPECT_LT((K.col(j) - col).norm(), 1e-6 * K.norm()) << "dof " << j;
+  }
+  const MatX3d dx = test::random_field(d.num_nodes, 3);
+  MatX3d df(d.num_nodes, 3);
+  forces.differential(x, dx, df);
+  const Eigen::VectorXd Kdx = K * Eigen::Map<const Eigen::VectorXd>(dx.data(), n);
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(df.data(), n) + Kdx).norm(), 1e-12 * Kdx.norm());
+}
+
+TEST_P(ForcesPerModel, RigidMotionGivesZeroForceExceptForLinear) {
+  const TetMeshData d = test::box_data(3, 2, 2, {0.3, 0.2, 0.2});
+  const Material mat = test::material(GetParam());
+  ElasticForces forces(d, mat);
+  const Eigen::Matrix3d R = test::some_rotation();
+  MatX3d x = (d.rest_positions * R.transpose()).rowwise() + Eigen::RowVector3d(0.3, -1.0, 2.0);
+  MatX3d f(d.num_nodes, 3);
+  const double W = forces.compute_with_energy(x, f);
+  // Force scale of a unit strain: E * (element face area ~ (0.1 m)^2).
+  const double unit = mat.young * 0.01;
+  if (GetParam() == MaterialModel::Linear) {
+    EXPECT_GT(f.cwiseAbs().maxCoeff(), 0.1 * unit);  // linear elasticity is not invariant
+  } else {
+    EXPECT_LT(f.cwiseAbs().maxCoeff(), 1e-12 * unit);
+    EXPECT_LT(std::abs(W), 1e-12 * mat.young * 0.012);
+  }
+}
+
+TEST_P(ForcesPerModel, PatchTestAffineFieldGivesAnalyticStressAndBalancedInteriorNodes) {
+  const Eigen::Vector3d size(0.3, 0.3, 0.3);
+  const TetMesh mesh = test::box(3, 3, 3, size);
+  const TetMeshData d = make_tet_mesh_data(mesh.V, mesh.T);
+  const Material mat = test::material(GetParam());
+  const Lame l = lame_parameters(mat);
+  ElasticForces forces(d, mat);
+  Eigen::Matrix3d A;
+  A << 1.05, 0.02, -0.03, 0.01, 0.97, 0.04, -0.02, 0.03, 1.02;
+  const MatX3d x = (d.rest_positions * A.transpose()).rowwise() + Eigen::RowVector3d(0.1, 0.2, 0.3);
+  MatX3d f(d.num_nodes, 3);
+  const double W = forces.compute_with_energy(x, f);
+  // Analytic first Piola-Kirchhoff stress of the homogeneous deformation F = A,
+  // written from the textbook definitions (not the library's laws).
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d P;
+  double psi = 0;
+  switch (GetParam()) {
+    case MaterialModel::Linear: {
+      const Eigen::Matrix3d eps = 0.5 * (A + A.transpose()) - I;
+      P = 2 * l.mu * eps + l.lambda * eps.trace() * I;
+      psi = l.mu * (eps.array() * eps.array()).sum() + 0.5 * l.lambda * eps.trace() * eps.trace();
+      break;
+    }
+    case MaterialModel::StVK: {
+      const Eigen::Matrix3d E = 0.5 * (A.transpose() * A - I);
+      P = A * (2 * l.mu * E + l.lambda * E.trace() * I);
+      psi = l.mu * (E.array() * E.array()).sum() + 0.5 * l.lambda * E.trace() * E.trace();
+      break;
+    }
+    case MaterialModel::Corotational: {
+      Eigen::JacobiSVD<Eigen::Matrix3d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();  // det A > 0
+      const Eigen::Matrix3d S = R.transpose() * A;
+      P = R * (2 * l.mu * (S - I) + l.lambda * (S - I).trace() * I);
+      psi = l.mu * (S - I).squaredNorm() + 0.5 * l.lambda * (S - I).trace() * (S - I).trace();
+      break;
+    }
+    case MaterialModel::StableNeoHookean: {
+      const double J = A.determinant(), lp = l.lambda + l.mu;
+      const Eigen::Matrix3d dJ = J * A.inverse().transpose();
+      P = l.mu * A + (lp * (J - 1) - l.mu) * dJ;
+      psi = 0.5 * l.mu * (A.squaredNorm() - 3) - l.mu * (J - 1) + 0.5 * lp * (J - 1) * (J - 1);
+      break;
+    }
+  }
+  EXPECT_NEAR(W, psi * size.prod(), 1e-12 * std::abs(psi * size.prod()));
+  for (int e = 0; e < d.num_tets(); ++e) EXPECT_LT((d.deformation_gradient(x, e) - A).norm(), 1e-13);
+  // Nodal forces: interior nodes are balanced; the internal force of a boundary
+  // node balances the traction P N of its rest boundary faces (one third of
+  // each face area for linear triangles), i.e. equals minus that traction.
+  MatX3d expected = MatX3d::Zero(d.num_nodes, 3);
+  for (int k = 0; k < mesh.F.rows(); ++k) {
+    const Eigen::Vector3d X0 = mesh.V.row(mesh.F(k, 0)), X1 = mesh.V.row(mesh.F(k, 1)),
+                          X2 = mesh.V.row(mesh.F(k, 2));
+    const Eigen::Vector3d area_normal = 0.5 * (X1 - X0).cross(X2 - X0);
+    for (int a = 0; a < 3; ++a) expected.row(mesh.F(k, a)) -= (P * area_normal / 3.0).transpose();
+  }
+  const double scale = P.norm() * 0.01;  // stress x element face area
+  EXPECT_LT((f - expected).cwiseAbs().maxCoeff(), 1e-12 * scale);
+  // The interior nodes of the 3x3x3 grid carry no external face.
+  for (int k = 1; k <= 2; ++k)
+    for (int j = 1; j <= 2; ++j)
+      for (int i = 1; i <= 2; ++i) EXPECT_LT(f.row(i + 4 * (j + 4 * k)).norm(), 1e-12 * scale);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllModels, ForcesPerModel, ::testing::ValuesIn(test::all_models()),
+                         test::model_name);
+
+TEST(Forces, RejectsShapeMismatch) {
+  const TetMeshData d = test::box_data(1, 1, 1);
+  ElasticForces forces(d, test::material(MaterialModel::StVK));
+  MatX3d x(d.num_nodes + 1, 3), f(d.num_nodes, 3);
+  EXPECT_THROW(forces.compute(x, f), ParameterError);
+}
+
+}  // namespace
+}  // namespace icd::fem
