@@ -1,0 +1,404 @@
+#include "collision/traversal.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "collision/cycle_clock.hpp"
+#include "mesh/io/error.hpp"
+
+namespace icd::collision {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A pair being refined. `split_b`: the node to split next is b (the paper's
+// p.2); the flag flips at every generated pair, which is Fig. 7's swap.
+struct WorkPair {
+  int32_t a;
+  int32_t b;
+  int32_t split_b;
+};
+
+// Growable ring buffer (FIFO), storage kept between queries of a thread.
+class PairQueue {
+ public:
+  void clear() { m_head = m_size = 0; }
+  bool empty() const { return m_size == 0; }
+  std::size_t size() const { return m_size; }
+  void push(const WorkPair& p) {
+    if (m_size == m_buf.size()) grow();
+    m_buf[(m_head + m_size) & m_mask] = p;
+    ++m_size;
+  }
+  WorkPair pop() {
+    const WorkPair p = m_buf[m_head];
+    m_head = (m_head + 1) & m_mask;
+    --m_size;
+    return p;
+  }
+  template <class F>
+  void for_each(F&& f) const {
+    for (std::size_t k = 0; k < m_size; ++k) f(m_buf[(m_head + k) & m_mask]);
+  }
+
+ private:
+  void grow() {
+    const std::size_t cap = std::max<std::size_t>(1024, 2 * m_buf.size());
+    std::vector<WorkPair> nb(cap);
+    for (std::size_t k = 0; k < m_size; ++k) nb[k] = m_buf[(m_head + k) & m_mask];
+    m_buf.swap(nb);
+    m_head = 0;
+    m_mask = cap - 1;
+  }
+  std::vector<WorkPair> m_buf;
+  std::size_t m_head = 0, m_size = 0, m_mask = 0;
+};
+
+// LIFO with the same interface.
+class PairStack {
+ public:
+  void clear() { m_buf.clear(); }
+  bool empty() const { return m_buf.empty(); }
+  std::size_t size() const { return m_buf.size(); }
+  void push(const WorkPair& p) { m_buf.push_back(p); }
+  WorkPair pop() {
+    const WorkPair p = m_buf.back();
+    m_buf.pop_back();
+    return p;
+  }
+  template <class F>
+  void for_each(F&& f) const {
+    for (auto it = m_buf.rbegin(); it != m_buf.rend(); ++it) f(*it);
+  }
+
+ private:
+  std::vector<WorkPair> m_buf;
+};
+
+// Budget: one integer compare per sphere test; the clock is read only every
+// `interval` tests.
+class Budget {
+ public:
+  Budget(const CollisionRequest& r, Clock::time_point start) : m_max_tests(r.budget_tests < 0 ? INT64_MAX : r.budget_tests) {
+    m_timed = std::isfinite(r.budget_seconds);
+    m_interval = r.clock_check_interval;
+    if (m_timed) {
+      if (r.clock == ClockSource::CycleCounter && has_cycle_counter()) {
+        m_use_tsc = true;
+        const double hz = cycle_counter_hz();
+        // Measured from the query's start on the steady clock, mapped to cycles.
+        const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+        m_tsc_deadline = read_cycle_counter() + static_cast<uint64_t>(std::max(0.0, r.budget_seconds - elapsed) * hz);
+      } else {
+        m_deadline = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(r.budget_seconds));
+      }
+    }
+    m_next = m_timed ? 0 : m_max_tests;  // a timed query reads the clock before its first test
+  }
+  // Call before test number `tests`; returns false (and sets the reason) to stop.
+  inline bool allow(int64_t tests, StopReason& reason) {
+    if (tests != m_next) [[likely]]
+      return true;
+    return slow(tests, reason);
+  }
+
+ private:
+  bool slow(int64_t tests, StopReason& reason) {
+    if (tests >= m_max_tests) {
+      reason = StopReason::TestBudget;
+      return false;
+    }
+    if (m_timed) {
+      const bool expired = m_use_tsc ? read_cycle_counter() >= m_tsc_deadline : Clock::now() >= m_deadline;
+      if (expired) {
+        reason = StopReason::TimeBudget;
+        return false;
+      }
+      m_next = std::min<int64_t>(tests + m_interval, m_max_tests);
+    } else {
+      m_next = m_max_tests;
+    }
+    return true;
+  }
+  int64_t m_max_tests;
+  int64_t m_next = 0;
+  bool m_timed = false, m_use_tsc = false;
+  int m_interval = 1;
+  Clock::time_point m_deadline;
+  uint64_t m_tsc_deadline = 0;
+};
+
+inline double penetration(const Sphere& p, const Sphere& q) {
+  const double dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
+  return p.r + q.r - std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+struct Trees {
+  const Sphere* sa;
+  const Sphere* sb;
+  const int32_t* fca;
+  const int32_t* cca;
+  const int32_t* fcb;
+  const int32_t* ccb;
+  const int32_t* la;
+  const int32_t* lb;
+  int cap;
+  bool expandable_a(int32_t n) const { return cca[n] > 0 && la[n] < cap; }
+  bool expandable_b(int32_t n) const { return ccb[n] > 0 && lb[n] < cap; }
+  bool overlaps(int32_t a, int32_t b) const { return overlap(sa[a], sb[b]); }
+};
+
+// Where a known-overlapping pair goes when it cannot be split further.
+inline void settle(const Trees& t, int32_t a, int32_t b, CollisionResult& res) {
+  if (t.cca[a] == 0 && t.ccb[b] == 0) res.colliding.push_back({a, b});
+  else res.untested.push_back({a, b});  // held back by depth_cap
+}
+
+// Chooses the node to split of an overlapping pair per Fig. 7: split b if
+// `split_b` and b is expandable, otherwise a (the swap for a leaf).
+inline bool choose_split_b(const Trees& t, const WorkPair& p) {
+  const bool eb = t.expandable_b(p.b);
+  return p.split_b ? eb : !t.expandable_a(p.a) && eb;
+}
+
+// Literal Fig. 7 (and Fig. 4 with a stack): pairs are tested when popped.
+template <class List>
+void run_literal(const Trees& t, List& list, Budget& budget, bool record_front, CollisionResult& res) {
+  StopReason reason = StopReason::Completed;
+  while (!list.empty()) {
+    if (!budget.allow(res.tests, reason)) {
+      res.interrupted = true;
+      res.stop_reason = reason;
+      break;
+    }
+    const WorkPair p = list.pop();
+    ++res.tests;
+    if (!t.overlaps(p.a, p.b)) {
+      if (record_front) res.front.push_back({p.a, p.b});
+      continue;
+    }
+    const bool ea = t.expandable_a(p.a), eb = t.expandable_b(p.b);
+    if (!ea && !eb) {
+      settle(t, p.a, p.b, res);
+      continue;
+    }
+    const bool split2_is_b = p.split_b != 0;
+    const bool split2_expandable = split2_is_b ? eb : ea;
+    if (!split2_expandable) {  // p.2 is a leaf, p.1 is not: push the swapped pair
+      list.push({p.a, p.b, !p.split_b});
+    } else if (split2_is_b) {
+      for (int32_t c = t.fcb[p.b], e = c + t.ccb[p.b]; c < e; ++c) list.push({p.a, c, 0});
+    } else {
+      for (int32_t c = t.fca[p.a], e = c + t.cca[p.a]; c < e; ++c) list.push({c, p.b, 1});
+    }
+    res.peak_list_size = std::max(res.peak_list_size, list.size());
+  }
+  list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
+}
+
+// Fast path: children are tested as they are generated; the list holds only
+// overlapping pairs that still need splitting.
+template <class List>
+void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, CollisionResult& res) {
+  StopReason reason = StopReason::Completed;
+  bool stopped = false;
+  while (!list.empty() && !stopped) {
+    const WorkPair p = list.pop();
+    const bool split_b = choose_split_b(t, p);
+    const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a];
+    const int32_t end = first + (split_b ? t.ccb[p.b] : t.cca[p.a]);
+    const int32_t next_flag = split_b ? 0 : 1;
+    for (int32_t c = first; c < end; ++c) {
+      const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
+      if (!budget.allow(res.tests, reason)) {
+        for (int32_t r = c; r < end; ++r) res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
+        res.interrupted = true;
+        res.stop_reason = reason;
+        stopped = true;
+        break;
+      }
+      ++res.tests;
+      if (!t.overlaps(a, b)) {
+        if (record_front) res.front.push_back({a, b});
+        continue;
+      }
+      if (t.expandable_a(a) || t.expandable_b(b)) list.push({a, b, next_flag});
+      else settle(t, a, b, res);
+    }
+    res.peak_list_size = std::max(res.peak_list_size, list.size());
+  }
+  list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
+}
+
+// Best-first by deepest overlap with a capped heap.
+struct HeapItem {
+  double key;
+  WorkPair p;
+  bool operator<(const HeapItem& o) const { return key < o.key; }
+};
+
+void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, Budget& budget, bool record_front,
+                  CollisionResult& res) {
+  StopReason reason = StopReason::Completed;
+  bool stopped = false;
+  while (!heap.empty() && !stopped) {
+    std::pop_heap(heap.begin(), heap.end());
+    const WorkPair p = heap.back().p;
+    heap.pop_back();
+    const bool split_b = choose_split_b(t, p);
+    const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a];
+    const int32_t count = split_b ? t.ccb[p.b] : t.cca[p.a];
+    if (heap.size() + static_cast<std::size_t>(count) > cap) {  // no room: report unrefined
+      res.untested.push_back({p.a, p.b});
+      continue;
+    }
+    const int32_t next_flag = split_b ? 0 : 1;
+    for (int32_t c = first; c < first + count; ++c) {
+      const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
+      if (!budget.allow(res.tests, reason)) {
+        for (int32_t r = c; r < first + count; ++r) res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
+        res.interrupted = true;
+        res.stop_reason = reason;
+        stopped = true;
+        break;
+      }
+      ++res.tests;
+      const double depth = penetration(t.sa[a], t.sb[b]);
+      if (depth < 0.0) {
+        if (record_front) res.front.push_back({a, b});
+        continue;
+      }
+      if (t.expandable_a(a) || t.expandable_b(b)) {
+        heap.push_back({depth, {a, b, next_flag}});
+        std::push_heap(heap.begin(), heap.end());
+      } else {
+        settle(t, a, b, res);
+      }
+    }
+    res.peak_list_size = std::max(res.peak_list_size, heap.size());
+  }
+  for (const HeapItem& h : heap) res.untested.push_back({h.p.a, h.p.b});
+}
+
+thread_local PairQueue t_queue;
+thread_local PairStack t_stack;
+thread_local std::vector<HeapItem> t_heap;
+
+}  // namespace
+
+CollisionRequest CollisionRequest::paper_reference(double budget_seconds) {
+  CollisionRequest r;
+  r.budget_seconds = budget_seconds;
+  r.mode = TraversalMode::BreadthFirstFifo;
+  r.test_on_push = false;
+  r.clock_check_interval = 1;
+  return r;
+}
+
+void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request, CollisionResult& res) {
+  const Clock::time_point start = Clock::now();
+  if (!(request.budget_seconds > 0.0)) throw ParameterError("CollisionRequest::budget_seconds must be > 0 (infinity for none)");
+  if (request.budget_tests < -1) throw ParameterError("CollisionRequest::budget_tests must be >= 0, or -1 for none");
+  if (request.clock_check_interval < 1) throw ParameterError("CollisionRequest::clock_check_interval must be >= 1");
+  if (request.depth_cap < 0) throw ParameterError("CollisionRequest::depth_cap must be >= 0");
+  if (request.mode == TraversalMode::Priority && request.max_list_size < 8)
+    throw ParameterError("CollisionRequest::max_list_size must be >= 8");
+  if (a.num_nodes() == 0 || b.num_nodes() == 0) throw ParameterError("collide: empty sphere tree");
+  res.colliding.clear();
+  res.untested.clear();
+  res.front.clear();
+  res.interrupted = false;
+  res.stop_reason = StopReason::Completed;
+  res.tests = 0;
+  res.peak_list_size = 0;
+
+  const Trees t{a.spheres.data(), b.spheres.data(), a.first_child.data(), a.child_count.data(),
+                b.first_child.data(), b.child_count.data(), a.level.data(), b.level.data(), request.depth_cap};
+  // Seeds: the root pair (Fig. 7: p.1 = root of a, p.2 = root of b, split p.2
+  // first), or the previous front, splitting the shallower node first.
+  std::vector<WorkPair> seeds;
+  if (request.start_front) {
+    seeds.reserve(request.start_front->size());
+    for (const NodePair& p : *request.start_front) {
+      if (p.a < 0 || p.a >= a.num_nodes() || p.b < 0 || p.b >= b.num_nodes())
+        throw ParameterError("collide: start_front pair (" + std::to_string(p.a) + ", " + std::to_string(p.b) + ") out of range");
+      seeds.push_back({p.a, p.b, a.level[p.a] >= b.level[p.b] ? 1 : 0});
+    }
+  } else {
+    seeds.push_back({0, 0, 1});
+  }
+  Budget budget(request, start);
+  const bool literal = !request.test_on_push && request.mode != TraversalMode::Priority;
+  StopReason reason = StopReason::Completed;
+  std::size_t seeded = 0;
+  auto seed_into = [&](auto&& push) {
+    // Fast and priority modes test the seeds themselves before queueing them.
+    for (; seeded < seeds.size(); ++seeded) {
+      const WorkPair& s = seeds[seeded];
+      if (!budget.allow(res.tests, reason)) {
+        res.interrupted = true;
+        res.stop_reason = reason;
+        for (std::size_t k = seeded; k < seeds.size(); ++k) res.untested.push_back({seeds[k].a, seeds[k].b});
+        return false;
+      }
+      ++res.tests;
+      if (!t.overlaps(s.a, s.b)) {
+        if (request.record_front) res.front.push_back({s.a, s.b});
+      } else if (t.expandable_a(s.a) || t.expandable_b(s.b)) {
+        push(s);
+      } else {
+        settle(t, s.a, s.b, res);
+      }
+    }
+    return true;
+  };
+
+  if (request.mode == TraversalMode::Priority) {
+    t_heap.clear();
+    if (seed_into([&](const WorkPair& s) { t_heap.push_back({penetration(t.sa[s.a], t.sb[s.b]), s}); std::push_heap(t_heap.begin(), t_heap.end()); }))
+      run_priority(t, t_heap, request.max_list_size, budget, request.record_front, res);
+    else
+      for (const HeapItem& h : t_heap) res.untested.push_back({h.p.a, h.p.b});
+  } else {
+    auto go = [&](auto& list) {
+      list.clear();
+      if (literal) {
+        for (const WorkPair& s : seeds) list.push(s);
+        run_literal(t, list, budget, request.record_front, res);
+      } else if (seed_into([&](const WorkPair& s) { list.push(s); })) {
+        run_fast(t, list, budget, request.record_front, res);
+      } else {
+        list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
+      }
+    };
+    if (request.mode == TraversalMode::BreadthFirstFifo) go(t_queue);
+    else go(t_stack);
+  }
+
+  // Tightness reached: the shallowest inner node among the untested pairs.
+  int level = std::max(a.num_levels(), b.num_levels()) - 1;
+  for (const NodePair& p : res.untested) {
+    if (t.cca[p.a] > 0) level = std::min(level, static_cast<int>(a.level[p.a]));
+    if (t.ccb[p.b] > 0) level = std::min(level, static_cast<int>(b.level[p.b]));
+  }
+  res.completed_level = level;
+  if (request.record_front) {
+    // Unfinished work first, so that a budget-limited next frame refines it
+    // before re-checking pruned pairs.
+    const std::size_t pruned = res.front.size();
+    res.front.insert(res.front.end(), res.untested.begin(), res.untested.end());
+    res.front.insert(res.front.end(), res.colliding.begin(), res.colliding.end());
+    std::rotate(res.front.begin(), res.front.begin() + pruned, res.front.end());
+  }
+  res.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+CollisionResult collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request) {
+  CollisionResult r;
+  collide(a, b, request, r);
+  return r;
+}
+
+}  // namespace icd::collision

@@ -1,0 +1,243 @@
+#include <gtest/gtest.h>
+
+#include "collision/traversal.hpp"
+#include "mesh/io/error.hpp"
+#include "tree_fixtures.hpp"
+
+namespace icd::collision {
+namespace {
+
+using namespace icd::collision::testing;
+
+struct Scene {
+  SphereTree a, b;
+};
+
+Scene torus_and_sphere(int levels, bool make_layered) {
+  const SurfaceMesh ta = make_torus(1.0, 0.3, 32, 16);
+  const SurfaceMesh sb = translated(make_icosphere(3, 0.6), {1.0, 0.2, 0.1});
+  OctreeTreeOptions o;
+  o.levels = levels;
+  Scene s{build_octree_tree(ta.V, ta.F, o), build_octree_tree(sb.V, sb.F, o)};
+  if (make_layered) {
+    s.a = layered(s.a);
+    s.b = layered(s.b);
+  }
+  return s;
+}
+
+std::vector<CollisionRequest> all_modes() {
+  std::vector<CollisionRequest> v;
+  for (auto mode : {TraversalMode::BreadthFirstFifo, TraversalMode::DepthFirst, TraversalMode::Priority})
+    for (bool fast : {true, false}) {
+      CollisionRequest r;
+      r.mode = mode;
+      r.test_on_push = fast;
+      r.max_list_size = 1 << 20;
+      if (mode == TraversalMode::Priority && !fast) continue;
+      v.push_back(r);
+    }
+  v.push_back(CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()));
+  return v;
+}
+
+TEST(Traversal, FullTraversalOfLayeredTreesEqualsBruteForceLeafPairs) {
+  const Scene s = torus_and_sphere(4, true);
+  const auto expected = brute_force_leaf_overlaps(s.a, s.b);
+  ASSERT_GT(expected.size(), 10u);
+  for (const CollisionRequest& r : all_modes()) {
+    const CollisionResult res = collide(s.a, s.b, r);
+    EXPECT_FALSE(res.interrupted);
+    EXPECT_EQ(res.stop_reason, StopReason::Completed);
+    EXPECT_TRUE(res.untested.empty());
+    EXPECT_EQ(as_set(res.colliding), expected) << "mode " << int(r.mode) << " fast " << r.test_on_push;
+    EXPECT_EQ(res.colliding.size(), expected.size());  // no duplicates
+    EXPECT_EQ(res.completed_level, 3);
+  }
+}
+
+TEST(Traversal, WrappedTreesAllModesAgreeAndSitBetweenOracles) {
+  const Scene s = torus_and_sphere(4, false);
+  const auto upper = brute_force_leaf_overlaps(s.a, s.b);
+  const auto pa = parents(s.a), pb = parents(s.b);
+  const CollisionResult ref = collide(s.a, s.b, CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()));
+  const auto ref_set = as_set(ref.colliding);
+  for (const CollisionRequest& r : all_modes()) EXPECT_EQ(as_set(collide(s.a, s.b, r).colliding), ref_set);
+  // Reported leaf pairs overlap; leaf pairs whose every ancestor combination overlaps are reported.
+  for (const auto& p : ref_set) EXPECT_TRUE(upper.count(p));
+  for (const auto& [i, j] : upper) {
+    bool all = true;
+    for (int x = i; x >= 0 && all; x = pa[x])
+      for (int y = j; y >= 0 && all; y = pb[y]) all = overlap(s.a.spheres[x], s.b.spheres[y]);
+    if (all) {
+      EXPECT_TRUE(ref_set.count({i, j}));
+    }
+  }
+}
+
+// Every leaf pair found by the full traversal lies under some reported pair.
+void expect_cut_covers(const SphereTree& a, const SphereTree& b, const std::set<std::pair<int, int>>& full,
+                       const CollisionResult& res) {
+  const auto pa = parents(a), pb = parents(b);
+  std::vector<NodePair> reported = res.colliding;
+  reported.insert(reported.end(), res.untested.begin(), res.untested.end());
+  for (const auto& [i, j] : full) {
+    bool under = false;
+    for (const NodePair& p : reported)
+      if (is_ancestor_or_self(pa, p.a, i) && is_ancestor_or_self(pb, p.b, j)) { under = true; break; }
+    ASSERT_TRUE(under) << "leaf pair (" << i << ", " << j << ") lost";
+  }
+}
+
+TEST(Traversal, InterruptedAtAnyTestBudgetIsConservativeOnThePairTree) {
+  const Scene s = torus_and_sphere(4, false);
+  const CollisionResult full = collide(s.a, s.b, CollisionRequest{});
+  const auto full_set = as_set(full.colliding);
+  for (CollisionRequest r : all_modes()) {
+    for (int64_t budget = 0; budget <= full.tests + 10; budget += 1 + budget / 3) {
+      r.budget_tests = budget;
+      const CollisionResult res = collide(s.a, s.b, r);
+      EXPECT_LE(res.tests, budget);
+      if (res.interrupted) {
+        EXPECT_EQ(res.tests, budget);
+        EXPECT_EQ(res.stop_reason, StopReason::TestBudget);
+      }
+      expect_cut_covers(s.a, s.b, full_set, res);
+    }
+  }
+}
+
+TEST(Traversal, BreadthFirstRefinesLevelByLevel) {
+  const Scene s = torus_and_sphere(4, false);
+  CollisionRequest r = CollisionRequest::paper_reference(std::numeric_limits<double>::infinity());
+  int last = 0;
+  for (int64_t budget = 1; budget < 4000; budget *= 2) {
+    r.budget_tests = budget;
+    const CollisionResult res = collide(s.a, s.b, r);
+    EXPECT_GE(res.completed_level, last);
+    last = res.completed_level;
+    // FIFO: no untested pair is more than one level apart from another.
+    int lo = 100, hi = -1;
+    for (const NodePair& p : res.untested) {
+      lo = std::min(lo, std::min<int>(s.a.level[p.a], s.b.level[p.b]));
+      hi = std::max(hi, std::min<int>(s.a.level[p.a], s.b.level[p.b]));
+    }
+    if (!res.untested.empty()) {
+      EXPECT_LE(hi - lo, 1);
+    }
+  }
+  EXPECT_EQ(last, 3);
+}
+
+TEST(Traversal, PriorityWithSmallCapStaysConservative) {
+  const Scene s = torus_and_sphere(4, false);
+  const auto full_set = as_set(collide(s.a, s.b, CollisionRequest{}).colliding);
+  CollisionRequest r;
+  r.mode = TraversalMode::Priority;
+  r.max_list_size = 16;
+  const CollisionResult res = collide(s.a, s.b, r);
+  EXPECT_LE(res.peak_list_size, 16u);
+  EXPECT_FALSE(res.interrupted);
+  EXPECT_FALSE(res.untested.empty());  // the cap held some pairs back
+  expect_cut_covers(s.a, s.b, full_set, res);
+}
+
+TEST(Traversal, DepthCapStopsAtTheLevel) {
+  const Scene s = torus_and_sphere(4, false);
+  const auto full_set = as_set(collide(s.a, s.b, CollisionRequest{}).colliding);
+  CollisionRequest r;
+  r.mode = TraversalMode::DepthFirst;
+  r.depth_cap = 2;
+  const CollisionResult res = collide(s.a, s.b, r);
+  EXPECT_TRUE(res.colliding.empty());
+  for (const NodePair& p : res.untested) {
+    EXPECT_LE(s.a.level[p.a], 2);
+    EXPECT_LE(s.b.level[p.b], 2);
+  }
+  EXPECT_EQ(res.completed_level, 2);
+  expect_cut_covers(s.a, s.b, full_set, res);
+}
+
+TEST(Traversal, TemporalCoherenceFrontIsConservative) {
+  for (bool make_layered : {true, false}) {
+    Scene s = torus_and_sphere(4, make_layered);
+    CollisionRequest r;
+    r.record_front = true;
+    CollisionResult prev = collide(s.a, s.b, r);
+    // Move b a little each frame; starting from the previous front must find
+    // what a query from the roots finds (exactly so for layered trees; for
+    // wrapped trees it may keep pairs whose ancestors separated).
+    for (int frame = 1; frame <= 5; ++frame) {
+      for (Sphere& sp : s.b.spheres) {
+        sp.x += 0.03;
+        sp.y -= 0.01;
+      }
+      const auto from_roots = as_set(collide(s.a, s.b, CollisionRequest{}).colliding);
+      CollisionRequest rf = r;
+      rf.start_front = &prev.front;
+      const CollisionResult from_front = collide(s.a, s.b, rf);
+      const auto got = as_set(from_front.colliding);
+      if (make_layered) {
+        EXPECT_EQ(got, from_roots) << "frame " << frame;
+      } else {
+        for (const auto& p : from_roots) EXPECT_TRUE(got.count(p)) << "frame " << frame;
+        const auto upper = brute_force_leaf_overlaps(s.a, s.b);
+        for (const auto& p : got) EXPECT_TRUE(upper.count(p)) << "frame " << frame;
+      }
+      prev = from_front;
+    }
+  }
+}
+
+TEST(Traversal, TemporalCoherenceRefinesInterruptedQueriesOverFrames) {
+  const Scene s = torus_and_sphere(4, true);
+  const CollisionResult full = collide(s.a, s.b, CollisionRequest{});
+  const auto full_set = as_set(full.colliding);
+  CollisionRequest ri;
+  ri.record_front = true;
+  ri.budget_tests = (3 * full.tests) / 4;
+  const CollisionResult from_roots = collide(s.a, s.b, ri);
+  ASSERT_TRUE(from_roots.interrupted);
+  CollisionResult cur = from_roots;
+  for (int frame = 0; frame < 6; ++frame) {
+    const std::vector<NodePair> front = cur.front;
+    ri.start_front = &front;
+    const CollisionResult next = collide(s.a, s.b, ri);
+    expect_cut_covers(s.a, s.b, full_set, next);
+    // Same budget, a tighter answer than the previous frame's.
+    EXPECT_LE(next.untested.size(), cur.untested.size());
+    EXPECT_GE(next.colliding.size(), cur.colliding.size());
+    cur = next;
+  }
+  EXPECT_LT(cur.untested.size(), from_roots.untested.size() / 4);
+  EXPECT_GT(cur.colliding.size(), from_roots.colliding.size());
+  for (const NodePair& p : cur.colliding) EXPECT_TRUE(full_set.count({p.a, p.b}));
+}
+
+TEST(Traversal, TimeBudgetStopsAndRejectsBadRequests) {
+  const Scene s = torus_and_sphere(4, false);
+  CollisionRequest r;
+  r.budget_seconds = 1e-9;
+  const CollisionResult res = collide(s.a, s.b, r);
+  EXPECT_TRUE(res.interrupted);
+  EXPECT_EQ(res.stop_reason, StopReason::TimeBudget);
+  EXPECT_EQ(res.completed_level, 0);
+  r.clock = ClockSource::CycleCounter;
+  EXPECT_TRUE(collide(s.a, s.b, r).interrupted);
+  CollisionRequest bad;
+  bad.budget_seconds = 0;
+  EXPECT_THROW(collide(s.a, s.b, bad), ParameterError);
+  bad = {};
+  bad.clock_check_interval = 0;
+  EXPECT_THROW(collide(s.a, s.b, bad), ParameterError);
+  bad = {};
+  bad.budget_tests = -5;
+  EXPECT_THROW(collide(s.a, s.b, bad), ParameterError);
+  std::vector<NodePair> front{{0, 100000}};
+  bad = {};
+  bad.start_front = &front;
+  EXPECT_THROW(collide(s.a, s.b, bad), ParameterError);
+}
+
+}  // namespace
+}  // namespace icd::collision
