@@ -1,0 +1,40 @@
+#pragma once
+/// Writing meshes, sphere sets and time series for ParaView and meshio:
+/// VTK XML UnstructuredGrid (.vtu) in the "ascii" data format, and PVD
+/// collections. Doubles are written in the shortest form that reads back
+/// exactly. Every file is written atomically (see write_file_atomically).
+///
+/// Common errors: ParameterError (message names the file and the array/row)
+/// for non-finite coordinates or values, indices outside [0, #points), a point
+/// data array whose row count differs from #points or that has no columns, an
+/// empty or duplicate array name; InputError if the file cannot be written.
+#include <filesystem>
+#include <span>
+
+#include "mesh/io/types.hpp"
+#include "mesh/io/vtk_types.hpp"
+
+namespace icd {
+
+/// Writes the tetrahedra T of `mesh` as VTK_TETRA (10) cells over the points V,
+/// plus the optional point-data arrays (#V rows each). The boundary F is not
+/// written (read_vtu_tet_mesh recomputes it).
+void write_vtu_tet_mesh(const std::filesystem::path& path, const TetMesh& mesh,
+                        std::span<const PointDataArray> point_data = {});
+
+/// Writes the triangles F of `mesh` as VTK_TRIANGLE (5) cells over the points V.
+void write_vtu_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh,
+                            std::span<const PointDataArray> point_data = {});
+
+/// Writes one VTK_VERTEX (1) cell per sphere centre and the radii as the
+/// point-data array "radius" (so ParaView's Glyph filter can scale spheres by
+/// it), plus the optional arrays (#S rows each; none may be named "radius").
+/// Radii must be finite and >= 0.
+void write_vtu_sphere_set(const std::filesystem::path& path, const SphereSet& spheres,
+                          std::span<const PointDataArray> point_data = {});
+
+/// Writes a PVD collection listing `entries` in the given order (one
+/// DataSet per entry, part 0). Times must be finite; file names non-empty.
+void write_pvd(const std::filesystem::path& path, std::span<const PvdEntry> entries);
+
+}  // namespace icd
