@@ -204,8 +204,10 @@ Array read_data_array(XmlScanner& xml, const Tag& tag) {
 }  // namespace
 
 VtuData read_vtu(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  const std::string bytes = detail::read_file_bytes(path);
+  return parse_vtu(detail::read_file_bytes(path), path.string());
+}
+
+VtuData parse_vtu(std::string_view bytes, std::string_view source) {
   XmlScanner xml(bytes, source);
   Tag tag;
   if (!xml.next(tag) || tag.name != "VTKFile")

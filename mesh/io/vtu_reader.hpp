@@ -5,6 +5,7 @@
 /// with a clear error.
 #include <cstdint>
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 #include "mesh/io/types.hpp"
@@ -26,6 +27,10 @@ struct VtuData {
 /// in [0, #P), all values are finite, point-data arrays have #P rows.
 /// Throws InputError "<path>: [line N: ]<reason>" on any malformed input.
 VtuData read_vtu(const std::filesystem::path& path);
+
+/// Same as read_vtu on in-memory file contents (for fuzzing); `source` names
+/// the data in error messages.
+VtuData parse_vtu(std::string_view bytes, std::string_view source);
 
 /// Reads a tetrahedral mesh: every cell must be VTK_TETRA (10) and positively
 /// oriented (signed volume > 0). F is recomputed with boundary_faces().
