@@ -2,6 +2,8 @@
 
 #include <random>
 
+#include <Eigen/Geometry>
+
 #include "collision/coverage.hpp"
 #include "collision/node_association.hpp"
 #include "collision/octree_tree.hpp"
