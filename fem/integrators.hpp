@@ -1,0 +1,38 @@
+#pragma once
+/// Time integrators of a Model: RK4 (the paper's), symplectic Euler (one force
+/// evaluation per step) and backward Euler (see backward_euler.hpp).
+#include "fem/model.hpp"
+
+namespace icd::fem {
+
+/// Time integration scheme.
+enum class Integrator {
+  RK4,              ///< classical 4th-order Runge-Kutta on (x, v) (paper section 3)
+  SymplecticEuler,  ///< v += h a(x, v); x += h v (central differences)
+  BackwardEuler     ///< implicit, Newton + CHOLMOD; unconditionally stable
+};
+
+/// "rk4", "symplectic_euler", "backward_euler".
+const char* to_string(Integrator integrator);
+
+/// Dynamic state of one object.
+struct State {
+  MatX3d x;  ///< positions (#V x 3), m
+  MatX3d v;  ///< velocities (#V x 3), m/s
+};
+
+/// Explicit steppers with their scratch buffers (no allocation per step).
+class ExplicitStepper {
+ public:
+  /// One symplectic Euler step of size h (s): v1 = v0 + h a(x0, v0), x1 = x0 + h v1.
+  /// One force evaluation (two with stiffness damping).
+  void symplectic_euler(Model& model, State& s, double h);
+  /// One classical RK4 step of size h on y = (x, v), y' = (v, a(x, v)): four evaluations.
+  void rk4(Model& model, State& s, double h);
+
+ private:
+  void resize(int n);
+  MatX3d m_a, m_x, m_v, m_dx, m_dv;
+};
+
+}  // namespace icd::fem

@@ -1,0 +1,99 @@
+#include "fem/model.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "fem/mass.hpp"
+#include "mesh/io/error.hpp"
+
+namespace icd::fem {
+
+Model::Model(const Eigen::Ref<const MatX3d>& rest_positions, const Eigen::Ref<const MatX4i>& tets,
+             const Material& material, const ModelOptions& options)
+    : m_forces(make_tet_mesh_data(rest_positions, tets), material, options.forces) {
+  m_mass = lumped_mass(m_forces.mesh(), material.density);
+  m_fixed.assign(num_nodes(), 0);
+  m_external = MatX3d::Zero(num_nodes(), 3);
+  m_scratch.resize(num_nodes(), 3);
+  set_gravity(options.gravity);
+  set_damping(options.damping);
+}
+
+void Model::set_fixed_nodes(const std::vector<int>& nodes) {
+  std::vector<char> fixed(num_nodes(), 0);
+  for (int i : nodes) {
+    if (i < 0 || i >= num_nodes())
+      throw ParameterError("fem::Model::set_fixed_nodes: node " + std::to_string(i) +
+                           " is out of range [0, " + std::to_string(num_nodes()) + ")");
+    fixed[i] = 1;
+  }
+  m_fixed = std::move(fixed);
+}
+
+std::vector<char> Model::fixed_dofs() const {
+  std::vector<char> d(3 * static_cast<size_t>(num_nodes()));
+  for (int i = 0; i < num_nodes(); ++i) d[3 * i] = d[3 * i + 1] = d[3 * i + 2] = m_fixed[i];
+  return d;
+}
+
+void Model::set_external_forces(const Eigen::Ref<const MatX3d>& forces) {
+  if (forces.rows() != num_nodes())
+    throw ParameterError("fem::Model::set_external_forces: " + std::to_string(forces.rows()) +
+                         " rows, expected #V = " + std::to_string(num_nodes()));
+  for (int i = 0; i < num_nodes(); ++i)
+    if (!forces.row(i).allFinite())
+      throw ParameterError("fem::Model::set_external_forces: force on node " + std::to_string(i) +
+                           " is not finite");
+  m_external = forces;
+}
+
+void Model::set_gravity(const Eigen::Vector3d& gravity) {
+  if (!gravity.allFinite()) throw ParameterError("fem::Model: gravity is not finite");
+  m_gravity = gravity;
+}
+
+void Model::set_damping(const RayleighDamping& damping) {
+  if (!(damping.alpha >= 0) || !(damping.beta >= 0) || !std::isfinite(damping.alpha) ||
+      !std::isfinite(damping.beta))
+    throw ParameterError("fem::RayleighDamping: alpha = " + std::to_string(damping.alpha) +
+                         ", beta = " + std::to_string(damping.beta) +
+                         " are invalid: expected finite values >= 0");
+  m_damping = damping;
+}
+
+void Model::total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
+                        Eigen::Ref<MatX3d> f) {
+  m_forces.compute(x, f);
+  if (m_damping.beta > 0) {
+    m_forces.differential(x, v, m_scratch);  // -K v
+    f += m_damping.beta * m_scratch;
+  }
+  const int n = num_nodes();
+  for (int i = 0; i < n; ++i) {
+    if (m_fixed[i]) {
+      f.row(i).setZero();
+      continue;
+    }
+    const double m = m_mass[i];
+    for (int c = 0; c < 3; ++c) f(i, c) += m_external(i, c) + m * (m_gravity[c] - m_damping.alpha * v(i, c));
+  }
+}
+
+void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
+                         Eigen::Ref<MatX3d> a) {
+  total_force(x, v, a);
+  for (int i = 0; i < num_nodes(); ++i) a.row(i) /= m_mass[i];
+}
+
+double Model::kinetic_energy(const Eigen::Ref<const MatX3d>& v) const {
+  return 0.5 * (m_mass.array() * v.rowwise().squaredNorm().array()).sum();
+}
+
+double Model::load_potential(const Eigen::Ref<const MatX3d>& x) const {
+  double p = 0;
+  for (int i = 0; i < num_nodes(); ++i)
+    if (!m_fixed[i]) p -= (m_external.row(i) + m_mass[i] * m_gravity.transpose()).dot(x.row(i));
+  return p;
+}
+
+}  // namespace icd::fem

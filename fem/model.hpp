@@ -1,0 +1,82 @@
+#pragma once
+/// The physical model of one deformable object: elastic forces, lumped mass,
+/// Rayleigh damping and boundary conditions (fixed nodes, external nodal
+/// forces, gravity). Integrators and solvers act on it.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fem/forces.hpp"
+
+namespace icd::fem {
+
+/// Rayleigh damping C = alpha M + beta K(x).
+struct RayleighDamping {
+  double alpha = 0;  ///< mass-proportional coefficient, 1/s, >= 0
+  double beta = 0;   ///< stiffness-proportional coefficient, s, >= 0
+};
+
+/// Options of a Model.
+struct ModelOptions {
+  RayleighDamping damping;
+  Eigen::Vector3d gravity{0.0, 0.0, 0.0};  ///< m/s^2
+  ForceOptions forces;
+};
+
+/// One object. Positions and velocities (#V x 3) are passed in; the model
+/// itself is stateless apart from boundary conditions and scratch space.
+class Model {
+ public:
+  /// rest_positions V (#V x 3, m), tets T (#T x 4, positive). Throws InputError
+  /// for a bad mesh and ParameterError for a bad material or options.
+  Model(const Eigen::Ref<const MatX3d>& rest_positions, const Eigen::Ref<const MatX4i>& tets,
+        const Material& material, const ModelOptions& options = {});
+
+  int num_nodes() const { return m_forces.mesh().num_nodes; }
+  const TetMeshData& mesh() const { return m_forces.mesh(); }
+  const Material& material() const { return m_forces.material(); }
+  ElasticForces& elastic() { return m_forces; }
+  /// Lumped nodal masses (#V), kg.
+  const Eigen::VectorXd& mass() const { return m_mass; }
+
+  /// Fixes the given nodes (their velocity and acceleration stay zero).
+  /// Throws ParameterError naming an out-of-range node.
+  void set_fixed_nodes(const std::vector<int>& nodes);
+  /// Per-node flag (#V), 1 for fixed.
+  const std::vector<char>& fixed_nodes() const { return m_fixed; }
+  /// Per-dof flag (3#V), 1 for a dof of a fixed node.
+  std::vector<char> fixed_dofs() const;
+  /// External nodal forces (#V x 3, N), constant until changed; the coupling
+  /// layer adds contact forces here. Throws ParameterError on a shape mismatch
+  /// or a non-finite entry (naming the node).
+  void set_external_forces(const Eigen::Ref<const MatX3d>& forces);
+  const MatX3d& external_forces() const { return m_external; }
+  void set_gravity(const Eigen::Vector3d& gravity);
+  const Eigen::Vector3d& gravity() const { return m_gravity; }
+  /// Throws ParameterError for negative or non-finite coefficients.
+  void set_damping(const RayleighDamping& damping);
+  const RayleighDamping& damping() const { return m_damping; }
+
+  /// Total force on every node (#V x 3, N): f_int(x) + f_ext + m g - alpha m v
+  /// - beta K(x) v; zero rows at fixed nodes.
+  void total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
+                   Eigen::Ref<MatX3d> f);
+  /// Accelerations M^-1 total_force (#V x 3, m/s^2), zero at fixed nodes.
+  void acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
+                    Eigen::Ref<MatX3d> a);
+  /// Kinetic energy 1/2 sum m |v|^2, J.
+  double kinetic_energy(const Eigen::Ref<const MatX3d>& v) const;
+  /// Potential of the conservative loads: -sum (f_ext + m g) . x, J.
+  double load_potential(const Eigen::Ref<const MatX3d>& x) const;
+
+ private:
+  ElasticForces m_forces;
+  Eigen::VectorXd m_mass;
+  std::vector<char> m_fixed;
+  MatX3d m_external;
+  Eigen::Vector3d m_gravity;
+  RayleighDamping m_damping;
+  MatX3d m_scratch;
+};
+
+}  // namespace icd::fem

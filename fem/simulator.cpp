@@ -1,0 +1,196 @@
+#include "fem/simulator.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "mesh/io/error.hpp"
+
+namespace icd::fem {
+
+Simulator::Simulator(Model model, const SimulatorOptions& options)
+    : m_model(std::move(model)), m_options(options) {
+  auto bad = [](const char* field, double value, const char* range) {
+    std::ostringstream os;
+    os << "fem::SimulatorOptions." << field << " = " << value << " is invalid: expected " << range;
+    throw ParameterError(os.str());
+  };
+  if (!(options.safety_factor > 0 && options.safety_factor <= 1)) bad("safety_factor", options.safety_factor, "(0, 1]");
+  if (!(options.fixed_step >= 0) || !std::isfinite(options.fixed_step)) bad("fixed_step", options.fixed_step, ">= 0 s");
+  if (!(options.max_step > 0) || !std::isfinite(options.max_step)) bad("max_step", options.max_step, "> 0 s");
+  if (options.check_interval < 1) bad("check_interval", options.check_interval, ">= 1");
+  if (!(options.max_energy_growth > 0)) bad("max_energy_growth", options.max_energy_growth, "> 0");
+  if (options.max_retries < 0) bad("max_retries", options.max_retries, ">= 0");
+  m_state.x = m_model.mesh().rest_positions;
+  m_state.v = MatX3d::Zero(m_model.num_nodes(), 3);
+  m_energy_floor = 1e-10 * m_model.material().young * m_model.mesh().rest_volume.sum();
+}
+
+void Simulator::set_positions(const Eigen::Ref<const MatX3d>& x) {
+  if (x.rows() != m_model.num_nodes() || !x.allFinite())
+    throw ParameterError("fem::Simulator::set_positions: expected a finite #V x 3 array, #V = " +
+                         std::to_string(m_model.num_nodes()));
+  m_state.x = x;
+}
+
+void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
+  if (v.rows() != m_model.num_nodes() || !v.allFinite())
+    throw ParameterError("fem::Simulator::set_velocities: expected a finite #V x 3 array, #V = " +
+                         std::to_string(m_model.num_nodes()));
+  m_state.v = v;
+  for (int i = 0; i < m_model.num_nodes(); ++i)
+    if (m_model.fixed_nodes()[i]) m_state.v.row(i).setZero();
+}
+
+double Simulator::stable_step_limit() {
+  if (m_options.integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
+  m_frequency = estimate_max_frequency(m_model, m_state.x, m_options.frequency, &m_warm_mode);
+  if (m_frequency.omega_max <= 0) return std::numeric_limits<double>::infinity();  // all fixed
+  return fem::stable_step_limit(m_options.integrator, m_frequency.omega_max, m_model.damping());
+}
+
+double Simulator::total_energy() {
+  return m_model.kinetic_energy(m_state.v) + m_model.elastic().energy(m_state.x) +
+         m_model.load_potential(m_state.x);
+}
+
+void Simulator::refuse_if_above_limit(double h, double limit, const char* what) const {
+  if (h <= limit) return;
+  std::ostringstream os;
+  os << "fem::Simulator: " << what << " " << h << " s exceeds the stable step limit " << limit << " s of "
+     << to_string(m_options.integrator) << " for the current state (largest eigenfrequency "
+     << m_frequency.omega_max << " rad/s, Rayleigh alpha " << m_model.damping().alpha << ", beta "
+     << m_model.damping().beta << ", contact stiffness " << m_options.frequency.contact_stiffness
+     << " N/m); use a step <= " << limit << " s or automatic stepping (fixed_step = 0)";
+  throw ParameterError(os.str());
+}
+
+void Simulator::integrate(double h) {
+  switch (m_options.integrator) {
+    case Integrator::RK4: m_explicit.rk4(m_model, m_state, h); break;
+    case Integrator::SymplecticEuler: m_explicit.symplectic_euler(m_model, m_state, h); break;
+    case Integrator::BackwardEuler: m_implicit.step(m_model, m_state, h, m_options.newton); break;
+  }
+}
+
+Simulator::Check Simulator::check(const Check& before) {
+  Check c;
+  const int n = m_model.num_nodes();
+  for (int i = 0; i < n; ++i)
+    if (!m_state.x.row(i).allFinite() || !m_state.v.row(i).allFinite()) {
+      std::ostringstream os;
+      os << "node " << i << " has a non-finite state: x = (" << m_state.x.row(i) << "), v = ("
+         << m_state.v.row(i) << ")";
+      c.ok = false;
+      c.message = os.str();
+      return c;
+    }
+  const ElementHealth h = m_model.elastic().health(m_state.x);
+  const bool allow_inversion =
+      m_options.inversion == InversionPolicy::Allow ||
+      (m_options.inversion == InversionPolicy::Auto && m_model.material().model == MaterialModel::StableNeoHookean);
+  if (h.first_nonfinite_element >= 0 || (!allow_inversion && h.min_det_f <= 0)) {
+    const int e = h.first_nonfinite_element >= 0 ? h.first_nonfinite_element : h.min_det_f_element;
+    std::ostringstream os;
+    os << "element " << e << " (nodes " << m_model.mesh().tets.row(e) << ") "
+       << (h.first_nonfinite_element >= 0 ? "has a non-finite energy" : "is inverted")
+       << ": det F = " << m_model.mesh().deformation_gradient(m_state.x, e).determinant();
+    c.ok = false;
+    c.message = os.str();
+    return c;
+  }
+  c.kinetic = m_model.kinetic_energy(m_state.v);
+  c.elastic = h.energy;
+  c.load = m_model.load_potential(m_state.x);
+  const double growth = (c.kinetic + c.elastic) - (before.kinetic + before.elastic) + (c.load - before.load);
+  const double allowed = m_options.max_energy_growth *
+                             (before.kinetic + before.elastic + std::abs(c.load - before.load)) +
+                         m_energy_floor;
+  if (!(growth <= allowed)) {
+    std::ostringstream os;
+    os << "total energy grew by " << growth << " J (allowed " << allowed << " J): kinetic "
+       << before.kinetic << " -> " << c.kinetic << " J, elastic " << before.elastic << " -> " << c.elastic
+       << " J, load potential " << before.load << " -> " << c.load << " J";
+    c.ok = false;
+    c.message = os.str();
+  }
+  return c;
+}
+
+AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
+  State good = m_state;
+  double t_good = 0, t = 0;
+  Check before;
+  {
+    const ElementHealth eh = m_model.elastic().health(m_state.x);
+    before.kinetic = m_model.kinetic_energy(m_state.v);
+    before.elastic = eh.energy;
+    before.load = m_model.load_potential(m_state.x);
+  }
+  const double h0 = h;
+  int since_check = 0, steps = 0, steps_good = 0;
+  while (t < total) {
+    const int remaining = static_cast<int>(std::ceil((total - t) / h * (1 - 1e-12)));
+    const double hh = (total - t) / std::max(remaining, 1);
+    integrate(hh);
+    ++steps;
+    t = (remaining <= 1) ? total : t + hh;
+    ++since_check;
+    if (since_check < m_options.check_interval && t < total) continue;
+    since_check = 0;
+    const Check c = check(before);
+    if (c.ok) {
+      good = m_state;
+      t_good = t;
+      before = c;
+      steps_good = steps;
+      continue;
+    }
+    if (rep.retries >= m_options.max_retries) {
+      std::ostringstream os;
+      os << "fem::Simulator: " << to_string(m_options.integrator) << " failed the health check after "
+         << rep.retries << " retries at t = " << m_time + t << " s (step reduced from " << h0 << " to " << hh
+         << " s): " << c.message;
+      m_state = good;
+      m_time += t_good;
+      throw NumericalError(os.str());
+    }
+    ++rep.retries;
+    m_state = good;
+    t = t_good;
+    steps = steps_good;
+    h *= 0.5;
+  }
+  rep.step = h;
+  rep.substeps = steps;
+  m_time += total;
+  return rep;
+}
+
+AdvanceReport Simulator::advance(double frame_dt) {
+  if (!(frame_dt > 0) || !std::isfinite(frame_dt))
+    throw ParameterError("fem::Simulator::advance: frame_dt = " + std::to_string(frame_dt) + " must be > 0");
+  AdvanceReport rep;
+  rep.step_limit = stable_step_limit();
+  rep.omega_max = m_frequency.omega_max;
+  double h;
+  if (m_options.fixed_step > 0) {
+    refuse_if_above_limit(m_options.fixed_step, rep.step_limit, "fixed_step");
+    h = m_options.fixed_step;
+  } else {
+    h = std::min(m_options.max_step, m_options.safety_factor * rep.step_limit);
+  }
+  return run(frame_dt, std::min(h, frame_dt), rep);
+}
+
+AdvanceReport Simulator::step(double dt) {
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw ParameterError("fem::Simulator::step: dt = " + std::to_string(dt) + " must be > 0");
+  AdvanceReport rep;
+  rep.step_limit = stable_step_limit();
+  rep.omega_max = m_frequency.omega_max;
+  refuse_if_above_limit(dt, rep.step_limit, "step dt");
+  return run(dt, dt, rep);
+}
+
+}  // namespace icd::fem

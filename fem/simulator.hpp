@@ -1,0 +1,107 @@
+#pragma once
+/// The simulation object of one deformable body: state, frame advance with
+/// automatic sub-stepping below the stable limit, health checks with rollback
+/// and bounded retries.
+#include <string>
+
+#include "fem/backward_euler.hpp"
+#include "fem/integrators.hpp"
+#include "fem/stable_step.hpp"
+
+namespace icd::fem {
+
+/// Whether an inverted element (det F <= 0) fails the health check.
+enum class InversionPolicy {
+  Auto,   ///< allowed only for the inversion-safe StableNeoHookean model
+  Allow,
+  Fail
+};
+
+/// Options of a Simulator.
+struct SimulatorOptions {
+  Integrator integrator = Integrator::RK4;
+  /// Automatic steps are safety_factor x the stable limit, in (0, 1].
+  double safety_factor = 0.9;
+  /// > 0: use this step (s); refused with a ParameterError naming the limit if
+  /// it exceeds the stable limit of the current state. 0: automatic.
+  double fixed_step = 0;
+  /// Largest step (s), also the backward Euler step when fixed_step is 0.
+  double max_step = 1e-2;
+  FrequencyOptions frequency;  ///< includes the added contact stiffness
+  int check_interval = 1;      ///< sub-steps between health checks (>= 1)
+  /// A check fails when KE + W grows by more than this fraction of
+  /// (KE + W + |work of the loads|) since the last check (explicit blow-up).
+  double max_energy_growth = 1.0;
+  InversionPolicy inversion = InversionPolicy::Auto;
+  int max_retries = 6;  ///< halvings of the step before giving up
+  NewtonOptions newton; ///< backward Euler
+};
+
+/// What advance() did.
+struct AdvanceReport {
+  int substeps = 0;       ///< accepted sub-steps
+  int retries = 0;        ///< rollbacks
+  double step = 0;        ///< last sub-step used, s
+  double step_limit = 0;  ///< stable limit at the start of the frame, s (inf for backward Euler)
+  double omega_max = 0;   ///< estimated largest eigenfrequency at the start, rad/s
+};
+
+/// One object over time. Starts at rest in the rest configuration.
+class Simulator {
+ public:
+  /// Throws ParameterError for invalid options.
+  Simulator(Model model, const SimulatorOptions& options = {});
+
+  Model& model() { return m_model; }
+  const SimulatorOptions& options() const { return m_options; }
+  const State& state() const { return m_state; }
+  const MatX3d& positions() const { return m_state.x; }
+  const MatX3d& velocities() const { return m_state.v; }
+  double time() const { return m_time; }
+  /// Sets positions / velocities (#V x 3); ParameterError on shape or non-finite values.
+  void set_positions(const Eigen::Ref<const MatX3d>& x);
+  void set_velocities(const Eigen::Ref<const MatX3d>& v);
+  /// Forwards to Model::set_external_forces.
+  void set_external_forces(const Eigen::Ref<const MatX3d>& f) { m_model.set_external_forces(f); }
+
+  /// Stable step limit (s) of the configured integrator for the current state
+  /// (inf for backward Euler); also updates last_frequency().
+  double stable_step_limit();
+  const FrequencyEstimate& last_frequency() const { return m_frequency; }
+
+  /// Advances by frame_dt (s) in equal sub-steps: the fixed step, or
+  /// safety_factor x the current limit (capped at max_step). Health checks
+  /// every check_interval sub-steps; on failure rolls back to the last good
+  /// state, halves the step and retries, at most max_retries times, then
+  /// throws NumericalError naming the node/element and quantities.
+  AdvanceReport advance(double frame_dt);
+  /// One step of exactly dt (s) (sub-divided only by retries). Throws
+  /// ParameterError naming the limit if dt exceeds the stable limit.
+  AdvanceReport step(double dt);
+
+  /// Total mechanical energy KE + W + load potential of the current state, J.
+  double total_energy();
+
+ private:
+  struct Check {
+    bool ok = true;
+    std::string message;
+    double kinetic = 0, elastic = 0, load = 0;
+  };
+  Check check(const Check& before);
+  void integrate(double h);
+  AdvanceReport run(double total, double h, AdvanceReport rep);
+  void refuse_if_above_limit(double h, double limit, const char* what) const;
+
+  Model m_model;
+  SimulatorOptions m_options;
+  State m_state;
+  double m_time = 0;
+  ExplicitStepper m_explicit;
+  BackwardEulerStepper m_implicit;
+  FrequencyEstimate m_frequency;
+  Eigen::VectorXd m_warm_mode;
+  double m_energy_floor = 0;
+};
+
+}  // namespace icd::fem

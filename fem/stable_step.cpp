@@ -1,0 +1,141 @@
+#include "fem/stable_step.hpp"
+
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "mesh/io/error.hpp"
+
+namespace icd::fem {
+namespace {
+
+bool rk4_stable(std::complex<double> z) {
+  const std::complex<double> R = 1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6.0 + z / 24.0)));
+  return std::abs(R) <= 1.0 + 1e-12;
+}
+
+double rk4_mode_limit(double omega, double c) {
+  // Roots of s^2 + c s + omega^2 = 0.
+  const std::complex<double> disc = std::sqrt(std::complex<double>(c * c - 4 * omega * omega, 0.0));
+  const std::complex<double> s1 = 0.5 * (-c + disc), s2 = 0.5 * (-c - disc);
+  auto stable = [&](double h) { return rk4_stable(h * s1) && rk4_stable(h * s2); };
+  const double scale = std::max(std::abs(s1), std::abs(s2));
+  if (scale == 0) return std::numeric_limits<double>::infinity();
+  double lo = 0, hi = 1.0 / scale;
+  while (stable(hi)) {
+    lo = hi;
+    hi *= 2;
+  }
+  for (int i = 0; i < 80; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (stable(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+double symplectic_euler_mode_limit(double omega, double c) {
+  double h = (std::sqrt(c * c + 4 * omega * omega) - c) / (omega * omega);
+  if (c > 0) h = std::min(h, 2.0 / c);
+  return h;
+}
+
+}  // namespace
+
+double stable_step_limit(Integrator integrator, double omega_max, const RayleighDamping& damping) {
+  if (!(omega_max > 0) || !std::isfinite(omega_max))
+    throw ParameterError("fem::stable_step_limit: omega_max = " + std::to_string(omega_max) +
+                         " must be finite and > 0");
+  if (integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
+  double limit = std::numeric_limits<double>::infinity();
+  for (int k = 0; k <= 96; ++k) {  // omega_max * 10^(-6 .. 0)
+    const double omega = omega_max * std::pow(10.0, -6.0 * (96 - k) / 96.0);
+    const double c = damping.alpha + damping.beta * omega * omega;
+    const double h = integrator == Integrator::RK4 ? rk4_mode_limit(omega, c)
+                                                   : symplectic_euler_mode_limit(omega, c);
+    limit = std::min(limit, h);
+  }
+  return limit;
+}
+
+FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const MatX3d>& x,
+                                         const FrequencyOptions& options, Eigen::VectorXd* warm) {
+  if (options.max_iterations < 1 || !(options.contact_stiffness >= 0) || !(options.tolerance > 0))
+    throw ParameterError("fem::FrequencyOptions: expected max_iterations >= 1, tolerance > 0 and "
+                         "contact_stiffness >= 0");
+  const int n = model.num_nodes();
+  const int ndof = 3 * n;
+  Eigen::VectorXd free = Eigen::VectorXd::Zero(ndof), inv_sqrt_m(ndof);
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      free[3 * i + c] = model.fixed_nodes()[i] ? 0.0 : 1.0;
+      inv_sqrt_m[3 * i + c] = 1.0 / std::sqrt(model.mass()[i]);
+    }
+  const int nfree = static_cast<int>(free.sum());
+  FrequencyEstimate est;
+  if (nfree == 0) return est;
+
+  MatX3d u(n, 3), du(n, 3);
+  auto apply = [&](const Eigen::VectorXd& q, Eigen::VectorXd& out) {
+    Eigen::Map<Eigen::VectorXd>(u.data(), ndof) = inv_sqrt_m.cwiseProduct(q).cwiseProduct(free);
+    model.elastic().differential(x, u, du);  // -K u
+    out = (-inv_sqrt_m.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(du.data(), ndof)) +
+           options.contact_stiffness * inv_sqrt_m.cwiseProduct(inv_sqrt_m).cwiseProduct(q))
+              .cwiseProduct(free);
+  };
+
+  Eigen::VectorXd q0(ndof);
+  if (warm && warm->size() == ndof && warm->cwiseProduct(free).norm() > 0) {
+    q0 = warm->cwiseProduct(free);
+  } else {
+    std::mt19937 gen(12345);
+    std::uniform_real_distribution<double> dist(-1.0, 1.0);
+    for (int k = 0; k < ndof; ++k) q0[k] = dist(gen);
+    q0 = q0.cwiseProduct(free);
+  }
+  q0.normalize();
+
+  const int kmax = std::min(options.max_iterations, nfree);
+  std::vector<Eigen::VectorXd> Q{q0};
+  std::vector<double> alpha, beta;
+  Eigen::VectorXd w, ritz;
+  double theta = 0;
+  Eigen::VectorXd s_top;
+  for (int j = 0; j < kmax; ++j) {
+    apply(Q[j], w);
+    alpha.push_back(Q[j].dot(w));
+    for (int pass = 0; pass < 2; ++pass)  // full reorthogonalisation, twice is enough
+      for (const auto& qi : Q) w -= qi.dot(w) * qi;
+    beta.push_back(w.norm());
+    const int k = j + 1;
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(k, k);
+    for (int i = 0; i < k; ++i) {
+      T(i, i) = alpha[i];
+      if (i + 1 < k) T(i, i + 1) = T(i + 1, i) = beta[i];
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T);
+    theta = es.eigenvalues()[k - 1];
+    s_top = es.eigenvectors().col(k - 1);
+    est.iterations = k;
+    est.residual = std::abs(beta[j] * s_top[k - 1]) / std::max(std::abs(theta), 1e-300);
+    if (est.residual <= options.tolerance || beta[j] <= 1e-14 * std::abs(theta)) {
+      est.converged = true;
+      break;
+    }
+    Q.push_back(w / beta[j]);
+  }
+  if (!std::isfinite(theta))
+    throw NumericalError("fem::estimate_max_frequency: the stiffness of the current state is not finite");
+  est.omega_max = std::sqrt(std::max(theta, 0.0));
+  if (warm) {
+    ritz = Eigen::VectorXd::Zero(ndof);
+    for (int i = 0; i < static_cast<int>(s_top.size()); ++i) ritz += s_top[i] * Q[i];
+    *warm = ritz;
+  }
+  return est;
+}
+
+}  // namespace icd::fem
