@@ -11,4 +11,4 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DICD_BUILD_TESTS=OFF -DICD_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$build" -j2 --target icd-main
 results="$root/results/main"
-"$build/experiments/icd-main" --out "$results" "$@"
+"$build/bin/icd-main" --out "$results" "$@"
