@@ -81,9 +81,11 @@ void BM_VtuWriteRead(benchmark::State& state) {
 }
 
 BENCHMARK_CAPTURE(BM_ParseOff_Ours, bunny, "bunny00.off")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_ParseOff_IostreamBaseline, bunny, "bunny00.off")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ParseOff_IostreamBaseline, bunny, "bunny00.off")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ReadSurfaceMesh_FromFile, bunny, "bunny00.off")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_ParseOff_Ours, dragon, "ChineseDragon-10kv.off")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ParseOff_Ours, dragon, "ChineseDragon-10kv.off")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ParseOff_IostreamBaseline, dragon, "ChineseDragon-10kv.off")
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VtuWriteRead)->Unit(benchmark::kMillisecond);

@@ -26,8 +26,10 @@ void print_stats(const std::string& file, const icd::ReadReport& report, double 
   row("vertices", std::to_string(s.vertices));
   row("faces", std::to_string(s.faces));
   row("edges", std::to_string(s.edges));
-  row("bounding box min", num(s.bbox_min.x()) + " " + num(s.bbox_min.y()) + " " + num(s.bbox_min.z()));
-  row("bounding box max", num(s.bbox_max.x()) + " " + num(s.bbox_max.y()) + " " + num(s.bbox_max.z()));
+  row("bounding box min",
+      num(s.bbox_min.x()) + " " + num(s.bbox_min.y()) + " " + num(s.bbox_min.z()));
+  row("bounding box max",
+      num(s.bbox_max.x()) + " " + num(s.bbox_max.y()) + " " + num(s.bbox_max.z()));
   row("surface area", num(s.area));
   row("enclosed volume", num(s.volume) + (s.boundary_edges > 0 ? " (surface is open)" : ""));
   row("boundary edges", std::to_string(s.boundary_edges));
@@ -45,10 +47,11 @@ void print_stats(const std::string& file, const icd::ReadReport& report, double 
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
-    std::fprintf(stderr,
-                 "usage: %s FILE...\n"
-                 "Reads triangle surface meshes (.off .obj .ply .stl) and prints their statistics.\n",
-                 argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s FILE...\n"
+        "Reads triangle surface meshes (.off .obj .ply .stl) and prints their statistics.\n",
+        argv[0]);
     return argc < 2 ? 2 : 0;
   }
   int status = 0;

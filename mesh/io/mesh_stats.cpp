@@ -60,7 +60,8 @@ SurfaceStats compute_surface_stats(const SurfaceMesh& mesh) {
     if (repeated || n.norm() <= 1e-12 * longest) ++s.degenerate_faces;
     for (int k = 0; k < 3; ++k) {
       const int i = F(f, k), j = F(f, (k + 1) % 3);
-      const auto lo = static_cast<uint64_t>(std::min(i, j)), hi = static_cast<uint64_t>(std::max(i, j));
+      const auto lo = static_cast<uint64_t>(std::min(i, j)),
+                 hi = static_cast<uint64_t>(std::max(i, j));
       half[3 * f + k] = {lo << 32 | hi, i < j};
       referenced[i] = 1;
       const int ri = find_root(parent, i), rj = find_root(parent, j);
@@ -83,8 +84,10 @@ SurfaceStats compute_surface_stats(const SurfaceMesh& mesh) {
     i = j;
   }
   for (int i = 0; i < nv; ++i) {
-    if (!referenced[i]) ++s.unreferenced_vertices;
-    else if (find_root(parent, i) == i) ++s.components;
+    if (!referenced[i])
+      ++s.unreferenced_vertices;
+    else if (find_root(parent, i) == i)
+      ++s.components;
   }
 
   // Exact duplicates: sort indices by position, compare neighbours.

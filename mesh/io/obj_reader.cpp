@@ -17,10 +17,10 @@ using detail::NumberStatus;
 using detail::throw_input_error;
 
 bool is_known_ignored(std::string_view keyword) {
-  static constexpr std::string_view known[] = {"vt", "vn", "vp", "g", "o", "s", "usemtl", "mtllib",
-                                               "l", "p", "cstype", "deg", "curv", "surf", "parm",
-                                               "end", "bevel", "c_interp", "d_interp", "lod",
-                                               "shadow_obj", "trace_obj", "maplib", "usemap"};
+  static constexpr std::string_view known[] = {
+      "vt",    "vn",       "vp",       "g",   "o",          "s",         "usemtl", "mtllib",
+      "l",     "p",        "cstype",   "deg", "curv",       "surf",      "parm",   "end",
+      "bevel", "c_interp", "d_interp", "lod", "shadow_obj", "trace_obj", "maplib", "usemap"};
   for (const auto k : known)
     if (keyword == k) return true;
   return false;
@@ -44,9 +44,9 @@ SurfaceMesh parse_obj(std::string_view bytes, std::string_view source, ReadRepor
       double xyz[3];
       for (double& c : xyz) {
         if (!t.next(tok))
-          throw_input_error(source, ln,
-                            "vertex " + std::to_string(builder.num_vertices()) +
-                                ": expected 3 coordinates");
+          throw_input_error(
+              source, ln,
+              "vertex " + std::to_string(builder.num_vertices()) + ": expected 3 coordinates");
         const NumberStatus s = detail::parse_double(tok, c);
         if (s != NumberStatus::ok)
           throw_input_error(source, ln,
@@ -75,11 +75,10 @@ SurfaceMesh parse_obj(std::string_view bytes, std::string_view source, ReadRepor
           // Relative: -1 is the last vertex read so far.
           idx += builder.num_vertices();
           if (idx < 0)
-            throw_input_error(source, ln,
-                              face + ": relative vertex index " + std::string(index) +
-                                  " is out of range (only " +
-                                  std::to_string(builder.num_vertices()) +
-                                  " vertices read so far)");
+            throw_input_error(
+                source, ln,
+                face + ": relative vertex index " + std::string(index) + " is out of range (only " +
+                    std::to_string(builder.num_vertices()) + " vertices read so far)");
         } else {
           idx -= 1;
         }
@@ -89,9 +88,9 @@ SurfaceMesh parse_obj(std::string_view bytes, std::string_view source, ReadRepor
     } else if (!is_known_ignored(tok)) {
       ++unknown[std::string(tok.substr(0, 16))];
       if (unknown.size() > 8)
-        throw_input_error(source, ln,
-                          "not an OBJ file: too many unknown keywords (latest " + detail::quote(tok) +
-                              ")");
+        throw_input_error(
+            source, ln,
+            "not an OBJ file: too many unknown keywords (latest " + detail::quote(tok) + ")");
     }
   }
   for (const auto& [k, n] : unknown)

@@ -43,9 +43,9 @@ int64_t parse_count(std::string_view source, int64_t line, std::string_view toke
   int64_t v = 0;
   const NumberStatus s = detail::parse_int64(token, v);
   if (s != NumberStatus::ok)
-    throw_input_error(source, line,
-                      "expected the number of " + std::string(what) + ", found " +
-                          detail::quote(token));
+    throw_input_error(
+        source, line,
+        "expected the number of " + std::string(what) + ", found " + detail::quote(token));
   return v;
 }
 
@@ -97,9 +97,9 @@ SurfaceMesh parse_off(std::string_view bytes, std::string_view source, ReadRepor
   builder.reserve(nv, nf);
   for (int64_t i = 0; i < nv; ++i) {
     if (!next_content_line(lines, line))
-      throw_input_error(source, lines.line_number(),
-                        "truncated file: expected vertex " + std::to_string(i) + " of " +
-                            std::to_string(nv));
+      throw_input_error(
+          source, lines.line_number(),
+          "truncated file: expected vertex " + std::to_string(i) + " of " + std::to_string(nv));
     detail::Tokens t(line);
     double xyz[3];
     for (double& c : xyz) {
@@ -124,16 +124,16 @@ SurfaceMesh parse_off(std::string_view bytes, std::string_view source, ReadRepor
   std::vector<int64_t> corners;
   for (int64_t f = 0; f < nf; ++f) {
     if (!next_content_line(lines, line))
-      throw_input_error(source, lines.line_number(),
-                        "truncated file: expected face " + std::to_string(f) + " of " +
-                            std::to_string(nf));
+      throw_input_error(
+          source, lines.line_number(),
+          "truncated file: expected face " + std::to_string(f) + " of " + std::to_string(nf));
     detail::Tokens t(line);
     t.next(tok);
     int64_t n = 0;
     if (detail::parse_int64(tok, n) != NumberStatus::ok)
-      throw_input_error(source, lines.line_number(),
-                        "face " + std::to_string(f) + ": expected the vertex count, found " +
-                            detail::quote(tok));
+      throw_input_error(
+          source, lines.line_number(),
+          "face " + std::to_string(f) + ": expected the vertex count, found " + detail::quote(tok));
     if (n < 3)
       throw_input_error(source, lines.line_number(),
                         "face " + std::to_string(f) + ": has " + std::to_string(n) +

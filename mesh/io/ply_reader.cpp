@@ -27,10 +27,10 @@ bool parse_type(std::string_view s, Type& t) {
     Type type;
   };
   static constexpr Entry table[] = {
-      {"char", Type::i8},     {"int8", Type::i8},     {"uchar", Type::u8},  {"uint8", Type::u8},
-      {"short", Type::i16},   {"int16", Type::i16},   {"ushort", Type::u16}, {"uint16", Type::u16},
-      {"int", Type::i32},     {"int32", Type::i32},   {"uint", Type::u32},  {"uint32", Type::u32},
-      {"float", Type::f32},   {"float32", Type::f32}, {"double", Type::f64}, {"float64", Type::f64}};
+      {"char", Type::i8},   {"int8", Type::i8},     {"uchar", Type::u8},   {"uint8", Type::u8},
+      {"short", Type::i16}, {"int16", Type::i16},   {"ushort", Type::u16}, {"uint16", Type::u16},
+      {"int", Type::i32},   {"int32", Type::i32},   {"uint", Type::u32},   {"uint32", Type::u32},
+      {"float", Type::f32}, {"float32", Type::f32}, {"double", Type::f64}, {"float64", Type::f64}};
   for (const auto& e : table)
     if (s == e.name) {
       t = e.type;
@@ -42,13 +42,17 @@ bool parse_type(std::string_view s, Type& t) {
 int64_t type_size(Type t) {
   switch (t) {
     case Type::i8:
-    case Type::u8: return 1;
+    case Type::u8:
+      return 1;
     case Type::i16:
-    case Type::u16: return 2;
+    case Type::u16:
+      return 2;
     case Type::i32:
     case Type::u32:
-    case Type::f32: return 4;
-    case Type::f64: return 8;
+    case Type::f32:
+      return 4;
+    case Type::f64:
+      return 8;
   }
   return 0;
 }
@@ -57,9 +61,9 @@ bool is_integer(Type t) { return t != Type::f32 && t != Type::f64; }
 
 struct Property {
   std::string name;
-  Type type = Type::f32;        // value type (list items for a list)
+  Type type = Type::f32;  // value type (list items for a list)
   bool is_list = false;
-  Type count_type = Type::u8;   // list length type
+  Type count_type = Type::u8;  // list length type
 };
 
 struct Element {
@@ -84,14 +88,22 @@ class BinaryCursor {
     if (m_big != (std::endian::native == std::endian::big))
       for (size_t i = 0; i < n / 2; ++i) std::swap(b[i], b[n - 1 - i]);
     switch (t) {
-      case Type::i8: return static_cast<int8_t>(b[0]);
-      case Type::u8: return b[0];
-      case Type::i16: return load<int16_t>(b);
-      case Type::u16: return load<uint16_t>(b);
-      case Type::i32: return load<int32_t>(b);
-      case Type::u32: return load<uint32_t>(b);
-      case Type::f32: return load<float>(b);
-      case Type::f64: return load<double>(b);
+      case Type::i8:
+        return static_cast<int8_t>(b[0]);
+      case Type::u8:
+        return b[0];
+      case Type::i16:
+        return load<int16_t>(b);
+      case Type::u16:
+        return load<uint16_t>(b);
+      case Type::i32:
+        return load<int32_t>(b);
+      case Type::u32:
+        return load<uint32_t>(b);
+      case Type::f32:
+        return load<float>(b);
+      case Type::f64:
+        return load<double>(b);
     }
     return 0;
   }
@@ -136,10 +148,14 @@ Header parse_header(std::string_view bytes, std::string_view source) {
       t.next(f);
       if (!t.next(version) || version != "1.0")
         throw_input_error(source, ln, "expected 'format <type> 1.0'");
-      if (f == "ascii") h.format = Format::ascii;
-      else if (f == "binary_little_endian") h.format = Format::binary_le;
-      else if (f == "binary_big_endian") h.format = Format::binary_be;
-      else throw_input_error(source, ln, "unknown PLY format " + detail::quote(f));
+      if (f == "ascii")
+        h.format = Format::ascii;
+      else if (f == "binary_little_endian")
+        h.format = Format::binary_le;
+      else if (f == "binary_big_endian")
+        h.format = Format::binary_be;
+      else
+        throw_input_error(source, ln, "unknown PLY format " + detail::quote(f));
       have_format = true;
     } else if (tok == "element") {
       Element e;
@@ -165,9 +181,9 @@ Header parse_header(std::string_view bytes, std::string_view source) {
           throw_input_error(source, ln, "expected 'property list <count type> <type> <name>'");
         p.is_list = true;
         if (!parse_type(count_type, p.count_type) || !is_integer(p.count_type))
-          throw_input_error(source, ln,
-                            "list count type " + detail::quote(count_type) +
-                                " is not an integer type");
+          throw_input_error(
+              source, ln,
+              "list count type " + detail::quote(count_type) + " is not an integer type");
         if (!parse_type(item_type, p.type))
           throw_input_error(source, ln, "unknown property type " + detail::quote(item_type));
       } else {
@@ -198,9 +214,9 @@ int64_t min_row_bytes(const Element& e, Format f) {
 }
 
 struct Roles {
-  int vertex = -1, face = -1;     // element indices
-  int x = -1, y = -1, z = -1;     // property indices in the vertex element
-  int indices = -1;               // property index in the face element
+  int vertex = -1, face = -1;  // element indices
+  int x = -1, y = -1, z = -1;  // property indices in the vertex element
+  int indices = -1;            // property index in the face element
 };
 
 Roles find_roles(const Header& h, std::string_view source) {
@@ -255,7 +271,8 @@ void read_binary(std::string_view data, const Header& h, const Roles& r, std::st
         const Property& p = e.properties[k];
         const auto truncated = [&] {
           throw_input_error(source, "truncated data: " + e.name + " " + std::to_string(row) +
-                                        " (property '" + p.name + "') ends past the end of the file");
+                                        " (property '" + p.name +
+                                        "') ends past the end of the file");
         };
         if (!p.is_list) {
           if (!cur.has(type_size(p.type))) truncated();
@@ -312,7 +329,8 @@ void read_ascii(std::string_view data, const Header& h, const Roles& r, std::str
         };
         const auto next = [&] {
           if (!ts.next(tok))
-            throw_input_error(source, ts.line_number(), "truncated data: " + where() + " is missing");
+            throw_input_error(source, ts.line_number(),
+                              "truncated data: " + where() + " is missing");
           if (row_line == 0) row_line = ts.line_number();
         };
         const auto number = [&](Type t) {
@@ -354,8 +372,9 @@ void read_ascii(std::string_view data, const Header& h, const Roles& r, std::str
       if (is_vertex) builder.add_vertex(xyz[0], xyz[1], xyz[2], row_line);
     }
   }
-  if (ts.next(tok)) builder.note("ignored data after the last element (line " +
-                                 std::to_string(ts.line_number()) + ")");
+  if (ts.next(tok))
+    builder.note("ignored data after the last element (line " + std::to_string(ts.line_number()) +
+                 ")");
 }
 
 }  // namespace
@@ -370,8 +389,8 @@ SurfaceMesh parse_ply(std::string_view bytes, std::string_view source, ReadRepor
   for (const Element& e : h.elements) {
     const int64_t row = min_row_bytes(e, h.format);
     const bool is_mesh = &e == &h.elements[roles.vertex] || &e == &h.elements[roles.face];
-    const int64_t max_count = is_mesh ? std::numeric_limits<int32_t>::max()
-                                      : std::numeric_limits<int64_t>::max() / 64;
+    const int64_t max_count =
+        is_mesh ? std::numeric_limits<int32_t>::max() : std::numeric_limits<int64_t>::max() / 64;
     detail::check_count_fits(source, e.header_line, "'" + e.name + "' elements", e.count, row,
                              left_for_rest, max_count);
     left_for_rest -= e.count * row;

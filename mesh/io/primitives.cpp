@@ -38,9 +38,9 @@ TetMesh make_box_tet_mesh(const BoxMeshOptions& o) {
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i)
-        m.V.row(id(i, j, k)) = o.min_corner.transpose() +
-                               Eigen::RowVector3d(o.size.x() * i / nx, o.size.y() * j / ny,
-                                                  o.size.z() * k / nz);
+        m.V.row(id(i, j, k)) =
+            o.min_corner.transpose() +
+            Eigen::RowVector3d(o.size.x() * i / nx, o.size.y() * j / ny, o.size.z() * k / nz);
   // Kuhn split: the 6 monotone paths from corner (0,0,0) to (1,1,1), one per
   // permutation of the axes; shared faces match between neighbouring cells.
   static constexpr std::array<std::array<int, 3>, 6> perms{
@@ -105,14 +105,14 @@ SurfaceMesh make_icosphere(int subdivisions, double radius) {
   if (subdivisions < 0 || subdivisions > 8)
     throw ParameterError("make_icosphere: subdivisions must be in [0, 8]");
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
-                                    {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
-                                    {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                    {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                    {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   for (auto& p : v) p.normalize();
-  std::vector<std::array<int, 3>> f = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (int s = 0; s < subdivisions; ++s) {
     std::map<std::pair<int, int>, int> mid;
     auto midpoint = [&](int a, int b) {

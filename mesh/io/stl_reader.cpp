@@ -104,9 +104,9 @@ void read_ascii(std::string_view bytes, std::string_view source, detail::Surface
   std::string_view tok;
   const auto expect = [&](std::string_view word, std::string_view context) {
     if (!ts.next(tok))
-      throw_input_error(source, ts.line_number(),
-                        "truncated file: expected '" + std::string(word) + "' " +
-                            std::string(context));
+      throw_input_error(
+          source, ts.line_number(),
+          "truncated file: expected '" + std::string(word) + "' " + std::string(context));
     if (tok != word)
       throw_input_error(source, ts.line_number(),
                         "expected '" + std::string(word) + "' " + std::string(context) +

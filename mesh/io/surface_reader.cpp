@@ -17,13 +17,17 @@ SurfaceMesh read_surface_mesh(const std::filesystem::path& path, ReadReport* rep
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   using Parser = SurfaceMesh (*)(std::string_view, std::string_view, ReadReport*);
   Parser parser = nullptr;
-  if (ext == ".off") parser = &parse_off;
-  else if (ext == ".obj") parser = &parse_obj;
-  else if (ext == ".ply") parser = &parse_ply;
-  else if (ext == ".stl") parser = &parse_stl;
+  if (ext == ".off")
+    parser = &parse_off;
+  else if (ext == ".obj")
+    parser = &parse_obj;
+  else if (ext == ".ply")
+    parser = &parse_ply;
+  else if (ext == ".stl")
+    parser = &parse_stl;
   else
-    detail::throw_input_error(name, "unknown mesh file extension '" + ext +
-                                        "' (supported: .off, .obj, .ply, .stl)");
+    detail::throw_input_error(
+        name, "unknown mesh file extension '" + ext + "' (supported: .off, .obj, .ply, .stl)");
   const std::string bytes = detail::read_file_bytes(path);
   return parser(bytes, name, report);
 }

@@ -26,16 +26,20 @@ SurfaceMesh read_surface_mesh(const std::filesystem::path& path, ReadReport* rep
 /// Parsers of in-memory file contents, for the reader above and for fuzzing.
 /// `source` names the data in error messages (normally the path).
 /// Same postconditions and errors as read_surface_mesh.
-SurfaceMesh parse_off(std::string_view bytes, std::string_view source, ReadReport* report = nullptr);
+SurfaceMesh parse_off(std::string_view bytes, std::string_view source,
+                      ReadReport* report = nullptr);
 /// OBJ: `v` and `f` lines (f corners as i, i/t, i/t/n or i//n; negative
 /// indices count back from the last vertex read); other keywords are ignored.
-SurfaceMesh parse_obj(std::string_view bytes, std::string_view source, ReadReport* report = nullptr);
+SurfaceMesh parse_obj(std::string_view bytes, std::string_view source,
+                      ReadReport* report = nullptr);
 /// PLY: element `vertex` with numeric properties x, y, z and element `face`
 /// with a list property `vertex_indices` or `vertex_index`; other properties
 /// and elements are skipped.
-SurfaceMesh parse_ply(std::string_view bytes, std::string_view source, ReadReport* report = nullptr);
+SurfaceMesh parse_ply(std::string_view bytes, std::string_view source,
+                      ReadReport* report = nullptr);
 /// STL, ASCII or binary (binary when the size is 84 + 50 * count). Corners with
 /// bit-identical coordinates (+0 and -0 alike) become one vertex.
-SurfaceMesh parse_stl(std::string_view bytes, std::string_view source, ReadReport* report = nullptr);
+SurfaceMesh parse_stl(std::string_view bytes, std::string_view source,
+                      ReadReport* report = nullptr);
 
 }  // namespace icd

@@ -32,8 +32,8 @@ void append_vertex(std::string& out, const SurfaceMesh& mesh, Eigen::Index i) {
 
 void write_off(const std::filesystem::path& path, const SurfaceMesh& mesh) {
   check_mesh(path, mesh);
-  std::string out = "OFF\n" + std::to_string(mesh.V.rows()) + ' ' + std::to_string(mesh.F.rows()) +
-                    " 0\n";
+  std::string out =
+      "OFF\n" + std::to_string(mesh.V.rows()) + ' ' + std::to_string(mesh.F.rows()) + " 0\n";
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) append_vertex(out, mesh, i);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
     out += '3';

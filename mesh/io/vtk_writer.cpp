@@ -36,8 +36,8 @@ void check_indices(const std::filesystem::path& path, const Eigen::MatrixBase<De
     for (Eigen::Index c = 0; c < cells.cols(); ++c)
       if (cells(i, c) < 0 || cells(i, c) >= num_points)
         fail(path, what + " " + std::to_string(i) + " has vertex index " +
-                       std::to_string(cells(i, c)) + " outside [0, " +
-                       std::to_string(num_points) + ")");
+                       std::to_string(cells(i, c)) + " outside [0, " + std::to_string(num_points) +
+                       ")");
 }
 
 void check_point_data(const std::filesystem::path& path, std::span<const PointDataArray> arrays,
@@ -47,15 +47,15 @@ void check_point_data(const std::filesystem::path& path, std::span<const PointDa
     if (!names.insert(a.name).second)
       fail(path, "point-data array name '" + a.name + "' is used twice");
     if (a.values.rows() != num_points || a.values.cols() < 1)
-      fail(path, "point-data array '" + a.name + "' is " + std::to_string(a.values.rows()) +
-                     " x " + std::to_string(a.values.cols()) + "; expected " +
-                     std::to_string(num_points) + " rows and at least 1 column");
+      fail(path, "point-data array '" + a.name + "' is " + std::to_string(a.values.rows()) + " x " +
+                     std::to_string(a.values.cols()) + "; expected " + std::to_string(num_points) +
+                     " rows and at least 1 column");
     check_finite(path, a.values, "point-data array '" + a.name + "'");
   }
 }
 
-void append_array(std::string& out, const std::string& attrs, const auto& values,
-                  Eigen::Index rows, Eigen::Index cols) {
+void append_array(std::string& out, const std::string& attrs, const auto& values, Eigen::Index rows,
+                  Eigen::Index cols) {
   out += "        <DataArray " + attrs + " format=\"ascii\">\n";
   for (Eigen::Index i = 0; i < rows; ++i) {
     out += "          ";
@@ -72,8 +72,9 @@ void append_double_array(std::string& out, const std::string& name_attr,
                          const Eigen::Ref<const Eigen::MatrixXd>& values) {
   std::string attrs = "type=\"Float64\"" + name_attr;
   attrs += " NumberOfComponents=\"" + std::to_string(values.cols()) + "\"";
-  append_array(out, attrs, [&](Eigen::Index i, Eigen::Index c) { return values(i, c); },
-               values.rows(), values.cols());
+  append_array(
+      out, attrs, [&](Eigen::Index i, Eigen::Index c) { return values(i, c); }, values.rows(),
+      values.cols());
 }
 
 // Writes a whole UnstructuredGrid whose cells all have `corners` vertices and
@@ -90,8 +91,8 @@ void write_grid(const std::filesystem::path& path, const Eigen::Ref<const MatX3d
          std::to_string(num_cells) + "\">\n";
   if (!point_data.empty() || extra) {
     out += "      <PointData>\n";
-    if (extra) append_double_array(out, " Name=\"" + detail::xml_escape(extra->name) + "\"",
-                                   extra->values);
+    if (extra)
+      append_double_array(out, " Name=\"" + detail::xml_escape(extra->name) + "\"", extra->values);
     for (const PointDataArray& a : point_data)
       append_double_array(out, " Name=\"" + detail::xml_escape(a.name) + "\"", a.values);
     out += "      </PointData>\n";
@@ -99,15 +100,17 @@ void write_grid(const std::filesystem::path& path, const Eigen::Ref<const MatX3d
   out += "      <Points>\n";
   append_double_array(out, " Name=\"Points\"", points);
   out += "      </Points>\n      <Cells>\n";
-  append_array(out, "type=\"Int64\" Name=\"connectivity\"",
-               [&](Eigen::Index i, Eigen::Index c) { return static_cast<int64_t>(cell(i, c)); },
-               num_cells, corners);
-  append_array(out, "type=\"Int64\" Name=\"offsets\"",
-               [&](Eigen::Index i, Eigen::Index) { return static_cast<int64_t>(corners * (i + 1)); },
-               num_cells, 1);
-  append_array(out, "type=\"UInt8\" Name=\"types\"",
-               [&](Eigen::Index, Eigen::Index) { return static_cast<int64_t>(cell_type); },
-               num_cells, 1);
+  append_array(
+      out, "type=\"Int64\" Name=\"connectivity\"",
+      [&](Eigen::Index i, Eigen::Index c) { return static_cast<int64_t>(cell(i, c)); }, num_cells,
+      corners);
+  append_array(
+      out, "type=\"Int64\" Name=\"offsets\"",
+      [&](Eigen::Index i, Eigen::Index) { return static_cast<int64_t>(corners * (i + 1)); },
+      num_cells, 1);
+  append_array(
+      out, "type=\"UInt8\" Name=\"types\"",
+      [&](Eigen::Index, Eigen::Index) { return static_cast<int64_t>(cell_type); }, num_cells, 1);
   out += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
   write_file_atomically(path, out);
 }
@@ -119,8 +122,9 @@ void write_vtu_tet_mesh(const std::filesystem::path& path, const TetMesh& mesh,
   check_finite(path, mesh.V, "vertex");
   check_indices(path, mesh.T, mesh.V.rows(), "tet");
   check_point_data(path, point_data, mesh.V.rows(), {});
-  write_grid(path, mesh.V, mesh.T.rows(), 4, kVtkTetra,
-             [&](Eigen::Index i, Eigen::Index c) { return mesh.T(i, c); }, point_data, nullptr);
+  write_grid(
+      path, mesh.V, mesh.T.rows(), 4, kVtkTetra,
+      [&](Eigen::Index i, Eigen::Index c) { return mesh.T(i, c); }, point_data, nullptr);
 }
 
 void write_vtu_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh,
@@ -128,8 +132,9 @@ void write_vtu_surface_mesh(const std::filesystem::path& path, const SurfaceMesh
   check_finite(path, mesh.V, "vertex");
   check_indices(path, mesh.F, mesh.V.rows(), "face");
   check_point_data(path, point_data, mesh.V.rows(), {});
-  write_grid(path, mesh.V, mesh.F.rows(), 3, kVtkTriangle,
-             [&](Eigen::Index i, Eigen::Index c) { return mesh.F(i, c); }, point_data, nullptr);
+  write_grid(
+      path, mesh.V, mesh.F.rows(), 3, kVtkTriangle,
+      [&](Eigen::Index i, Eigen::Index c) { return mesh.F(i, c); }, point_data, nullptr);
 }
 
 void write_vtu_sphere_set(const std::filesystem::path& path, const SphereSet& spheres,
@@ -141,12 +146,13 @@ void write_vtu_sphere_set(const std::filesystem::path& path, const SphereSet& sp
   check_finite(path, spheres.centers, "sphere centre");
   for (Eigen::Index i = 0; i < n; ++i)
     if (!std::isfinite(spheres.radii[i]) || spheres.radii[i] < 0)
-      fail(path, "sphere " + std::to_string(i) + " has radius " +
-                     std::to_string(spheres.radii[i]) + "; radii must be finite and >= 0");
+      fail(path, "sphere " + std::to_string(i) + " has radius " + std::to_string(spheres.radii[i]) +
+                     "; radii must be finite and >= 0");
   check_point_data(path, point_data, n, {"radius"});
   const PointDataArray radius{"radius", spheres.radii};
-  write_grid(path, spheres.centers, n, 1, kVtkVertex,
-             [](Eigen::Index i, Eigen::Index) { return i; }, point_data, &radius);
+  write_grid(
+      path, spheres.centers, n, 1, kVtkVertex, [](Eigen::Index i, Eigen::Index) { return i; },
+      point_data, &radius);
 }
 
 void write_pvd(const std::filesystem::path& path, std::span<const PvdEntry> entries) {

@@ -39,9 +39,10 @@ class XmlScanner {
   XmlScanner(std::string_view text, std::string_view source) : m_text(text), m_source(source) {}
 
   int64_t line_at(size_t offset) const {
-    return 1 + std::count(m_text.begin(), m_text.begin() + static_cast<std::ptrdiff_t>(
-                                                               std::min(offset, m_text.size())),
-                          '\n');
+    return 1 +
+           std::count(m_text.begin(),
+                      m_text.begin() + static_cast<std::ptrdiff_t>(std::min(offset, m_text.size())),
+                      '\n');
   }
   [[noreturn]] void fail(size_t offset, const std::string& what) const {
     throw_input_error(m_source, line_at(offset), what);
@@ -103,8 +104,7 @@ class XmlScanner {
         return;
       }
       const size_t key_start = p;
-      while (!at_end() && m_text[p] != '=' && !detail::is_space(m_text[p]) && m_text[p] != '>')
-        ++p;
+      while (!at_end() && m_text[p] != '=' && !detail::is_space(m_text[p]) && m_text[p] != '>') ++p;
       const std::string key(m_text.substr(key_start, p - key_start));
       while (!at_end() && detail::is_space(m_text[p])) ++p;
       if (at_end() || m_text[p] != '=')
@@ -134,8 +134,8 @@ int64_t int_attribute(const XmlScanner& xml, const Tag& tag, std::string_view ke
   if (!v) xml.fail(tag.begin, "<" + std::string(tag.name) + "> has no " + std::string(key));
   int64_t n = 0;
   if (detail::parse_int64(*v, n) != detail::NumberStatus::ok || n < 0)
-    xml.fail(tag.begin, std::string(key) + "=" + detail::quote(*v) +
-                            " is not a non-negative integer");
+    xml.fail(tag.begin,
+             std::string(key) + "=" + detail::quote(*v) + " is not a non-negative integer");
   return n;
 }
 
@@ -146,8 +146,9 @@ struct Array {
   int64_t components = 1;
   std::vector<double> reals;
   std::vector<int64_t> ints;
-  int64_t size() const { return is_float ? static_cast<int64_t>(reals.size())
-                                         : static_cast<int64_t>(ints.size()); }
+  int64_t size() const {
+    return is_float ? static_cast<int64_t>(reals.size()) : static_cast<int64_t>(ints.size());
+  }
 };
 
 Array read_data_array(XmlScanner& xml, const Tag& tag) {
@@ -158,7 +159,8 @@ Array read_data_array(XmlScanner& xml, const Tag& tag) {
   if (!type) xml.fail(tag.begin, label + " has no type");
   static constexpr std::string_view ints[] = {"Int8",  "UInt8",  "Int16", "UInt16",
                                               "Int32", "UInt32", "Int64", "UInt64"};
-  if (*type == "Float32" || *type == "Float64") a.is_float = true;
+  if (*type == "Float32" || *type == "Float64")
+    a.is_float = true;
   else if (std::find(std::begin(ints), std::end(ints), *type) == std::end(ints))
     xml.fail(tag.begin, label + " has unknown type " + detail::quote(*type));
   const std::string* format = tag.find("format");
@@ -214,7 +216,8 @@ VtuData parse_vtu(std::string_view bytes, std::string_view source) {
     throw_input_error(source, "not a VTK XML file: no <VTKFile> element");
   const std::string* type = tag.find("type");
   if (!type || *type != "UnstructuredGrid")
-    xml.fail(tag.begin, "VTKFile type is " + (type ? detail::quote(*type) : std::string("missing")) +
+    xml.fail(tag.begin, "VTKFile type is " +
+                            (type ? detail::quote(*type) : std::string("missing")) +
                             "; expected 'UnstructuredGrid'");
   if (const std::string* c = tag.find("compressor"))
     xml.fail(tag.begin, "compressed VTU (" + *c + ") is not supported");
@@ -294,8 +297,8 @@ VtuData parse_vtu(std::string_view bytes, std::string_view source) {
     throw_input_error(source, "<Cells> needs the DataArrays 'connectivity', 'offsets' and 'types'");
   for (const Array* a : {conn, offs, types})
     if (a->is_float || a->components != 1)
-      throw_input_error(source, "Cells DataArray '" + a->name +
-                                    "' must be a one-component integer array");
+      throw_input_error(source,
+                        "Cells DataArray '" + a->name + "' must be a one-component integer array");
   if (offs->size() != num_cells || types->size() != num_cells)
     throw_input_error(source, "NumberOfCells=" + std::to_string(num_cells) + " but 'offsets' has " +
                                   std::to_string(offs->size()) + " and 'types' " +
@@ -382,8 +385,10 @@ TetMesh read_vtu_tet_mesh(const std::filesystem::path& path) {
   const Eigen::VectorXd vol = signed_tet_volumes(m.V, m.T);
   for (Eigen::Index e = 0; e < vol.size(); ++e)
     if (!(vol[e] > 0))
-      throw_input_error(path.string(), "tet " + std::to_string(e) + " is inverted or degenerate "
-                                       "(signed volume " + std::to_string(vol[e]) + ")");
+      throw_input_error(path.string(), "tet " + std::to_string(e) +
+                                           " is inverted or degenerate "
+                                           "(signed volume " +
+                                           std::to_string(vol[e]) + ")");
   m.F = boundary_faces(m.T);
   return m;
 }

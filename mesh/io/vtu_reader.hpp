@@ -15,11 +15,11 @@ namespace icd {
 
 /// The raw contents of an UnstructuredGrid piece.
 struct VtuData {
-  MatX3d points;                          ///< #P x 3
-  std::vector<int64_t> connectivity;      ///< concatenated cell vertex indices
-  std::vector<int64_t> offsets;           ///< #C end offsets into connectivity
-  std::vector<uint8_t> types;             ///< #C VTK cell types
-  std::vector<PointDataArray> point_data; ///< #P x k each, in file order
+  MatX3d points;                           ///< #P x 3
+  std::vector<int64_t> connectivity;       ///< concatenated cell vertex indices
+  std::vector<int64_t> offsets;            ///< #C end offsets into connectivity
+  std::vector<uint8_t> types;              ///< #C VTK cell types
+  std::vector<PointDataArray> point_data;  ///< #P x k each, in file order
 };
 
 /// Reads and validates a VTU file: counts match the Piece attributes, offsets

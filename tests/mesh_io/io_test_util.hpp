@@ -44,7 +44,8 @@ class TempDir {
 };
 
 /// Writes `bytes` verbatim to `path`.
-inline std::filesystem::path write_bytes(const std::filesystem::path& path, std::string_view bytes) {
+inline std::filesystem::path write_bytes(const std::filesystem::path& path,
+                                         std::string_view bytes) {
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   return path;
@@ -69,8 +70,8 @@ inline std::string input_error_message(const std::function<void()>& fn) {
 inline void expect_contains_all(const std::string& message,
                                 std::initializer_list<std::string_view> parts) {
   for (const auto p : parts)
-    EXPECT_NE(message.find(p), std::string::npos) << "message: '" << message
-                                                  << "' lacks '" << p << "'";
+    EXPECT_NE(message.find(p), std::string::npos)
+        << "message: '" << message << "' lacks '" << p << "'";
 }
 
 /// printf("%.17g"): an encoding of doubles independent of the library's

@@ -118,8 +118,10 @@ TEST(MeshStats, EdgeCountsMatchBruteForceOnRandomSoups) {
     m.F.resize(nf, 3);
     for (int f = 0; f < nf; ++f) {
       int a = static_cast<int>(rng() % nv), b, c;
-      do b = static_cast<int>(rng() % nv); while (b == a);
-      do c = static_cast<int>(rng() % nv); while (c == a || c == b);
+      do b = static_cast<int>(rng() % nv);
+      while (b == a);
+      do c = static_cast<int>(rng() % nv);
+      while (c == a || c == b);
       m.F.row(f) << a, b, c;
     }
     std::map<std::pair<int, int>, std::pair<int, int>> edges;  // -> (count, forward)

@@ -52,8 +52,7 @@ TEST(ReaderErrors, Off) {
   ASSERT_EQ(read_surface_mesh(write_bytes(dir / "ok.off", kTriOff)).F.rows(), 1);
   expect_read_error(dir, "empty.off", "", {"truncated", "empty"});
   expect_read_error(dir, "header.off", "OFX\n3 1 0\n", {"line 1", "not an OFF file"});
-  expect_read_error(dir, "trunc_v.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n",
-                    {"truncated", "vertex 2"});
+  expect_read_error(dir, "trunc_v.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n", {"truncated", "vertex 2"});
   expect_read_error(dir, "trunc_f.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
                     {"truncated", "face 1"});
   expect_read_error(dir, "short_face.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n",
@@ -99,11 +98,12 @@ TEST(ReaderErrors, HugeHeaderCountsFailFast) {
                     "property float x\nproperty float y\nproperty float z\nelement face 1\n"
                     "property list uchar int vertex_indices\nend_header\n",
                     {"line 3", "1000000000000"});
-  expect_read_error(dir, "big2.ply",
-                    "ply\nformat ascii 1.0\nelement vertex 3\n"
-                    "property float x\nproperty float y\nproperty float z\nelement face 2000000000\n"
-                    "property list uchar int vertex_indices\nend_header\n0 0 0\n",
-                    {"line 7", "truncated", "2000000000"});
+  expect_read_error(
+      dir, "big2.ply",
+      "ply\nformat ascii 1.0\nelement vertex 3\n"
+      "property float x\nproperty float y\nproperty float z\nelement face 2000000000\n"
+      "property list uchar int vertex_indices\nend_header\n0 0 0\n",
+      {"line 7", "truncated", "2000000000"});
   expect_read_error(dir, "bigother.ply",
                     "ply\nformat binary_big_endian 1.0\nelement vertex 3\n"
                     "property float x\nproperty float y\nproperty float z\nelement face 1\n"
@@ -155,9 +155,9 @@ std::string ply_header(const std::string& format, int nv, int nf) {
 TEST(ReaderErrors, PlyAscii) {
   TempDir dir;
   const std::string h = ply_header("ascii", 3, 1);
-  ASSERT_EQ(read_surface_mesh(write_bytes(dir / "ok.ply", h + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"))
-                .F.rows(),
-            1);
+  ASSERT_EQ(
+      read_surface_mesh(write_bytes(dir / "ok.ply", h + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).F.rows(),
+      1);
   expect_read_error(dir, "magic.ply", "plx\n", {"line 1", "not a PLY file"});
   expect_read_error(dir, "noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n",
                     {"no 'end_header'"});
@@ -174,8 +174,7 @@ TEST(ReaderErrors, PlyAscii) {
                     "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                     "property float z\nend_header\n0 0 0\n",
                     {"empty mesh", "no 'face' element"});
-  expect_read_error(dir, "trunc.ply", h + "0 0 0\n1 0 0\n0 1\n",
-                    {"truncated", "vertex 2", "'z'"});
+  expect_read_error(dir, "trunc.ply", h + "0 0 0\n1 0 0\n0 1\n", {"truncated", "vertex 2", "'z'"});
   expect_read_error(dir, "trunc_f.ply", h + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n",
                     {"truncated", "face 0"});
   expect_read_error(dir, "nonnum.ply", h + "0 0 0\n1 q 0\n0 1 0\n3 0 1 2\n",
@@ -283,8 +282,9 @@ TEST(ReaderErrors, TruncationsAndCorruptionsNeverCrash) {
       {"ply", ply_header("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
       {"ply", h + be_verts + be_face},
       {"stl", binary_stl(1, {0, 0, 0, 1, 0, 0, 0, 1, 0})},
-      {"stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
-              "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n"}};
+      {"stl",
+       "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+       "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n"}};
   std::mt19937 rng(0);
   int read_ok = 0, rejected = 0;
   for (const auto& [ext, text] : files) {

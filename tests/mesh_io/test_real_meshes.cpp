@@ -21,7 +21,8 @@ std::filesystem::path data_file(const char* name) {
 
 TEST(RealMeshes, Bunny) {
   const auto path = data_file("bunny00.off");
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " missing (run scripts/fetch_meshes.sh)";
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " missing (run scripts/fetch_meshes.sh)";
   ReadReport report;
   const SurfaceMesh m = read_surface_mesh(path, &report);
   EXPECT_EQ(m.V.rows(), 37706);
@@ -42,7 +43,8 @@ TEST(RealMeshes, Bunny) {
 
 TEST(RealMeshes, Dragon) {
   const auto path = data_file("ChineseDragon-10kv.off");
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " missing (run scripts/fetch_meshes.sh)";
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " missing (run scripts/fetch_meshes.sh)";
   const SurfaceMesh m = read_surface_mesh(path);
   EXPECT_EQ(m.V.rows(), 10000);
   EXPECT_EQ(m.F.rows(), 19994);

@@ -157,10 +157,11 @@ TEST(SurfaceReaders, PlyBinaryLittleEndian) {
   TempDir dir;
   const SurfaceMesh m = make_icosphere(1, 0.7);
   ReadReport report;
-  expect_same(read_surface_mesh(write_bytes(dir / "le.ply",
-                                            binary_ply<uint8_t>(m, false, "vertex_indices", "uchar")),
-                                &report),
-              m);
+  expect_same(
+      read_surface_mesh(
+          write_bytes(dir / "le.ply", binary_ply<uint8_t>(m, false, "vertex_indices", "uchar")),
+          &report),
+      m);
   EXPECT_EQ(report.format, "PLY binary_little_endian");
 }
 
@@ -168,9 +169,9 @@ TEST(SurfaceReaders, PlyBinaryBigEndianWithIntCountsAndVertexIndex) {
   TempDir dir;
   const SurfaceMesh m = make_icosphere(1, 0.7);
   ReadReport report;
-  expect_same(read_surface_mesh(write_bytes(dir / "be.PLY",
-                                            binary_ply<int32_t>(m, true, "vertex_index", "int")),
-                                &report),
+  expect_same(read_surface_mesh(
+                  write_bytes(dir / "be.PLY", binary_ply<int32_t>(m, true, "vertex_index", "int")),
+                  &report),
               m);
   EXPECT_EQ(report.format, "PLY binary_big_endian");
 }
@@ -179,11 +180,10 @@ TEST(SurfaceReaders, PlyBinaryFloatCoordinates) {
   TempDir dir;
   SurfaceMesh m = make_icosphere(1, 1.0);
   m.V = m.V.cast<float>().cast<double>();  // what a float file can hold exactly
-  std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex " +
-                  std::to_string(m.V.rows()) +
-                  "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-                  std::to_string(m.F.rows()) +
-                  "\nproperty list uchar uint vertex_indices\nend_header\n";
+  std::string s =
+      "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(m.V.rows()) +
+      "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+      std::to_string(m.F.rows()) + "\nproperty list uchar uint vertex_indices\nend_header\n";
   for (int i = 0; i < m.V.rows(); ++i)
     for (int c = 0; c < 3; ++c) put<float>(s, static_cast<float>(m.V(i, c)), false);
   for (int f = 0; f < m.F.rows(); ++f) {
@@ -196,12 +196,11 @@ TEST(SurfaceReaders, PlyBinaryFloatCoordinates) {
 TEST(SurfaceReaders, PlyAscii) {
   TempDir dir;
   const SurfaceMesh m = make_torus(1.0, 0.25, 6, 5);
-  std::string s = "ply\r\nformat ascii 1.0\r\nobj_info test\r\nelement vertex " +
-                  std::to_string(m.V.rows()) +
-                  "\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\n"
-                  "property list uchar float extra\r\nelement face " +
-                  std::to_string(m.F.rows()) +
-                  "\r\nproperty list uchar int vertex_indices\r\nend_header\r\n";
+  std::string s =
+      "ply\r\nformat ascii 1.0\r\nobj_info test\r\nelement vertex " + std::to_string(m.V.rows()) +
+      "\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\n"
+      "property list uchar float extra\r\nelement face " +
+      std::to_string(m.F.rows()) + "\r\nproperty list uchar int vertex_indices\r\nend_header\r\n";
   for (int i = 0; i < m.V.rows(); ++i)
     s += g17(m.V(i, 0)) + " " + g17(m.V(i, 1)) + " " + g17(m.V(i, 2)) + " 2 0.5 1e-3\r\n";
   for (int f = 0; f < m.F.rows(); ++f)
@@ -300,8 +299,9 @@ TEST(SurfaceReaders, PolygonsAreFanTriangulatedWithANote) {
   const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
                            {2, 3, 7, 6}, {0, 4, 7, 3}, {1, 2, 6, 5}};
   std::string off = "OFF\n8 6 12\n" + verts, obj;
-  for (const auto& q : quads) off += "4 " + std::to_string(q[0]) + " " + std::to_string(q[1]) +
-                                     " " + std::to_string(q[2]) + " " + std::to_string(q[3]) + "\n";
+  for (const auto& q : quads)
+    off += "4 " + std::to_string(q[0]) + " " + std::to_string(q[1]) + " " + std::to_string(q[2]) +
+           " " + std::to_string(q[3]) + "\n";
   for (size_t p = 0; p < verts.size();) {
     const size_t e = verts.find('\n', p);
     obj += "v " + verts.substr(p, e - p + 1);

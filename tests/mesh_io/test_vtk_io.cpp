@@ -59,8 +59,9 @@ Eigen::MatrixXd random_matrix(Eigen::Index rows, Eigen::Index cols, unsigned see
 TEST(VtkIo, OwnReaderRoundTripsExactly) {
   TempDir dir;
   const TetMesh tets = small_tet_mesh();
-  const std::vector<PointDataArray> pd = {{"displacement", random_matrix(tets.V.rows(), 3, 1)},
-                                          {"a <weird> & \"name\"", random_matrix(tets.V.rows(), 1, 2)}};
+  const std::vector<PointDataArray> pd = {
+      {"displacement", random_matrix(tets.V.rows(), 3, 1)},
+      {"a <weird> & \"name\"", random_matrix(tets.V.rows(), 1, 2)}};
   write_vtu_tet_mesh(dir / "tets.vtu", tets, pd);
   const TetMesh t2 = read_vtu_tet_mesh(dir / "tets.vtu");
   EXPECT_TRUE(t2.V == tets.V);
@@ -80,8 +81,8 @@ TEST(VtkIo, OwnReaderRoundTripsExactly) {
   EXPECT_TRUE(s2.F == ico.F);
 
   const SphereSet spheres = random_spheres(17);
-  write_vtu_sphere_set(dir / "spheres.vtu", spheres, std::vector<PointDataArray>{
-                                                          {"level", random_matrix(17, 1, 3)}});
+  write_vtu_sphere_set(dir / "spheres.vtu", spheres,
+                       std::vector<PointDataArray>{{"level", random_matrix(17, 1, 3)}});
   const SphereSet sp2 = read_vtu_sphere_set(dir / "spheres.vtu");
   EXPECT_TRUE(sp2.centers == spheres.centers);
   EXPECT_TRUE(sp2.radii == spheres.radii);
@@ -91,8 +92,8 @@ TEST(VtkIo, OwnReaderRoundTripsExactly) {
 // What meshio reports for one file.
 struct MeshioView {
   int64_t num_points = -1;
-  std::map<std::string, std::vector<int64_t>> cells;        // type -> connectivity
-  std::vector<double> points;                               // row-major
+  std::map<std::string, std::vector<int64_t>> cells;                      // type -> connectivity
+  std::vector<double> points;                                             // row-major
   std::map<std::string, std::pair<int, std::vector<double>>> point_data;  // name -> (k, values)
 };
 
@@ -100,7 +101,8 @@ bool meshio_available() {
   return std::system("/usr/bin/python3 -c 'import meshio' > /dev/null 2>&1") == 0;
 }
 
-std::map<std::string, MeshioView> read_with_meshio(const std::vector<std::filesystem::path>& files) {
+std::map<std::string, MeshioView> read_with_meshio(
+    const std::vector<std::filesystem::path>& files) {
   std::string cmd =
       "/usr/bin/python3 -c '\n"
       "import sys, meshio\n"
@@ -210,18 +212,19 @@ TEST(VtkIo, MeshioReadsWhatWeWrite) {
 
 TEST(VtkIo, PvdListsTheSteps) {
   TempDir dir;
-  const std::vector<PvdEntry> steps = {{0.0, "frame_0000.vtu"}, {0.01, "frame_0001.vtu"},
-                                       {0.025, "sub dir/f&2.vtu"}};
+  const std::vector<PvdEntry> steps = {
+      {0.0, "frame_0000.vtu"}, {0.01, "frame_0001.vtu"}, {0.025, "sub dir/f&2.vtu"}};
   write_pvd(dir / "run.pvd", steps);
   std::ifstream in(dir / "run.pvd");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   expect_contains_all(text, {"type=\"Collection\"", "timestep=\"0.01\"", "file=\"frame_0001.vtu\"",
                              "file=\"sub dir/f&amp;2.vtu\""});
   if (!meshio_available()) return;  // the XML check below needs /usr/bin/python3
-  const std::string cmd = "/usr/bin/python3 -c 'import sys, xml.etree.ElementTree as E\n"
-                          "for d in E.parse(sys.argv[1]).getroot().iter(\"DataSet\"):\n"
-                          "    print(repr(float(d.get(\"timestep\"))), d.get(\"file\"))' '" +
-                          (dir / "run.pvd").string() + "'";
+  const std::string cmd =
+      "/usr/bin/python3 -c 'import sys, xml.etree.ElementTree as E\n"
+      "for d in E.parse(sys.argv[1]).getroot().iter(\"DataSet\"):\n"
+      "    print(repr(float(d.get(\"timestep\"))), d.get(\"file\"))' '" +
+      (dir / "run.pvd").string() + "'";
   std::string out;
   if (std::FILE* p = ::popen(cmd.c_str(), "r")) {
     char buf[1024];
@@ -260,16 +263,16 @@ TEST(VtkIo, WriterRejectsBadData) {
       "'v' is 11 x 3");
   expect_param_error(
       [&] {
-        write_vtu_surface_mesh(path, ico, std::vector<PointDataArray>{
-                                              {"v", Eigen::MatrixXd::Zero(12, 1)},
-                                              {"v", Eigen::MatrixXd::Zero(12, 1)}});
+        write_vtu_surface_mesh(path, ico,
+                               std::vector<PointDataArray>{{"v", Eigen::MatrixXd::Zero(12, 1)},
+                                                           {"v", Eigen::MatrixXd::Zero(12, 1)}});
       },
       "used twice");
   SphereSet s = random_spheres(4);
   expect_param_error(
       [&] {
-        write_vtu_sphere_set(path, s, std::vector<PointDataArray>{
-                                          {"radius", Eigen::MatrixXd::Zero(4, 1)}});
+        write_vtu_sphere_set(path, s,
+                             std::vector<PointDataArray>{{"radius", Eigen::MatrixXd::Zero(4, 1)}});
       },
       "'radius' is used twice");
   s.radii[2] = -1.0;
@@ -278,7 +281,9 @@ TEST(VtkIo, WriterRejectsBadData) {
   t.T(0, 3) = -1;
   expect_param_error([&] { write_vtu_tet_mesh(path, t); }, "tet 0");
   expect_param_error(
-      [&] { write_pvd(dir / "bad.vtu", std::vector<PvdEntry>{{std::nan(""), "a.vtu"}}); },
+      [&] {
+        write_pvd(dir / "bad.vtu", std::vector<PvdEntry>{{std::nan(""), "a.vtu"}});
+      },
       "non-finite time");
 }
 
@@ -312,8 +317,10 @@ TEST(VtkIo, ReaderRejectsMalformedFiles) {
     SCOPED_TRACE(name);
     const auto path = write_bytes(dir / name, text);
     const std::string msg = input_error_message([&] {
-      if (as_tets) read_vtu_tet_mesh(path);
-      else read_vtu_surface_mesh(path);
+      if (as_tets)
+        read_vtu_tet_mesh(path);
+      else
+        read_vtu_surface_mesh(path);
     });
     expect_contains_all(msg, {name});
     expect_contains_all(msg, parts);
@@ -334,26 +341,31 @@ TEST(VtkIo, ReaderRejectsMalformedFiles) {
                {"'binary'", "only format=\"ascii\""});
   expect_error("appended.vtu", replace("</UnstructuredGrid>", "</UnstructuredGrid><AppendedData>"),
                {"appended", "not supported"});
-  expect_error("noconn.vtu", replace("Name=\"connectivity\"", "Name=\"conn\""),
-               {"'connectivity'"});
+  expect_error("noconn.vtu", replace("Name=\"connectivity\"", "Name=\"conn\""), {"'connectivity'"});
   expect_error("count.vtu", replace("NumberOfPoints=\"12\"", "NumberOfPoints=\"13\""),
                {"NumberOfPoints=13"});
   expect_error("huge.vtu", replace("NumberOfPoints=\"12\"", "NumberOfPoints=\"1000000000000\""),
                {"exceeds"});
-  expect_error("nan.vtu", replace("Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">\n          ",
-                                  "Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">\n          nan "),
-               {"NaN"});
-  expect_error("word.vtu", replace("Name=\"offsets\" format=\"ascii\">\n          3",
-                                   "Name=\"offsets\" format=\"ascii\">\n          three"),
+  expect_error(
+      "nan.vtu",
+      replace("Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">\n          ",
+              "Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">\n          nan "),
+      {"NaN"});
+  expect_error("word.vtu",
+               replace("Name=\"offsets\" format=\"ascii\">\n          3",
+                       "Name=\"offsets\" format=\"ascii\">\n          three"),
                {"'offsets'", "'three'", "not an integer"});
-  expect_error("offsets.vtu", replace("Name=\"offsets\" format=\"ascii\">\n          3\n          6",
-                                      "Name=\"offsets\" format=\"ascii\">\n          3\n          3"),
+  expect_error("offsets.vtu",
+               replace("Name=\"offsets\" format=\"ascii\">\n          3\n          6",
+                       "Name=\"offsets\" format=\"ascii\">\n          3\n          3"),
                {"cell 1", "offset 3"});
-  expect_error("range.vtu", replace("Name=\"connectivity\" format=\"ascii\">\n          0",
-                                    "Name=\"connectivity\" format=\"ascii\">\n          12"),
+  expect_error("range.vtu",
+               replace("Name=\"connectivity\" format=\"ascii\">\n          0",
+                       "Name=\"connectivity\" format=\"ascii\">\n          12"),
                {"cell 0", "index 12", "out of range"});
-  expect_error("type.vtu", replace("Name=\"types\" format=\"ascii\">\n          5",
-                                   "Name=\"types\" format=\"ascii\">\n          7"),
+  expect_error("type.vtu",
+               replace("Name=\"types\" format=\"ascii\">\n          5",
+                       "Name=\"types\" format=\"ascii\">\n          7"),
                {"cell 0", "VTK type 7", "VTK_TRIANGLE"});
   expect_error("tri_as_tet.vtu", good, {"cell 0", "VTK_TETRA"}, true);
   expect_error("truncated.vtu", good.substr(0, good.size() / 2), {});

@@ -19,8 +19,9 @@ void throw_input_error(std::string_view source, std::string_view what) {
 void check_count_fits(std::string_view source, int64_t line, std::string_view what, int64_t count,
                       int64_t min_bytes_each, int64_t bytes_left, int64_t max_count) {
   if (count < 0)
-    throw_input_error(source, line, "negative number of " + std::string(what) + " (" +
-                                        std::to_string(count) + ")");
+    throw_input_error(
+        source, line,
+        "negative number of " + std::string(what) + " (" + std::to_string(count) + ")");
   if (count > max_count)
     throw_input_error(source, line,
                       "header announces " + std::to_string(count) + " " + std::string(what) +
@@ -29,8 +30,7 @@ void check_count_fits(std::string_view source, int64_t line, std::string_view wh
     throw_input_error(source, line,
                       "truncated file: header announces " + std::to_string(count) + " " +
                           std::string(what) + " (at least " + std::to_string(min_bytes_each) +
-                          " bytes each) but only " +
-                          std::to_string(bytes_left) + " bytes follow");
+                          " bytes each) but only " + std::to_string(bytes_left) + " bytes follow");
 }
 
 }  // namespace icd::detail

@@ -16,9 +16,9 @@ void SurfaceBuilder::reserve(int64_t vertices, int64_t polygons) {
 void SurfaceBuilder::add_vertex(double x, double y, double z, int64_t line) {
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
     const char* what = (std::isnan(x) || std::isnan(y) || std::isnan(z)) ? "NaN" : "infinite";
-    throw_input_error(m_source, line,
-                      "vertex " + std::to_string(num_vertices()) + " has a " + what +
-                          " coordinate");
+    throw_input_error(
+        m_source, line,
+        "vertex " + std::to_string(num_vertices()) + " has a " + what + " coordinate");
   }
   if (num_vertices() >= std::numeric_limits<int32_t>::max())
     throw_input_error(m_source, line, "too many vertices (more than 2^31 - 1)");
