@@ -93,6 +93,11 @@ struct CollisionResult {
 /// request's budget. Pairs are pruned when their spheres do not overlap, which
 /// is conservative for surface contacts when each node covers its subtree's
 /// surface patch (wrapped trees, octree trees). Reuses `result`'s storage.
+/// Time budget: the clock is read every clock_check_interval tests; the time
+/// needed to copy the pending pairs into `untested` is reserved out of the
+/// budget, so the call returns close to the deadline (reuse `result` between
+/// queries so that its vectors do not reallocate). The first timed query of a
+/// process calibrates its clocks (~20 ms) before its budget starts.
 /// Throws ParameterError for an invalid request (bad budget, interval, cap,
 /// start_front index out of range). Trees are assumed valid (see validate()).
 void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request, CollisionResult& result);

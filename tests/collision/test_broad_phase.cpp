@@ -22,7 +22,9 @@ TEST(BroadPhase, SweepAndPruneEqualsAllPairs) {
     }
     const auto expected = all_pairs_overlapping(s);
     EXPECT_EQ(sweep_and_prune(s), expected) << "trial " << trial;
-    if (trial == 19) EXPECT_GT(expected.size(), 50u);
+    if (trial == 19) {
+      EXPECT_GT(expected.size(), 50u);
+    }
   }
   EXPECT_TRUE(sweep_and_prune({}).empty());
   EXPECT_THROW(sweep_and_prune({{0, 0, 0, 1}, {0, std::nan(""), 0, 1}}), ParameterError);
