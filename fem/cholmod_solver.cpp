@@ -41,8 +41,13 @@ void check_status(const cholmod_common& c, const char* call) {
 
 }  // namespace
 
-CholmodSolver::CholmodSolver() : m_impl(new Impl) {
+CholmodSolver::CholmodSolver(CholmodOrdering ordering) : m_impl(new Impl) {
   cholmod_start(&m_impl->common);
+  if (ordering != CholmodOrdering::Default) {
+    m_impl->common.nmethods = 1;
+    m_impl->common.method[0].ordering = ordering == CholmodOrdering::Amd ? CHOLMOD_AMD : CHOLMOD_METIS;
+    m_impl->common.postorder = 1;
+  }
   m_impl->common.print = 0;
   m_impl->common.error_handler = nullptr;
   m_impl->common.quick_return_if_not_posdef = 1;

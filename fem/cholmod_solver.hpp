@@ -7,13 +7,18 @@
 
 namespace icd::fem {
 
+/// Fill-reducing ordering of the symbolic analysis.
+enum class CholmodOrdering {
+  Default,  ///< CHOLMOD's strategy: AMD, METIS tried when AMD's fill is poor
+  Amd,
+  Metis     ///< METIS nested dissection (least fill on 3D meshes)
+};
+
 /// Sparse symmetric positive definite solver. The matrix is given with both
 /// triangles (or at least the upper one); only the upper triangle is read.
-/// Fill-reducing ordering: CHOLMOD's default strategy (AMD, with METIS tried
-/// when AMD's fill is poor).
 class CholmodSolver {
  public:
-  CholmodSolver();
+  explicit CholmodSolver(CholmodOrdering ordering = CholmodOrdering::Default);
   ~CholmodSolver();
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;

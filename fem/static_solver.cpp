@@ -39,21 +39,30 @@ NewtonReport StaticSolver::solve(Model& model, MatX3d& x, const NewtonOptions& o
       rep.converged = true;
       break;
     }
-    // Backtracking: accept when the potential or the residual decreases.
+    // Backtracking: accept when the potential or the residual decreases. If
+    // neither does at a residual already near the tolerance, the iteration has
+    // reached the round-off floor of the internal forces: stop, converged.
     double t = 1.0;
-    for (int ls = 0; ls < 30; ++ls, t *= 0.5) {
+    bool accepted = false;
+    for (int ls = 0; ls < 30 && !accepted; ++ls, t *= 0.5) {
       x_try = x;
       flat(x_try) += t * dx;
       const double pt = potential(x_try);
       model.total_force(x_try, zero, g_try);
       const double gt = flat(g_try).norm();
-      if ((std::isfinite(pt) && pt < pot) || gt < gn || ls == 29) {
+      if ((std::isfinite(pt) && pt < pot) || gt < gn) {
         x.swap(x_try);
         g.swap(g_try);
         gn = gt;
         pot = pt;
+        accepted = true;
+      } else if (ls == 0 && gn <= std::sqrt(options.tolerance) * rep.reference) {
         break;
       }
+    }
+    if (!accepted) {
+      rep.converged = gn <= std::sqrt(options.tolerance) * rep.reference;
+      break;
     }
   }
   rep.residual = gn;

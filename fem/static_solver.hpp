@@ -13,10 +13,12 @@ class StaticSolver {
  public:
   /// Solves for x (in: initial guess, e.g. rest positions; out: equilibrium;
   /// fixed nodes stay where they are). Converged when |residual| <= tolerance
-  /// * |f_ext + M g| over the free nodes (or when the Newton update is below
-  /// 1e-14 of the mesh size). Line search on the total potential
-  /// W(x) - (f_ext + M g) . x. Damping is irrelevant at rest.
-  NewtonReport solve(Model& model, MatX3d& x, const NewtonOptions& options = {1000, 1e-10});
+  /// * |f_ext + M g| over the free nodes, when the Newton update is below
+  /// 1e-14 of the mesh size, or when no step along the Newton direction
+  /// reduces the potential or the residual while |residual| <= sqrt(tolerance)
+  /// * |f_ext + M g| (the round-off floor of the internal forces). Line search
+  /// on the total potential W(x) - (f_ext + M g) . x. Damping plays no role.
+  NewtonReport solve(Model& model, MatX3d& x, const NewtonOptions& options = {100, 1e-10});
 
  private:
   CholmodSolver m_solver;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "fem/material.hpp"
+#include "fem/model.hpp"
 #include "fem/tet_mesh_data.hpp"
 #include "mesh/io/primitives.hpp"
 
@@ -57,6 +58,35 @@ inline Material material(MaterialModel model, double young = 1e6, double poisson
 /// Test-name generator of parameterised tests over material models.
 inline std::string model_name(const ::testing::TestParamInfo<MaterialModel>& param_info) {
   return to_string(param_info.param);
+}
+
+/// Cantilever 1.0 x 0.1 x 0.1 m on a (10 r) x r x r-cell structured mesh,
+/// clamped (all nodes fixed) at x = 0, optionally under gravity along -z.
+inline Model cantilever(int r, const Material& mat, double gravity = 9.81, RayleighDamping damping = {},
+                        int num_threads = 1) {
+  const TetMesh m = box(10 * r, r, r);
+  ModelOptions o;
+  o.gravity = {0.0, 0.0, -gravity};
+  o.damping = damping;
+  o.forces.num_threads = num_threads;
+  Model model(m.V, m.T, mat, o);
+  std::vector<int> fixed;
+  for (int i = 0; i < m.V.rows(); ++i)
+    if (m.V(i, 0) < 1e-12) fixed.push_back(i);
+  model.set_fixed_nodes(fixed);
+  return model;
+}
+
+/// Mean z displacement of the nodes at x = L = 1 m.
+inline double tip_deflection(const Model& model, const MatX3d& x) {
+  double sum = 0;
+  int count = 0;
+  for (int i = 0; i < model.num_nodes(); ++i)
+    if (model.mesh().rest_positions(i, 0) > 1.0 - 1e-12) {
+      sum += x(i, 2) - model.mesh().rest_positions(i, 2);
+      ++count;
+    }
+  return sum / count;
 }
 
 /// A rotation about a generic axis by a large angle.
