@@ -98,6 +98,11 @@ double output_seconds_per_pair() {
   return cost;
 }
 
+// Per-pair cost of finishing an interrupted query (copying the pending pairs,
+// computing completed_level), learnt from the interrupted queries of this
+// thread, starting from the calibrated copy cost.
+thread_local double t_finish_cost = 0.0;
+
 // Budget: one integer compare per sphere test; the clock is read only every
 // `interval` tests.
 class Budget {
@@ -134,12 +139,13 @@ class Budget {
       return false;
     }
     if (m_timed) {
-      const double reserve = static_cast<double>(pending) * output_seconds_per_pair();
+      const double reserve = static_cast<double>(pending) * t_finish_cost;
       const bool expired =
           m_use_tsc ? read_cycle_counter() + static_cast<uint64_t>(reserve * cycle_counter_hz()) >= m_tsc_deadline
                     : Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(reserve)) >= m_deadline;
       if (expired) {
         reason = StopReason::TimeBudget;
+        m_stopped_at = Clock::now();
         return false;
       }
       m_next = std::min<int64_t>(tests + m_interval, m_max_tests);
@@ -148,6 +154,11 @@ class Budget {
     }
     return true;
   }
+
+ public:
+  Clock::time_point m_stopped_at{};  ///< when a time stop was decided
+
+ private:
   int64_t m_max_tests;
   int64_t m_next = 0;
   bool m_timed = false, m_use_tsc = false;
@@ -327,7 +338,7 @@ CollisionRequest CollisionRequest::paper_reference(double budget_seconds) {
 
 void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request, CollisionResult& res) {
   if (std::isfinite(request.budget_seconds)) {  // one-time calibrations, outside the budget
-    output_seconds_per_pair();
+    if (t_finish_cost == 0.0) t_finish_cost = output_seconds_per_pair();
     if (request.clock == ClockSource::CycleCounter) cycle_counter_hz();
   }
   const Clock::time_point start = Clock::now();
@@ -424,7 +435,15 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
     res.front.insert(res.front.end(), res.colliding.begin(), res.colliding.end());
     std::rotate(res.front.begin(), res.front.begin() + pruned, res.front.end());
   }
-  res.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const Clock::time_point end = Clock::now();
+  res.seconds = std::chrono::duration<double>(end - start).count();
+  if (res.stop_reason == StopReason::TimeBudget && res.untested.size() >= 256) {
+    const double observed = std::chrono::duration<double>(end - budget.m_stopped_at).count() / res.untested.size();
+    // Smoothed and clipped, so that one preempted finish does not make later
+    // queries stop far too early; never below the calibrated copy cost.
+    t_finish_cost = std::max(output_seconds_per_pair(),
+                             0.9 * t_finish_cost + 0.1 * std::min(observed, 4.0 * t_finish_cost));
+  }
 }
 
 CollisionResult collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request) {
