@@ -1,0 +1,62 @@
+#pragma once
+/// Top-down construction of a wrapped sphere tree from an adaptive
+/// medial-axis approximation (paper sec. 4.1; Bradshaw & O'Sullivan 2004).
+#include <vector>
+
+#include "collision/sphere_tree.hpp"
+#include "mesh/io/types.hpp"
+#include "mesh/spheres/reduction.hpp"
+#include "mesh/spheres/surface_sampling.hpp"
+
+namespace icd::mesh {
+
+/// Options of build_sphere_tree(). Lengths are fractions of the longest side
+/// of the model's axis-aligned bounding box (so 0.001 is 2 units when that
+/// side is 2000), which makes the defaults independent of the model's scale.
+struct SphereTreeOptions {
+  int branching = 8;  ///< at most this many children per node (>= 2)
+  /// Levels *below the root*: the tree has depth + 1 levels (the root is
+  /// level 0), at most branching^l nodes on level l. depth 3 with branching 8
+  /// is the paper's setting (1 + 8 + 64 + 512 nodes at most), as in the
+  /// reference toolkit (whose .sph header then reads "4 8").
+  int depth = 3;
+  /// Optional cap on the number of spheres of each level (index = level; a
+  /// missing or non-positive entry means branching^level). Extra spheres go
+  /// where they lower the error most.
+  std::vector<int> max_spheres_per_level;
+  /// Spacing of the coverage samples (relative); their gap (<= spacing /
+  /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
+  double cover_spacing = 1.0 / 700.0;
+  /// Spacing of the samples whose Voronoi diagram gives the medial axis and
+  /// on which the spheres are placed (relative, >= cover_spacing).
+  double medial_spacing = 1.0 / 120.0;
+  int refinement_iterations = 2;          ///< adaptive medial-axis rounds (>= 0)
+  double refinement_tolerance = 0.002;    ///< medial sphere error that triggers refinement (relative)
+  int lloyd_iterations = 8;               ///< see ReductionOptions
+  /// Wall-clock budget (seconds, > 0). Past it the optimisation stops early
+  /// (no more refinement or Lloyd rounds); the tree stays valid and covering.
+  double time_limit = 60.0;
+};
+
+/// Result of build_sphere_tree().
+struct SphereTreeBuild {
+  collision::SphereTree tree;          ///< spheres in model units; assoc_* left empty
+  SurfaceSamples samples;              ///< the coverage samples
+  /// Coverage samples of each node: node i covers samples node_samples[i]
+  /// with margin (|s - c| + gap[s] <= r); its children divide them.
+  std::vector<std::vector<int>> node_samples;
+  std::vector<double> node_depth;      ///< distance from each centre to the surface
+  int num_medial_spheres = 0;          ///< medial spheres (Voronoi + cover) after refinement
+  int num_refinement_points = 0;       ///< points added by the adaptive refinement
+  double seconds = 0;                  ///< wall-clock build time
+  bool hit_time_limit = false;         ///< true when the optimisation was cut short
+};
+
+/// Builds the wrapped sphere tree of the triangle mesh (V #V x 3, F #F x 3,
+/// outward-oriented; holes are closed first, see close_holes). Every level
+/// covers the whole surface: each node covers its samples with margin, and
+/// its children divide those samples. Deterministic. Throws ParameterError
+/// for invalid options, InputError for an empty or invalid mesh.
+SphereTreeBuild build_sphere_tree(const SurfaceMesh& mesh, const SphereTreeOptions& options = {});
+
+}  // namespace icd::mesh

@@ -1,0 +1,195 @@
+#include "mesh/spheres/evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <unordered_map>
+
+#include "mesh/io/error.hpp"
+#include "mesh/io/primitives.hpp"
+#include "mesh/spheres/mesh_oracle.hpp"
+#include "mesh/spheres/surface_sampling.hpp"
+
+namespace icd::mesh {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Spheres of one level bucketed in a uniform grid; very large spheres are
+/// kept in a separate list tested for every query.
+class SphereGrid {
+ public:
+  SphereGrid(std::vector<collision::Sphere> spheres) : m_spheres(std::move(spheres)) {
+    std::vector<double> radii;
+    for (const auto& s : m_spheres) radii.push_back(s.r);
+    std::nth_element(radii.begin(), radii.begin() + static_cast<long>(radii.size() / 2), radii.end());
+    m_cell = std::max(radii[radii.size() / 2], 1e-9);
+    for (int i = 0; i < static_cast<int>(m_spheres.size()); ++i) {
+      const auto& s = m_spheres[static_cast<size_t>(i)];
+      if (s.r > 4 * m_cell) {
+        m_big.push_back(i);
+        continue;
+      }
+      const Eigen::Vector3i lo = cell({s.x - s.r, s.y - s.r, s.z - s.r});
+      const Eigen::Vector3i hi = cell({s.x + s.r, s.y + s.r, s.z + s.r});
+      for (int a = lo.x(); a <= hi.x(); ++a)
+        for (int b = lo.y(); b <= hi.y(); ++b)
+          for (int c = lo.z(); c <= hi.z(); ++c) m_cells[key({a, b, c})].push_back(i);
+    }
+  }
+
+  bool covered(const Eigen::Vector3d& p) const {
+    for (int i : m_big) {
+      if (inside(i, p)) return true;
+    }
+    auto it = m_cells.find(key(cell(p)));
+    if (it == m_cells.end()) return false;
+    for (int i : it->second) {
+      if (inside(i, p)) return true;
+    }
+    return false;
+  }
+
+  /// Distance from p to the nearest sphere (<= 0 when covered); brute force.
+  double gap(const Eigen::Vector3d& p) const {
+    double best = kInf;
+    for (const auto& s : m_spheres) best = std::min(best, (p - s.center()).norm() - s.r);
+    return best;
+  }
+
+ private:
+  bool inside(int i, const Eigen::Vector3d& p) const {
+    const auto& s = m_spheres[static_cast<size_t>(i)];
+    return (p - s.center()).squaredNorm() <= s.r * s.r;
+  }
+  Eigen::Vector3i cell(const Eigen::Vector3d& p) const {
+    return {static_cast<int>(std::floor(p.x() / m_cell)), static_cast<int>(std::floor(p.y() / m_cell)),
+            static_cast<int>(std::floor(p.z() / m_cell))};
+  }
+  static long long key(const Eigen::Vector3i& c) {
+    return (static_cast<long long>(c.x()) * 73856093LL) ^ (static_cast<long long>(c.y()) * 19349663LL) ^
+           (static_cast<long long>(c.z()) * 83492791LL);
+  }
+
+  std::vector<collision::Sphere> m_spheres;
+  double m_cell = 1;
+  std::vector<int> m_big;
+  std::unordered_map<long long, std::vector<int>> m_cells;
+};
+
+void check_tree(const collision::SphereTree& tree) {
+  const int n = tree.num_nodes();
+  if (n == 0 || tree.num_levels() < 1 || tree.level_offset.back() != n ||
+      static_cast<int>(tree.first_child.size()) != n || static_cast<int>(tree.child_count.size()) != n) {
+    throw ParameterError("evaluate_sphere_tree: the tree is empty or its arrays are inconsistent");
+  }
+  for (const auto& s : tree.spheres) {
+    if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || !(s.r >= 0)) {
+      throw ParameterError("evaluate_sphere_tree: a sphere has a non-finite centre or a negative radius");
+    }
+  }
+}
+
+}  // namespace
+
+MatX3d probe_directions(int subdivisions) { return make_icosphere(subdivisions, 1.0).V; }
+
+std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh, const collision::SphereTree& tree,
+                                               const EvaluationOptions& options) {
+  if (!(options.normalized_size > 0) || !(options.coverage_spacing > 0)) {
+    throw ParameterError("EvaluationOptions: normalized_size and coverage_spacing must be positive");
+  }
+  check_tree(tree);
+  const double side = longest_bounding_box_side(mesh.V);
+  if (!(side > 0)) throw InputError("evaluate_sphere_tree: the mesh is empty or degenerate");
+  const double scale = options.normalized_size / side;
+  SurfaceMesh scaled = mesh;
+  scaled.V *= scale;
+  std::vector<collision::Sphere> spheres = tree.spheres;
+  for (auto& s : spheres) s.x *= scale, s.y *= scale, s.z *= scale, s.r *= scale;
+
+  const MeshOracle oracle(close_holes(scaled));
+  const MatX3d probes42 = probe_directions(1), probes162 = probe_directions(2);
+  auto sphere_error = [&](const collision::Sphere& s, const MatX3d& dirs) {
+    double err = 0;
+    for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
+      const Eigen::Vector3d p = s.center() + s.r * dirs.row(d).transpose();
+      if (!oracle.inside(p)) err = std::max(err, oracle.distance(p));
+    }
+    return err;
+  };
+
+  const int num_levels = tree.num_levels();
+  std::vector<LevelMetrics> out(static_cast<size_t>(num_levels));
+  std::vector<int32_t> parent(static_cast<size_t>(tree.num_nodes()), -1);
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    for (int k = 0; k < tree.child_count[static_cast<size_t>(i)]; ++k) {
+      parent[static_cast<size_t>(tree.first_child[static_cast<size_t>(i)] + k)] = i;
+    }
+  }
+  std::vector<SphereGrid> grids;
+  for (int l = 0; l < num_levels; ++l) {
+    LevelMetrics& m = out[static_cast<size_t>(l)];
+    m.level = l;
+    const int begin = tree.level_offset[static_cast<size_t>(l)], end = tree.level_offset[static_cast<size_t>(l) + 1];
+    m.num_spheres = end - begin;
+    for (int i = begin; i < end; ++i) {
+      const auto& s = spheres[static_cast<size_t>(i)];
+      const double e42 = sphere_error(s, probes42), e162 = sphere_error(s, probes162);
+      m.worst_error_42 = std::max(m.worst_error_42, e42);
+      m.worst_error_162 = std::max(m.worst_error_162, e162);
+      m.mean_error_42 += e42 / m.num_spheres;
+      m.mean_error_162 += e162 / m.num_spheres;
+      const int p = parent[static_cast<size_t>(i)];
+      if (p >= 0) {
+        const auto& ps = spheres[static_cast<size_t>(p)];
+        m.max_child_protrusion = std::max(m.max_child_protrusion, (s.center() - ps.center()).norm() + s.r - ps.r);
+      }
+    }
+    grids.emplace_back(std::vector<collision::Sphere>(spheres.begin() + begin, spheres.begin() + end));
+    for (Eigen::Index v = 0; v < scaled.V.rows(); ++v) {
+      if (!grids.back().covered(scaled.V.row(v))) ++m.num_uncovered_vertices;
+    }
+  }
+
+  // Dense coverage, streamed triangle by triangle (no sample storage).
+  std::vector<double> uncovered_area(static_cast<size_t>(num_levels), 0.0);
+  double total_area = 0;
+  for (Eigen::Index f = 0; f < scaled.F.rows(); ++f) {
+    const Eigen::Vector3d a = scaled.V.row(scaled.F(f, 0)), b = scaled.V.row(scaled.F(f, 1)),
+                          c = scaled.V.row(scaled.F(f, 2));
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int n = std::max(1, static_cast<int>(std::ceil(longest / options.coverage_spacing)));
+    const double sub_area = 0.5 * (b - a).cross(c - a).norm() / (static_cast<double>(n) * n);
+    total_area += sub_area * n * n;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i + j <= n; ++i) {
+        // Number of sub-triangles having lattice point (i, j) as a corner.
+        const bool corner = (i == 0 && j == 0) || (i == n && j == 0) || (i == 0 && j == n);
+        const bool edge = (i == 0 || j == 0 || i + j == n);
+        const int incident = corner ? 1 : (edge ? 3 : 6);
+        const double weight = sub_area * incident / 3.0;
+        const Eigen::Vector3d p =
+            a + (b - a) * (static_cast<double>(i) / n) + (c - a) * (static_cast<double>(j) / n);
+        for (int l = 0; l < num_levels; ++l) {
+          LevelMetrics& m = out[static_cast<size_t>(l)];
+          ++m.num_dense_samples;
+          if (grids[static_cast<size_t>(l)].covered(p)) continue;
+          ++m.num_uncovered_samples;
+          uncovered_area[static_cast<size_t>(l)] += weight;
+          m.max_uncovered_gap = std::max(m.max_uncovered_gap, grids[static_cast<size_t>(l)].gap(p));
+        }
+      }
+    }
+  }
+  for (int l = 0; l < num_levels; ++l) {
+    out[static_cast<size_t>(l)].uncovered_area_fraction =
+        total_area > 0 ? uncovered_area[static_cast<size_t>(l)] / total_area : 0.0;
+  }
+  return out;
+}
+
+}  // namespace icd::mesh

@@ -1,0 +1,54 @@
+#pragma once
+/// Per-level quality of a sphere tree against its surface (issue 5 metrics).
+#include <vector>
+
+#include "collision/sphere_tree.hpp"
+#include "mesh/io/types.hpp"
+
+namespace icd::mesh {
+
+/// Options of evaluate_sphere_tree().
+struct EvaluationOptions {
+  /// The model (and tree) are scaled so that the longest bounding-box side
+  /// is this long; every length reported is in these units.
+  double normalized_size = 2000.0;
+  /// Spacing of the dense coverage sampling, in normalized units (> 0): each
+  /// triangle is split into n x n sub-triangles (n = ceil(longest edge /
+  /// spacing)) whose corners are tested, weighted by a third of each
+  /// sub-triangle's area. Make it much finer than the build's samples.
+  double coverage_spacing = 1.0;
+};
+
+/// Metrics of one level of the tree (normalized units).
+struct LevelMetrics {
+  int level = 0;
+  int num_spheres = 0;
+  /// Error of a sphere with P probes: the largest distance to the surface of
+  /// the probes c + r d (d: the P vertices of a subdivided icosahedron) that
+  /// lie outside the closed mesh (0 when none does). Worst and mean over the level.
+  double worst_error_42 = 0, mean_error_42 = 0;
+  double worst_error_162 = 0, mean_error_162 = 0;
+  double uncovered_area_fraction = 0;  ///< area of dense samples outside every sphere / total area
+  long long num_dense_samples = 0;     ///< dense samples tested
+  long long num_uncovered_samples = 0; ///< dense samples outside every sphere of the level
+  double max_uncovered_gap = 0;        ///< largest distance from an uncovered sample to the nearest sphere
+  int num_uncovered_vertices = 0;      ///< mesh vertices outside every sphere of the level
+  /// How far the level's spheres stick out of their parents (max over nodes
+  /// of |c - c_parent| + r - r_parent, >= 0; 0 for the root).
+  double max_child_protrusion = 0;
+};
+
+/// Evaluates every level of `tree` (model units, built for `mesh`: V #V x 3,
+/// F #F x 3, outward-oriented) after scaling both so the longest side of the
+/// mesh's bounding box is options.normalized_size. Holes are closed (see
+/// close_holes) before any inside test; coverage is measured on the input
+/// surface. Throws ParameterError for bad options or an invalid tree (see
+/// collision::validate), InputError for an empty or degenerate mesh.
+std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh, const collision::SphereTree& tree,
+                                               const EvaluationOptions& options = {});
+
+/// The probe directions: vertices of the icosahedron subdivided `subdivisions`
+/// times (12, 42, 162, ... unit vectors).
+MatX3d probe_directions(int subdivisions);
+
+}  // namespace icd::mesh

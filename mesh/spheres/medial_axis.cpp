@@ -1,0 +1,154 @@
+#include "mesh/spheres/medial_axis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include "mesh/io/error.hpp"
+
+namespace icd::mesh {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb>;
+using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
+
+Eigen::Vector3d to_eigen(const Point& p) { return {p.x(), p.y(), p.z()}; }
+
+/// One inner Voronoi vertex: circumcentre, circumradius, and the samples
+/// (vertex infos) of its Delaunay cell.
+struct InnerVertex {
+  Eigen::Vector3d center;
+  double circumradius;
+  double inscribed;
+  int corner[4];
+};
+
+std::vector<InnerVertex> inner_vertices(const Delaunay& dt, const MeshOracle& oracle) {
+  std::vector<InnerVertex> out;
+  for (auto cell = dt.finite_cells_begin(); cell != dt.finite_cells_end(); ++cell) {
+    const Point c = CGAL::circumcenter(cell->vertex(0)->point(), cell->vertex(1)->point(),
+                                       cell->vertex(2)->point(), cell->vertex(3)->point());
+    const Eigen::Vector3d center = to_eigen(c);
+    if (!center.allFinite() || !oracle.inside(center)) continue;
+    InnerVertex v;
+    v.center = center;
+    v.circumradius = std::sqrt(CGAL::squared_distance(c, cell->vertex(0)->point()));
+    v.inscribed = oracle.distance(center);
+    for (int k = 0; k < 4; ++k) v.corner[k] = cell->vertex(k)->info();
+    out.push_back(v);
+  }
+  return out;
+}
+
+}  // namespace
+
+MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSamples& samples,
+                                      const MedialAxisOptions& options) {
+  if (options.refinement_iterations < 0 || options.max_insertions_per_iteration < 0) {
+    throw ParameterError("MedialAxisOptions: refinement_iterations and max_insertions_per_iteration must be >= 0");
+  }
+  if (!(options.error_tolerance > 0)) {
+    throw ParameterError("MedialAxisOptions::error_tolerance must be positive, got " +
+                         std::to_string(options.error_tolerance));
+  }
+  const auto ns = static_cast<int>(samples.points.rows());
+  if (ns < 4) throw InputError("approximate_medial_axis: need at least 4 samples, got " + std::to_string(ns));
+
+  std::vector<std::pair<Point, int>> input;
+  input.reserve(static_cast<size_t>(ns));
+  for (int s = 0; s < ns; ++s) {
+    input.emplace_back(Point(samples.points(s, 0), samples.points(s, 1), samples.points(s, 2)), s);
+  }
+  Delaunay dt(input.begin(), input.end());
+  if (dt.dimension() < 3) throw InputError("approximate_medial_axis: the samples are coplanar");
+
+  MedialSpheres out;
+  std::vector<InnerVertex> inner = inner_vertices(dt, oracle);
+  int next_info = ns;  // inserted points get infos >= ns (not samples)
+  for (int it = 0; it < options.refinement_iterations; ++it) {
+    // Worst spheres first, so that the insertion budget goes where the error is.
+    std::vector<std::pair<double, int>> bad;
+    for (int i = 0; i < static_cast<int>(inner.size()); ++i) {
+      const double err = inner[static_cast<size_t>(i)].circumradius - inner[static_cast<size_t>(i)].inscribed;
+      if (err > options.error_tolerance) bad.emplace_back(-err, i);
+    }
+    if (bad.empty()) break;
+    std::sort(bad.begin(), bad.end());
+    if (static_cast<int>(bad.size()) > options.max_insertions_per_iteration) {
+      bad.resize(static_cast<size_t>(options.max_insertions_per_iteration));
+    }
+    int inserted = 0;
+    for (const auto& [neg_err, i] : bad) {
+      (void)neg_err;
+      const Eigen::Vector3d q = oracle.closest_point(inner[static_cast<size_t>(i)].center);
+      const Point p(q.x(), q.y(), q.z());
+      Delaunay::Locate_type lt;
+      int li, lj;
+      const auto cell = dt.locate(p, lt, li, lj);
+      if (lt == Delaunay::VERTEX) continue;
+      auto vh = dt.insert(p, cell);
+      vh->info() = next_info++;
+      ++inserted;
+    }
+    out.num_inserted += inserted;
+    if (inserted == 0) break;
+    inner = inner_vertices(dt, oracle);
+  }
+
+  // Cover spheres for samples that no inner cell touches (thin features).
+  std::vector<char> touched(static_cast<size_t>(ns), 0);
+  for (const auto& v : inner) {
+    for (int k = 0; k < 4; ++k) {
+      if (v.corner[k] < ns) touched[static_cast<size_t>(v.corner[k])] = 1;
+    }
+  }
+  const SurfaceMesh& mesh = oracle.mesh();
+  std::vector<Eigen::Vector3d> cover_centers;
+  std::vector<double> cover_radii;
+  for (int s = 0; s < ns; ++s) {
+    if (touched[static_cast<size_t>(s)]) continue;
+    const int f = samples.face[s];
+    Eigen::Vector3d center = samples.points.row(s);
+    if (f >= 0 && f < mesh.F.rows()) {
+      const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                            c = mesh.V.row(mesh.F(f, 2));
+      const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+      const double step = 0.25 * samples.gap[s];
+      if (n.allFinite() && step > 0 && oracle.inside(center - step * n)) center -= step * n;
+    }
+    cover_centers.push_back(center);
+    cover_radii.push_back(oracle.distance(center));
+  }
+
+  const auto nm = static_cast<Eigen::Index>(inner.size() + cover_centers.size());
+  out.centers.resize(nm, 3);
+  out.radii.resize(nm);
+  out.circumradii.resize(nm);
+  Eigen::Index m = 0;
+  for (const auto& v : inner) {
+    out.centers.row(m) = v.center;
+    out.radii[m] = v.inscribed;
+    out.circumradii[m] = v.circumradius;
+    ++m;
+  }
+  out.num_voronoi = static_cast<int>(inner.size());
+  for (size_t i = 0; i < cover_centers.size(); ++i) {
+    out.centers.row(m) = cover_centers[i];
+    out.radii[m] = cover_radii[i];
+    out.circumradii[m] = cover_radii[i];
+    ++m;
+  }
+  return out;
+}
+
+}  // namespace icd::mesh

@@ -1,0 +1,210 @@
+#include "mesh/spheres/reduction.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/convex_hull_3.h>
+
+#include "mesh/io/error.hpp"
+
+namespace icd::mesh {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Extreme points (convex hull vertices) of the member samples, as rows.
+std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points, const std::vector<int>& members) {
+  std::vector<Eigen::Vector3d> out;
+  if (members.size() <= 64) {
+    for (int s : members) out.emplace_back(points.row(s));
+    return out;
+  }
+  std::vector<Point> in;
+  in.reserve(members.size());
+  for (int s : members) in.emplace_back(points(s, 0), points(s, 1), points(s, 2));
+  std::vector<Point> hull;
+  CGAL::extreme_points_3(in, std::back_inserter(hull));
+  if (hull.empty()) {  // degenerate (coplanar) input: keep every point
+    for (int s : members) out.emplace_back(points.row(s));
+    return out;
+  }
+  for (const Point& p : hull) out.emplace_back(p.x(), p.y(), p.z());
+  return out;
+}
+
+double max_distance(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& c) {
+  double best = 0;
+  for (const auto& p : pts) best = std::max(best, (p - c).squaredNorm());
+  return std::sqrt(best);
+}
+
+void refit_radius(const ReductionProblem& problem, FittedSphere& sphere) {
+  double r = 0;
+  for (int s : sphere.members) {
+    r = std::max(r, (problem.points.row(s).transpose() - sphere.center).norm() + problem.gap[s]);
+  }
+  sphere.radius = r;
+  sphere.error = r - sphere.depth;
+}
+
+/// Lloyd assignment: member -> index of the sphere minimizing |s - c| - depth.
+std::vector<int> assign(const ReductionProblem& problem, const std::vector<int>& members,
+                        const std::vector<FittedSphere>& spheres) {
+  std::vector<int> owner(members.size(), 0);
+  for (size_t m = 0; m < members.size(); ++m) {
+    const Eigen::Vector3d s = problem.points.row(members[m]);
+    double best = kInf;
+    for (size_t j = 0; j < spheres.size(); ++j) {
+      const double v = (s - spheres[j].center).norm() - spheres[j].depth;
+      if (v < best) best = v, owner[m] = static_cast<int>(j);
+    }
+  }
+  return owner;
+}
+
+double objective(const std::vector<FittedSphere>& spheres) {
+  double worst = 0, sum = 0;
+  for (const auto& s : spheres) worst = std::max(worst, s.error), sum += s.error;
+  return worst + sum / static_cast<double>(spheres.size());
+}
+
+/// Splits `members` by `owner` into the spheres' member lists; removes empty spheres.
+void distribute(const std::vector<int>& members, const std::vector<int>& owner,
+                std::vector<FittedSphere>& spheres) {
+  for (auto& s : spheres) s.members.clear();
+  for (size_t m = 0; m < members.size(); ++m) spheres[static_cast<size_t>(owner[m])].members.push_back(members[m]);
+  spheres.erase(std::remove_if(spheres.begin(), spheres.end(), [](const FittedSphere& s) { return s.members.empty(); }),
+                spheres.end());
+}
+
+}  // namespace
+
+FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>& members, const FittedSphere* hint,
+                        const ReductionOptions& options) {
+  assert(!members.empty());
+  FittedSphere out;
+  out.members = members;
+  std::sort(out.members.begin(), out.members.end());
+  const std::vector<Eigen::Vector3d> hull = extreme_points(problem.points, members);
+  double gmax = 0;
+  for (int s : members) gmax = std::max(gmax, problem.gap[s]);
+
+  Eigen::Vector3d ball_center;
+  double ball_radius;
+  if (hint != nullptr) {
+    ball_center = hint->center, ball_radius = hint->radius;
+  } else {
+    ball_center = Eigen::Vector3d::Zero();
+    for (const auto& p : hull) ball_center += p;
+    ball_center /= static_cast<double>(hull.size());
+    ball_radius = max_distance(hull, ball_center) + gmax;
+  }
+  std::vector<int> cands = problem.medial_grid.query_ball(ball_center, ball_radius);
+  const size_t limit = static_cast<size_t>(std::max(1, options.max_candidates));
+  const size_t stride = cands.size() > limit ? (cands.size() + limit - 1) / limit : 1;
+
+  double best = kInf;
+  int best_idx = -1;
+  for (size_t i = 0; i < cands.size(); i += stride) {
+    const int m = cands[i];
+    const Eigen::Vector3d c = problem.medial.centers.row(m);
+    const double cost = max_distance(hull, c) - problem.medial.radii[m];
+    if (cost < best) best = cost, best_idx = m;
+  }
+  if (hint != nullptr && hint->depth > 0) {
+    const double cost = max_distance(hull, hint->center) - hint->depth;
+    if (cost <= best) best = cost, best_idx = -2;
+  }
+  if (best_idx >= 0) {
+    out.center = problem.medial.centers.row(best_idx);
+    out.depth = problem.medial.radii[best_idx];
+  } else if (best_idx == -2) {
+    out.center = hint->center;
+    out.depth = hint->depth;
+  } else {
+    out.center = ball_center;
+    out.depth = 0;
+  }
+  refit_radius(problem, out);
+  return out;
+}
+
+void assign_and_refit(const ReductionProblem& problem, const std::vector<int>& members,
+                      std::vector<FittedSphere>& spheres) {
+  if (spheres.empty()) return;
+  const std::vector<int> owner = assign(problem, members, spheres);
+  distribute(members, owner, spheres);
+  for (auto& s : spheres) refit_radius(problem, s);
+}
+
+std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem& problem,
+                                                         const std::vector<int>& members, int max_k,
+                                                         const ReductionOptions& options) {
+  if (max_k < 1) throw ParameterError("reduce_to_spheres: max_k must be >= 1, got " + std::to_string(max_k));
+  if (members.empty()) throw ParameterError("reduce_to_spheres: no samples to cover");
+  std::vector<std::vector<FittedSphere>> result;
+  std::vector<FittedSphere> spheres{fit_sphere(problem, members, nullptr, options)};
+  result.push_back(spheres);
+
+  for (int k = 2; k <= max_k; ++k) {
+    // Seed: the sample whose assignment cost (error it causes) is largest.
+    const std::vector<int> owner = assign(problem, members, spheres);
+    double worst = -kInf;
+    size_t worst_m = 0;
+    for (size_t m = 0; m < members.size(); ++m) {
+      const auto& sp = spheres[static_cast<size_t>(owner[m])];
+      const int s = members[m];
+      const double v = (problem.points.row(s).transpose() - sp.center).norm() - sp.depth + problem.gap[s];
+      if (v > worst) worst = v, worst_m = m;
+    }
+    const Eigen::Vector3d seed = problem.points.row(members[worst_m]);
+    const double search = std::max(spheres[static_cast<size_t>(owner[worst_m])].radius, 1e-12);
+    const std::vector<int> cands = problem.medial_grid.query_ball(seed, search);
+    double best = kInf;
+    int best_idx = -1;
+    for (int m : cands) {
+      const Eigen::Vector3d c = problem.medial.centers.row(m);
+      const double depth = problem.medial.radii[m];
+      const double v = (seed - c).norm() - depth - options.depth_bias * depth;
+      if (v < best) best = v, best_idx = m;
+    }
+    if (best_idx < 0) break;  // nothing to add: keep fewer spheres
+    FittedSphere added;
+    added.center = problem.medial.centers.row(best_idx);
+    added.depth = problem.medial.radii[best_idx];
+    added.radius = search;
+    spheres.push_back(added);
+    assign_and_refit(problem, members, spheres);
+
+    std::vector<FittedSphere> best_config = spheres;
+    double best_obj = objective(spheres);
+    for (int it = 0; it < options.lloyd_iterations; ++it) {
+      if (std::chrono::steady_clock::now() > options.deadline) break;
+      std::vector<std::vector<int>> before;
+      for (auto& s : spheres) {
+        const FittedSphere hint = s;
+        s = fit_sphere(problem, s.members, &hint, options);
+        before.push_back(s.members);
+      }
+      assign_and_refit(problem, members, spheres);
+      const double obj = objective(spheres);
+      if (obj < best_obj) best_obj = obj, best_config = spheres;
+      bool stable = spheres.size() == before.size();
+      for (size_t j = 0; stable && j < spheres.size(); ++j) stable = spheres[j].members == before[j];
+      if (stable) break;
+    }
+    spheres = best_config;
+    result.push_back(spheres);
+  }
+  while (static_cast<int>(result.size()) < max_k) result.push_back(result.back());
+  return result;
+}
+
+}  // namespace icd::mesh

@@ -1,0 +1,75 @@
+#pragma once
+/// Reduction of the medial-sphere set to a few spheres covering a patch of
+/// surface samples (one node of the sphere tree and its children).
+#include <chrono>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mesh/io/types.hpp"
+#include "mesh/spheres/medial_axis.hpp"
+#include "mesh/spheres/point_grid.hpp"
+
+namespace icd::mesh {
+
+/// A sphere fitted to surface samples: it contains every member sample s
+/// with margin gap[s], i.e. |s - center| + gap[s] <= radius.
+struct FittedSphere {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0;   ///< model units
+  double depth = 0;    ///< distance from the centre to the surface (centre inside; 0 if unknown)
+  /// Error bound radius - depth: no point of the sphere is farther than this
+  /// from the object (a point of the sphere at distance radius from the centre
+  /// is at most radius - depth beyond the surface along the ray from the centre).
+  double error = 0;
+  std::vector<int> members;  ///< sample indices the sphere covers (sorted)
+};
+
+/// The fixed data of a reduction: samples with their coverage margins, and
+/// the candidate centres (medial spheres) with a grid over them.
+struct ReductionProblem {
+  const MatX3d& points;          ///< #S x 3 surface samples
+  const Eigen::VectorXd& gap;    ///< #S coverage margins
+  const MedialSpheres& medial;   ///< candidate centres and their depths
+  const PointGrid& medial_grid;  ///< grid over medial.centers
+};
+
+/// Options of reduce_to_spheres().
+struct ReductionOptions {
+  int lloyd_iterations = 8;      ///< assignment / refit rounds after each split (>= 0)
+  int max_candidates = 2500;     ///< candidate centres tried per refit (evenly thinned beyond)
+  double depth_bias = 0.05;      ///< preference for deep centres when seeding a new sphere
+  /// Past this time only the greedy splits run (no Lloyd rounds): the result is still valid.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+};
+
+/// Fits one sphere to the samples `members`: the candidate centre with the
+/// smallest error bound (max |s - c| + gap - depth(c), evaluated on the
+/// extreme points of the members), then the exact radius over all members.
+/// `hint` (may be null) restricts the candidates to those inside it; without
+/// it the candidates inside the members' bounding ball are tried. Falls back
+/// to the members' bounding ball (depth 0) when no candidate is found.
+FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>& members,
+                        const FittedSphere* hint, const ReductionOptions& options);
+
+/// Reduces the medial set to k = 1 .. max_k spheres that together cover
+/// `members` (non-empty): greedy splitting (a new sphere at the medial ball
+/// touching the worst-covered sample) followed after each split by Lloyd
+/// rounds: each sample goes to the sphere j minimizing |s - c_j| - depth_j
+/// (this minimizes the worst error bound for fixed centres), then each
+/// sphere's centre is refitted (fit_sphere). The best configuration seen
+/// (lowest worst + mean error) is kept. Returns result[k - 1] = k spheres
+/// (possibly fewer when a sphere lost all its samples), each sample in
+/// exactly one sphere's members. Deterministic.
+std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem& problem,
+                                                         const std::vector<int>& members, int max_k,
+                                                         const ReductionOptions& options);
+
+/// Divides `members` among `spheres` (the rule of reduce_to_spheres: sample
+/// s goes to the sphere minimizing |s - c| - depth) and refits every radius
+/// so that each sphere covers its share with margin; centres and depths are
+/// kept, errors updated, spheres left without samples removed.
+void assign_and_refit(const ReductionProblem& problem, const std::vector<int>& members,
+                      std::vector<FittedSphere>& spheres);
+
+}  // namespace icd::mesh
