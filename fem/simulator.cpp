@@ -21,6 +21,8 @@ Simulator::Simulator(Model model, const SimulatorOptions& options)
   if (options.check_interval < 1) bad("check_interval", options.check_interval, ">= 1");
   if (!(options.max_energy_growth > 0)) bad("max_energy_growth", options.max_energy_growth, "> 0");
   if (options.max_retries < 0) bad("max_retries", options.max_retries, ">= 0");
+  if (!(options.frequency_reuse_time >= 0) || !std::isfinite(options.frequency_reuse_time))
+    bad("frequency_reuse_time", options.frequency_reuse_time, ">= 0 s");
   m_state.x = m_model.mesh().rest_positions;
   m_state.v = MatX3d::Zero(m_model.num_nodes(), 3);
   m_energy_floor = 1e-10 * m_model.material().young * m_model.mesh().rest_volume.sum();
@@ -31,6 +33,7 @@ void Simulator::set_positions(const Eigen::Ref<const MatX3d>& x) {
     throw ParameterError("fem::Simulator::set_positions: expected a finite #V x 3 array, #V = " +
                          std::to_string(m_model.num_nodes()));
   m_state.x = x;
+  m_estimate_time = -1;  // a new configuration: estimate again
 }
 
 void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
@@ -44,7 +47,12 @@ void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
 
 double Simulator::stable_step_limit() {
   if (m_options.integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
-  m_frequency = estimate_max_frequency(m_model, m_state.x, m_options.frequency, &m_warm_mode);
+  // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time).
+  const bool fresh = m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
+  if (!fresh) {
+    m_frequency = estimate_max_frequency(m_model, m_state.x, m_options.frequency, &m_warm_mode);
+    m_estimate_time = m_time;
+  }
   if (m_frequency.omega_max <= 0) return std::numeric_limits<double>::infinity();  // all fixed
   return fem::stable_step_limit(m_options.integrator, m_frequency.omega_max, m_model.damping());
 }

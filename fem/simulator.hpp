@@ -28,6 +28,11 @@ struct SimulatorOptions {
   /// Largest step (s), also the backward Euler step when fixed_step is 0.
   double max_step = 1e-2;
   FrequencyOptions frequency;  ///< includes the added contact stiffness
+  /// Reuse the last largest-eigenfrequency estimate for calls of advance() /
+  /// step() within this much simulated time (s, >= 0; 0 = estimate at every
+  /// call). For callers that advance in many short pieces (the runner's
+  /// detection/response cycles); the health checks still guard every step.
+  double frequency_reuse_time = 0;
   int check_interval = 1;      ///< sub-steps between health checks (>= 1)
   /// A check fails when KE + W grows by more than this fraction of
   /// (KE + W + |work of the loads|) since the last check (explicit blow-up).
@@ -102,6 +107,7 @@ class Simulator {
   FrequencyEstimate m_frequency;
   Eigen::VectorXd m_warm_mode;
   double m_energy_floor = 0;
+  double m_estimate_time = -1;  ///< simulated time of the last frequency estimate (-1: none)
 };
 
 }  // namespace icd::fem
