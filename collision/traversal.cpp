@@ -278,8 +278,12 @@ struct HeapItem {
   bool operator<(const HeapItem& o) const { return key < o.key; }
 };
 
-void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, Budget& budget, bool record_front,
-                  CollisionResult& res) {
+inline double priority_of(PriorityKey key, const Sphere& p, const Sphere& q) {
+  return key == PriorityKey::LargestSphere ? std::max(p.r, q.r) : penetration(p, q);
+}
+
+void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, PriorityKey key, Budget& budget,
+                  bool record_front, CollisionResult& res) {
   StopReason reason = StopReason::Completed;
   bool stopped = false;
   while (!heap.empty() && !stopped) {
@@ -289,9 +293,13 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
     const bool split_b = choose_split_b(t, p);
     const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a];
     const int32_t count = split_b ? t.ccb[p.b] : t.cca[p.a];
-    if (heap.size() + static_cast<std::size_t>(count) > cap) {  // no room: report unrefined
-      res.untested.push_back({p.a, p.b});
-      continue;
+    if (heap.size() + static_cast<std::size_t>(count) > cap) {
+      // Full: give up the lower-priority half (reported unrefined), keep the rest.
+      std::sort(heap.begin(), heap.end());
+      const std::size_t drop = std::max(heap.size() / 2, heap.size() + count - cap);
+      for (std::size_t k = 0; k < drop && k < heap.size(); ++k) res.untested.push_back({heap[k].p.a, heap[k].p.b});
+      heap.erase(heap.begin(), heap.begin() + std::min(drop, heap.size()));
+      std::make_heap(heap.begin(), heap.end());
     }
     const int32_t next_flag = split_b ? 0 : 1;
     for (int32_t c = first; c < first + count; ++c) {
@@ -304,13 +312,12 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
         break;
       }
       ++res.tests;
-      const double depth = penetration(t.sa[a], t.sb[b]);
-      if (depth < 0.0) {
+      if (!t.overlaps(a, b)) {
         if (record_front) res.front.push_back({a, b});
         continue;
       }
       if (t.expandable_a(a) || t.expandable_b(b)) {
-        heap.push_back({depth, {a, b, next_flag}});
+        heap.push_back({priority_of(key, t.sa[a], t.sb[b]), {a, b, next_flag}});
         std::push_heap(heap.begin(), heap.end());
       } else {
         settle(t, a, b, res);
@@ -318,6 +325,7 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
     }
     res.peak_list_size = std::max(res.peak_list_size, heap.size());
   }
+  res.untested.reserve(res.untested.size() + heap.size());
   for (const HeapItem& h : heap) res.untested.push_back({h.p.a, h.p.b});
 }
 
@@ -346,8 +354,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
   if (request.budget_tests < -1) throw ParameterError("CollisionRequest::budget_tests must be >= 0, or -1 for none");
   if (request.clock_check_interval < 1) throw ParameterError("CollisionRequest::clock_check_interval must be >= 1");
   if (request.depth_cap < 0) throw ParameterError("CollisionRequest::depth_cap must be >= 0");
-  if (request.mode == TraversalMode::Priority && request.max_list_size < 8)
-    throw ParameterError("CollisionRequest::max_list_size must be >= 8");
+  if (request.mode == TraversalMode::Priority && request.max_list_size < 16)
+    throw ParameterError("CollisionRequest::max_list_size must be >= 16");
   if (a.num_nodes() == 0 || b.num_nodes() == 0) throw ParameterError("collide: empty sphere tree");
   res.colliding.clear();
   res.untested.clear();
@@ -400,8 +408,12 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
 
   if (request.mode == TraversalMode::Priority) {
     t_heap.clear();
-    if (seed_into([&](const WorkPair& s) { t_heap.push_back({penetration(t.sa[s.a], t.sb[s.b]), s}); std::push_heap(t_heap.begin(), t_heap.end()); }))
-      run_priority(t, t_heap, request.max_list_size, budget, request.record_front, res);
+    const auto push = [&](const WorkPair& s) {
+      t_heap.push_back({priority_of(request.priority, t.sa[s.a], t.sb[s.b]), s});
+      std::push_heap(t_heap.begin(), t_heap.end());
+    };
+    if (seed_into(push))
+      run_priority(t, t_heap, request.max_list_size, request.priority, budget, request.record_front, res);
     else
       for (const HeapItem& h : t_heap) res.untested.push_back({h.p.a, h.p.b});
   } else {

@@ -20,7 +20,13 @@ struct NodePair {
 enum class TraversalMode {
   BreadthFirstFifo,  ///< paper Fig. 7: FIFO PAIRLIST, level by level, pair order swapped
   DepthFirst,        ///< paper Fig. 4: LIFO (recursive order), optionally depth-capped
-  Priority,          ///< best-first by deepest overlap (r_a + r_b - |c_a - c_b|), capped list
+  Priority,          ///< best-first (see PriorityKey) with a capped list
+};
+
+/// What the Priority mode refines first.
+enum class PriorityKey {
+  LargestSphere,   ///< the pair with the largest sphere, max(r_a, r_b): shrinks the suspected region fastest
+  DeepestOverlap,  ///< the pair with the deepest overlap r_a + r_b - |c_a - c_b| (contact detail first)
 };
 
 /// Why the query stopped.
@@ -53,9 +59,11 @@ struct CollisionRequest {
   /// Nodes at this level or deeper are not split (treated as leaves; pairs
   /// stopped there are reported in `untested`). Default: no cap.
   int depth_cap = std::numeric_limits<int>::max();
-  /// Priority mode: largest number of pairs held in the list (>= 8). A pair
-  /// whose children would not fit is reported in `untested` unrefined.
+  /// Priority mode: largest number of pairs held in the list (>= 16). When
+  /// children would not fit, the lower-priority half of the list is moved,
+  /// unrefined, to `untested` (the least valuable work is given up first).
   std::size_t max_list_size = 1 << 14;
+  PriorityKey priority = PriorityKey::LargestSphere;
   /// Temporal coherence: if non-null, start from these pairs (normally the
   /// previous result's `front`) instead of the root pair. Conservative as long
   /// as the pairs form a cut of the pair tree, which `front` does.

@@ -61,6 +61,9 @@ void check_all_budgets(const SphereTree& a, const SphereTree& b, const std::vect
     r.max_list_size = 64;
     requests.push_back(r);
   }
+  requests.back().priority = PriorityKey::DeepestOverlap;  // the capped priority mode with both keys
+  requests.push_back(requests.back());
+  requests.back().priority = PriorityKey::LargestSphere;
   requests.push_back(CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()));
   const int64_t full_tests = collide(a, b, CollisionRequest::paper_reference(INFINITY)).tests;
   int checked = 0, lossy_without_untested = 0;

@@ -37,6 +37,11 @@ std::vector<CollisionRequest> all_modes() {
       if (mode == TraversalMode::Priority && !fast) continue;
       v.push_back(r);
     }
+  CollisionRequest deepest;
+  deepest.mode = TraversalMode::Priority;
+  deepest.priority = PriorityKey::DeepestOverlap;
+  deepest.max_list_size = 1 << 20;
+  v.push_back(deepest);
   v.push_back(CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()));
   return v;
 }
