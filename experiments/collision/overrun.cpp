@@ -3,8 +3,9 @@
 // the budget (p50 / p99 / p99.9), for the paper's literal Fig. 7 (clock read
 // at every test) and for the fast path (clock every 16 tests, steady_clock or
 // rdtsc). A second thread measures the floor in the same run: it spins on the
-// clock with random deadlines and records how late it sees them (the time the
-// VM takes the processor away), plus the gaps between consecutive reads.
+// clock towards deadlines of the same length and records how late it sees
+// them (the time the VM takes the processor away), plus the gaps between
+// consecutive reads.
 //
 // Usage: icd_collision_overrun [--queries N] [--max-seconds S] [--csv FILE]
 //   N: queries per (configuration, budget), default 10000; S: time cap per
@@ -36,25 +37,34 @@ void spin_for(double s) {
   }
 }
 
+// The floor: a thread that only spins on the clock. It waits for deadlines
+// of the budget currently measured (plus the same random start jitter) and
+// records how late it sees them, binned per budget, plus the gaps between
+// consecutive clock reads.
 struct Floor {
   std::atomic<bool> stop{false};
-  std::vector<double> lateness;  // seconds past a random deadline
-  std::vector<double> gaps;      // gaps > 1 us between consecutive clock reads
+  std::atomic<int> bin{-1};  // index of the budget being measured, -1 = idle
+  std::vector<double> budgets;
+  std::vector<std::vector<double>> lateness;  // per budget, seconds past the deadline
+  std::vector<double> gaps;                   // gaps > 1 us between consecutive clock reads
   double spun = 0;
   void run() {
     std::mt19937 rng(42);
-    std::uniform_real_distribution<double> u(5e-6, 50e-6);
+    std::uniform_real_distribution<double> jitter(0.0, 20e-6);
+    lateness.assign(budgets.size(), {});
     const auto t_begin = Clock::now();
     auto prev = Clock::now();
     while (!stop.load(std::memory_order_relaxed)) {
-      const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(u(rng)));
+      const int k = bin.load(std::memory_order_relaxed);
+      const double wait = (k < 0 ? 10e-6 : budgets[k]) + jitter(rng);
+      const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait));
       for (;;) {
         const auto now = Clock::now();
         const double gap = std::chrono::duration<double>(now - prev).count();
         if (gap > 1e-6) gaps.push_back(gap);
         prev = now;
         if (now >= deadline) {
-          lateness.push_back(std::chrono::duration<double>(now - deadline).count());
+          if (k >= 0) lateness[k].push_back(std::chrono::duration<double>(now - deadline).count());
           break;
         }
       }
@@ -121,6 +131,7 @@ int main(int argc, char** argv) {
   const std::vector<double> budgets{10e-6, 100e-6, 1e-3, 10e-3, 100e-3};
 
   Floor floor;
+  floor.budgets = budgets;
   std::thread floor_thread([&] { floor.run(); });
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> jitter(0.0, 20e-6);
@@ -138,7 +149,9 @@ int main(int argc, char** argv) {
   std::printf("\n%-40s %9s %7s %6s %9s %9s %9s %9s %10s\n", "configuration", "budget", "queries", "intr%", "p50 us",
               "p99 us", "p99.9 us", "max us", "tests p50");
   for (const Config& c : configs) {
-    for (double budget : budgets) {
+    for (std::size_t bi = 0; bi < budgets.size(); ++bi) {
+      const double budget = budgets[bi];
+      floor.bin = static_cast<int>(bi);
       CollisionRequest r = c.request;
       r.budget_seconds = budget;
       std::vector<double> over, tests;
@@ -166,19 +179,22 @@ int main(int argc, char** argv) {
             << 1e6 * quantile(over, 1.0) << ',' << median(tests) << '\n';
     }
   }
+  floor.bin = -1;
   floor.stop = true;
   floor_thread.join();
-  std::printf("\nfloor (other thread, same run, %.1f s): lateness past random deadlines over %zu deadlines: "
-              "p50 %.2f us, p99 %.2f us, p99.9 %.2f us, max %.1f us\n",
-              floor.spun, floor.lateness.size(), 1e6 * quantile(floor.lateness, 0.5),
-              1e6 * quantile(floor.lateness, 0.99), 1e6 * quantile(floor.lateness, 0.999),
-              1e6 * quantile(floor.lateness, 1.0));
+  std::printf("\nfloor (other thread, same run, %.1f s): lateness past deadlines of the same length, per budget:\n",
+              floor.spun);
+  std::printf("%9s %9s %9s %9s %9s %9s\n", "budget", "deadlines", "p50 us", "p99 us", "p99.9 us", "max us");
+  for (std::size_t bi = 0; bi < budgets.size(); ++bi) {
+    const auto& l = floor.lateness[bi];
+    std::printf("%8.0fus %9zu %9.2f %9.2f %9.2f %9.1f\n", budgets[bi] * 1e6, l.size(), 1e6 * quantile(l, 0.5),
+                1e6 * quantile(l, 0.99), 1e6 * quantile(l, 0.999), 1e6 * quantile(l, 1.0));
+    if (csv)
+      csv << "floor," << budgets[bi] << ',' << l.size() << ",0," << 1e6 * quantile(l, 0.5) << ','
+          << 1e6 * quantile(l, 0.99) << ',' << 1e6 * quantile(l, 0.999) << ',' << 1e6 * quantile(l, 1.0) << ",0\n";
+  }
   std::printf("floor: %zu clock gaps > 1 us (%.0f per second), gap p50 %.1f us, p99 %.1f us, max %.1f us\n",
               floor.gaps.size(), floor.gaps.size() / floor.spun, 1e6 * quantile(floor.gaps, 0.5),
               1e6 * quantile(floor.gaps, 0.99), 1e6 * quantile(floor.gaps, 1.0));
-  if (csv)
-    csv << "floor," << 0 << ',' << floor.lateness.size() << ",0," << 1e6 * quantile(floor.lateness, 0.5) << ','
-        << 1e6 * quantile(floor.lateness, 0.99) << ',' << 1e6 * quantile(floor.lateness, 0.999) << ','
-        << 1e6 * quantile(floor.lateness, 1.0) << ",0\n";
   return 0;
 }
