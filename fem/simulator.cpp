@@ -49,12 +49,13 @@ double Simulator::stable_step_limit() {
   if (m_options.integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
   // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time).
   const bool fresh = m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
-  if (!fresh) {
-    m_frequency = estimate_max_frequency(m_model, m_state.x, m_options.frequency, &m_warm_mode);
-    m_estimate_time = m_time;
-  }
-  if (m_frequency.omega_max <= 0) return std::numeric_limits<double>::infinity();  // all fixed
-  return fem::stable_step_limit(m_options.integrator, m_frequency.omega_max, m_model.damping());
+  if (fresh) return m_cached_limit;
+  m_frequency = estimate_max_frequency(m_model, m_state.x, m_options.frequency, &m_warm_mode);
+  m_estimate_time = m_time;
+  m_cached_limit = m_frequency.omega_max <= 0  // all fixed
+                       ? std::numeric_limits<double>::infinity()
+                       : fem::stable_step_limit(m_options.integrator, m_frequency.omega_max, m_model.damping());
+  return m_cached_limit;
 }
 
 double Simulator::total_energy() {

@@ -108,6 +108,7 @@ class Simulator {
   Eigen::VectorXd m_warm_mode;
   double m_energy_floor = 0;
   double m_estimate_time = -1;  ///< simulated time of the last frequency estimate (-1: none)
+  double m_cached_limit = 0;    ///< stable step limit of that estimate, s
 };
 
 }  // namespace icd::fem
