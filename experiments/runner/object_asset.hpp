@@ -1,0 +1,42 @@
+#pragma once
+/// Everything the simulation needs of one object, CGAL-free: the dense
+/// surface, the coarse tet mesh, the rigid links and the sphere tree tied to
+/// the coarse nodes. Built from a generated primitive, or loaded from an asset
+/// bundle (preprocessing a raw mesh into the cache on first use).
+#include <filesystem>
+
+#include "collision/sphere_tree.hpp"
+#include "coupling/rigid_links.hpp"
+#include "experiments/runner/scene.hpp"
+#include "mesh/io/types.hpp"
+
+namespace icd::runner {
+
+/// One object's data, in the scene's units (metres) once placed.
+struct ObjectAsset {
+  SurfaceMesh dense;            ///< the rendered / contact surface
+  TetMesh coarse;               ///< the reduced model (rest positions)
+  Eigen::VectorXi surface_nodes;  ///< coarse nodes on the coarse surface (reduced coordinates Q)
+  coupling::RigidLinks links;   ///< dense vertex -> three coarse surface nodes
+  collision::SphereTree tree;   ///< wrapped sphere tree with node association
+};
+
+/// Builds a primitive object: a dense icosphere (or box surface) over a
+/// structured coarse tet mesh (for a sphere: the cells of a grid inside the
+/// ball), octree sphere tree with `levels` levels, links and association.
+ObjectAsset make_primitive_asset(const PrimitiveSpec& spec, int levels);
+
+/// Loads the asset of an object spec: generated primitive, bundle folder, or
+/// raw mesh preprocessed into `cache_dir` by the icd-preprocess tool found in
+/// `tool_dir` (so the runtime never links CGAL). Throws InputError naming the
+/// object and the file on failure.
+ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::path& cache_dir,
+                              const std::filesystem::path& tool_dir);
+
+/// Scales (longest bounding-box side of the dense mesh -> spec.size, when > 0),
+/// rotates (XYZ Euler, degrees) about the dense bounding-box centre and moves
+/// that centre to spec.position: dense, coarse, spheres and association rest
+/// distances alike.
+void place_object(ObjectAsset& asset, const ObjectSpec& spec);
+
+}  // namespace icd::runner

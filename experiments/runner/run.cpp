@@ -1,0 +1,186 @@
+#include "experiments/runner/run.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "mesh/io/atomic_write.hpp"
+#include "mesh/io/error.hpp"
+#include "mesh/io/vtk_writer.hpp"
+
+namespace icd::runner {
+namespace {
+
+void write_frame_vtu(World& world, int frame, const std::filesystem::path& dir,
+                     std::vector<std::vector<PvdEntry>>& series) {
+  const Scene& scene = world.scene();
+  const double t = frame / scene.frame_rate;
+  auto& objects = world.objects();
+  size_t s = 0;
+  char suffix[32];
+  std::snprintf(suffix, sizeof suffix, "_%06d.vtu", frame);
+  for (RuntimeObject& o : objects) {
+    TetMesh coarse = o.asset.coarse;
+    coarse.V = o.positions;
+    const std::string cname = o.spec.name + "_coarse" + suffix;
+    write_vtu_tet_mesh(dir / cname, coarse);
+    series[s++].push_back({t, cname});
+    if (o.plan.dense_update && scene.output.dense) {
+      SurfaceMesh dense{o.dense, o.asset.dense.F};
+      const std::string dname = o.spec.name + "_dense" + suffix;
+      write_vtu_surface_mesh(dir / dname, dense);
+      series[s].push_back({t, dname});
+    }
+    ++s;
+  }
+  if (scene.output.spheres && !world.plan().pairs.empty()) {
+    // The spheres used for the contact response: colliding and untested pairs.
+    for (size_t p = 0; p < world.plan().pairs.size(); ++p) {
+      const auto [i, j] = world.plan().pairs[p];
+      const collision::CollisionResult& r = world.results()[p];
+      for (int side = 0; side < 2; ++side) {
+        const collision::SphereTree& tree = objects[side ? j : i].asset.tree;
+        std::vector<int> ids;
+        std::vector<double> leaf;
+        for (const auto* list : {&r.colliding, &r.untested})
+          for (const collision::NodePair& np : *list) {
+            ids.push_back(side ? np.b : np.a);
+            leaf.push_back(list == &r.colliding ? 1.0 : 0.0);
+          }
+        SphereSet set;
+        set.centers.resize(static_cast<Eigen::Index>(ids.size()), 3);
+        set.radii.resize(static_cast<Eigen::Index>(ids.size()));
+        PointDataArray level{"level", Eigen::MatrixXd(ids.size(), 1)};
+        PointDataArray colliding{"colliding_leaf", Eigen::MatrixXd(ids.size(), 1)};
+        for (size_t k = 0; k < ids.size(); ++k) {
+          const collision::Sphere& sp = tree.spheres[ids[k]];
+          set.centers.row(k) << sp.x, sp.y, sp.z;
+          set.radii[k] = sp.r;
+          level.values(k, 0) = tree.level[ids[k]];
+          colliding.values(k, 0) = leaf[k];
+        }
+        const std::string name = objects[side ? j : i].spec.name + "_contact_spheres_pair" +
+                                 std::to_string(p) + suffix;
+        const PointDataArray arrays[] = {level, colliding};
+        write_vtu_sphere_set(dir / name, set, arrays);
+        series[s].push_back({t, name});
+        ++s;
+      }
+    }
+  }
+}
+
+std::string format_duration(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  return buf;
+}
+
+}  // namespace
+
+std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
+  std::ostringstream csv;
+  csv.precision(9);
+  csv << "frame,time,wall,fem,links,sphere_update,collision,response,budget,pair_list,"
+         "collision_list,tests,interrupted,completed_level,active_pairs,max_penetration,"
+         "contact_force,substeps,min_step,energy,exact_contacts\n";
+  for (const FrameMetrics& m : frames)
+    csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
+        << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
+        << ',' << m.budget << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests
+        << ',' << m.interrupted << ',' << m.completed_level << ',' << m.active_pairs << ','
+        << m.max_penetration << ',' << m.contact_force << ',' << m.substeps << ',' << m.min_step
+        << ',' << m.energy << ',' << m.exact_contacts << '\n';
+  return csv.str();
+}
+
+std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt) {
+  if (opt.out_dir.empty()) throw ParameterError("run_scene: an output folder is required");
+  Scene scene = scene_in;
+  if (opt.frames >= 0) scene.frames = opt.frames;
+  std::filesystem::create_directories(opt.out_dir);
+  // Remove a previous run's results first: nothing stale that looks complete.
+  std::filesystem::remove(opt.out_dir / "frames.csv");
+  const std::filesystem::path vtu_dir = opt.out_dir / "vtu";
+  const std::filesystem::path vtu_tmp = opt.out_dir / "vtu.part";
+  std::filesystem::remove_all(vtu_dir);
+  std::filesystem::remove_all(vtu_tmp);
+
+  World world(scene, opt.cache_dir, opt.tool_dir);
+  const bool tty = opt.progress && isatty(fileno(stderr));
+  std::vector<FrameMetrics> frames;
+  frames.reserve(scene.frames);
+  std::vector<std::vector<PvdEntry>> series;
+  if (scene.output.vtu_every > 0) {
+    std::filesystem::create_directories(vtu_tmp);
+    series.resize(world.objects().size() * 2 + world.plan().pairs.size() * 2);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  for (int f = 0; f < scene.frames; ++f) {
+    FrameMetrics m = world.step();
+    if (scene.output.vtu_every > 0 && (f % scene.output.vtu_every == 0 || f + 1 == scene.frames)) {
+      const auto t0 = std::chrono::steady_clock::now();
+      write_frame_vtu(world, f, vtu_tmp, series);
+      m.times.output = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    frames.push_back(m);
+    if (opt.progress && (tty ? true : (f + 1) % std::max(1, scene.frames / 10) == 0)) {
+      const double el =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const int width = 30, done = (f + 1) * width / scene.frames;
+      std::fprintf(stderr, "%s[%s%s] %d/%d frames, %s elapsed%s", tty ? "\r" : "",
+                   std::string(done, '#').c_str(), std::string(width - done, '.').c_str(), f + 1,
+                   scene.frames, format_duration(el).c_str(), tty ? "" : "\n");
+    }
+  }
+  if (tty) std::fprintf(stderr, "\n");
+
+  if (opt.log) {
+    std::fprintf(opt.log,
+                 "%-13s %7s %8s %8s %8s %8s %8s %9s %9s %6s\n", "frames", "fps", "fem%", "links%",
+                 "update%", "collide%", "respond%", "PAIRLIST", "COLLLIST", "intr.");
+    const int ranges = std::max(1, std::min(opt.summary_ranges, scene.frames));
+    for (int r = 0; r < ranges; ++r) {
+      const int a = r * scene.frames / ranges, b = (r + 1) * scene.frames / ranges;
+      StageTimes sum;
+      double wall = 0, pl = 0, cl = 0;
+      int intr = 0;
+      for (int f = a; f < b; ++f) {
+        const FrameMetrics& m = frames[f];
+        wall += m.wall;
+        sum.fem += m.times.fem;
+        sum.links += m.times.links;
+        sum.sphere_update += m.times.sphere_update;
+        sum.collision += m.times.collision;
+        sum.response += m.times.response;
+        pl += m.pair_list;
+        cl += m.collision_list;
+        intr += m.interrupted;
+      }
+      const double n = b - a;
+      char label[32];
+      std::snprintf(label, sizeof label, "%d-%d", a, b - 1);
+      std::fprintf(opt.log, "%-13s %7.1f %8.1f %8.1f %8.1f %8.1f %8.1f %9.1f %9.1f %6d\n", label,
+                   n / wall, 100 * sum.fem / wall, 100 * sum.links / wall,
+                   100 * sum.sphere_update / wall, 100 * sum.collision / wall,
+                   100 * sum.response / wall, pl / n, cl / n, intr);
+    }
+  }
+
+  if (scene.output.csv) write_file_atomically(opt.out_dir / "frames.csv", metrics_csv(frames));
+  if (scene.output.vtu_every > 0) {
+    for (size_t s = 0; s < series.size(); ++s) {
+      if (series[s].empty()) continue;
+      const std::string stem = series[s].front().file.substr(
+          0, series[s].front().file.size() - std::string("_000000.vtu").size());
+      write_pvd(vtu_tmp / (stem + ".pvd"), series[s]);
+    }
+    std::filesystem::rename(vtu_tmp, vtu_dir);
+  }
+  return frames;
+}
+
+}  // namespace icd::runner

@@ -1,0 +1,32 @@
+#pragma once
+/// Running a scene end to end: progress, per-range summaries, per-frame CSV,
+/// optional VTU/PVD time series. Shared by icd-run, icd-main and the tests.
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+#include "experiments/runner/world.hpp"
+
+namespace icd::runner {
+
+/// Options of run_scene().
+struct RunOptions {
+  std::filesystem::path out_dir;     ///< results folder (created); required
+  std::filesystem::path cache_dir;   ///< preprocessed assets cache
+  std::filesystem::path tool_dir;    ///< where icd-preprocess lives
+  int frames = -1;                   ///< override the scene's frame count (-1 = keep)
+  bool progress = true;              ///< progress bar on stderr
+  int summary_ranges = 4;            ///< summary lines (frame ranges) printed at the end
+  std::FILE* log = stdout;           ///< where summaries go (nullptr = silent)
+};
+
+/// Runs the scene and writes `<out_dir>/frames.csv` (and the VTU/PVD series
+/// if asked). Files are written under temporary names and renamed at the
+/// end, so an interrupted run leaves no complete-looking output. Returns the
+/// metrics of every frame. Throws on any error (after removing partial files).
+std::vector<FrameMetrics> run_scene(const Scene& scene, const RunOptions& options);
+
+/// The per-frame CSV (header + one row per frame).
+std::string metrics_csv(const std::vector<FrameMetrics>& frames);
+
+}  // namespace icd::runner

@@ -1,0 +1,290 @@
+#include "experiments/runner/scene.hpp"
+
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "icd/config.hpp"
+#include "mesh/io/error.hpp"
+
+namespace icd::runner {
+namespace {
+
+// Reads the fields of one JSON object, remembering the field path for
+// messages, and rejects fields nobody asked for.
+class Fields {
+ public:
+  Fields(const Json& j, std::string path, const std::string& source)
+      : m_path(std::move(path)), m_source(source) {
+    if (!j.is_object()) fail(m_path, std::string("must be an object, got ") + j.type_name());
+    m_obj = &j.as_object();
+  }
+
+  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
+    throw InputError(m_source + ": " + (field.empty() ? "<root>" : field) + ": " + what);
+  }
+  std::string path(const std::string& key) const {
+    return m_path.empty() ? key : m_path + "." + key;
+  }
+
+  const Json* get(const std::string& key) {
+    m_used.insert(key);
+    auto it = m_obj->find(key);
+    return it == m_obj->end() ? nullptr : &it->second;
+  }
+
+  double number(const std::string& key, double def, double lo, double hi, bool lo_open = false) {
+    const Json* j = get(key);
+    if (!j) return def;
+    if (!j->is_number()) fail(path(key), std::string("must be a number, got ") + j->type_name());
+    const double v = j->as_number();
+    if (v < lo || v > hi || (lo_open && v == lo))
+      fail(path(key), "must be in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) +
+                          "], got " + fmt(v));
+    return v;
+  }
+  int integer(const std::string& key, int def, int lo, int hi) {
+    const double v = number(key, def, lo, hi);
+    if (v != std::floor(v)) fail(path(key), "must be an integer, got " + fmt(v));
+    return static_cast<int>(v);
+  }
+  bool boolean(const std::string& key, bool def) {
+    const Json* j = get(key);
+    if (!j) return def;
+    if (!j->is_bool()) fail(path(key), std::string("must be true or false, got ") + j->type_name());
+    return j->as_bool();
+  }
+  std::string string(const std::string& key, const std::string& def,
+                     const std::vector<std::string>& allowed = {}) {
+    const Json* j = get(key);
+    if (!j) return def;
+    if (!j->is_string()) fail(path(key), std::string("must be a string, got ") + j->type_name());
+    const std::string& s = j->as_string();
+    if (!allowed.empty()) {
+      bool ok = false;
+      std::string list;
+      for (const auto& a : allowed) {
+        ok |= a == s;
+        list += (list.empty() ? "" : ", ") + ('"' + a + '"');
+      }
+      if (!ok) fail(path(key), "must be one of " + list + ", got \"" + s + "\"");
+    }
+    return s;
+  }
+  Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& def, double limit) {
+    const Json* j = get(key);
+    if (!j) return def;
+    if (!j->is_array() || j->as_array().size() != 3)
+      fail(path(key), "must be an array of 3 numbers");
+    Eigen::Vector3d v;
+    for (int k = 0; k < 3; ++k) {
+      const Json& e = j->as_array()[k];
+      if (!e.is_number()) fail(path(key) + "[" + std::to_string(k) + "]", "must be a number");
+      v[k] = e.as_number();
+      if (std::abs(v[k]) > limit)
+        fail(path(key) + "[" + std::to_string(k) + "]", "magnitude above " + fmt(limit));
+    }
+    return v;
+  }
+
+  void finish() const {
+    for (const auto& [key, value] : *m_obj)
+      if (!m_used.count(key)) fail(path(key), "unknown field");
+  }
+
+  static std::string fmt(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+  }
+
+ private:
+  const Json::Object* m_obj = nullptr;
+  std::string m_path;
+  const std::string& m_source;
+  std::set<std::string> m_used;
+};
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+fem::Material parse_material(Fields& f) {
+  fem::Material m;
+  const std::string model =
+      f.string("model", "stvk", {"linear", "corotational", "stvk", "stable_neo_hookean"});
+  m.model = model == "linear"         ? fem::MaterialModel::Linear
+            : model == "corotational" ? fem::MaterialModel::Corotational
+            : model == "stvk"         ? fem::MaterialModel::StVK
+                                      : fem::MaterialModel::StableNeoHookean;
+  m.young = f.number("young", 1e5, 0, 1e12, true);
+  m.poisson = f.number("poisson", 0.3, -1, 0.5, true);
+  if (m.poisson >= 0.5 || m.poisson <= -1)
+    f.fail(f.path("poisson"), "must be in (-1, 0.5), got " + Fields::fmt(m.poisson));
+  m.density = f.number("density", 1000, 0, 1e6, true);
+  return m;
+}
+
+ObjectSpec parse_object(const Json& j, const std::string& path, const std::string& source) {
+  Fields f(j, path, source);
+  ObjectSpec o;
+  o.name = f.string("name", path);
+  const std::string mesh = f.string("mesh", ""), asset = f.string("asset", "");
+  const Json* prim = f.get("primitive");
+  const int sources = !mesh.empty() + !asset.empty() + (prim != nullptr);
+  if (sources != 1)
+    f.fail(path, "needs exactly one of \"mesh\", \"asset\" or \"primitive\" (got " +
+                     std::to_string(sources) + ")");
+  o.mesh = mesh;
+  o.asset = asset;
+  if (prim) {
+    Fields p(*prim, f.path("primitive"), source);
+    PrimitiveSpec ps;
+    ps.type = p.string("type", "sphere", {"sphere", "box"});
+    ps.radius = p.number("radius", ps.radius, 0, 1e3, true);
+    ps.extent = p.vec3("extent", ps.extent, 1e3);
+    if (ps.extent.minCoeff() <= 0) p.fail(p.path("extent"), "sides must be positive");
+    ps.subdivisions = p.integer("subdivisions", ps.subdivisions, 0, 6);
+    ps.cells = p.integer("cells", ps.cells, 1, 64);
+    p.finish();
+    o.primitive = ps;
+  }
+  if (const Json* pre = f.get("preprocess")) {
+    Fields p(*pre, f.path("preprocess"), source);
+    o.preprocess.coarse_tets = p.integer("coarse_tets", o.preprocess.coarse_tets, 10, 1000000);
+    o.preprocess.tree_levels = p.integer("tree_levels", o.preprocess.tree_levels, 1, 8);
+    o.preprocess.tree_branching = p.integer("tree_branching", o.preprocess.tree_branching, 2, 64);
+    o.preprocess.tree_builder =
+        p.string("tree_builder", o.preprocess.tree_builder, {"medial", "octree"});
+    p.finish();
+  }
+  o.size = f.number("size", 0, 0, 1e4);
+  o.position = f.vec3("position", o.position, 1e6);
+  o.rotation_deg = f.vec3("rotation_deg", o.rotation_deg, 1e4);
+  o.velocity = f.vec3("velocity", o.velocity, 1e4);
+  const std::string kind = f.string("kind", "deformable", {"deformable", "rigid", "static"});
+  o.kind = kind == "deformable" ? ObjectKind::Deformable
+           : kind == "rigid"    ? ObjectKind::Rigid
+                                : ObjectKind::Static;
+  if (o.kind == ObjectKind::Static && o.velocity.norm() > 0)
+    f.fail(f.path("velocity"), "a static object cannot have a velocity");
+  if (const Json* mat = f.get("material")) {
+    Fields m(*mat, f.path("material"), source);
+    o.material = parse_material(m);
+    const Json* ray = m.get("rayleigh");
+    if (ray) {
+      const Eigen::Vector3d def(0, 0, 0);
+      if (!ray->is_array() || ray->as_array().size() != 2 || !ray->as_array()[0].is_number() ||
+          !ray->as_array()[1].is_number())
+        m.fail(m.path("rayleigh"), "must be [alpha, beta], two numbers");
+      o.damping.alpha = ray->as_array()[0].as_number();
+      o.damping.beta = ray->as_array()[1].as_number();
+      if (!(o.damping.alpha >= 0) || !(o.damping.beta >= 0) || o.damping.alpha > 1e6 ||
+          o.damping.beta > 1)
+        m.fail(m.path("rayleigh"), "needs 0 <= alpha <= 1e6 (1/s) and 0 <= beta <= 1 (s)");
+    }
+    m.finish();
+  }
+  const std::string integ =
+      f.string("integrator", "rk4", {"rk4", "symplectic_euler", "backward_euler"});
+  o.integrator = integ == "rk4"                ? fem::Integrator::RK4
+                 : integ == "symplectic_euler" ? fem::Integrator::SymplecticEuler
+                                               : fem::Integrator::BackwardEuler;
+  if (const Json* fixed = f.get("fixed_nodes")) {
+    if (!fixed->is_array()) f.fail(f.path("fixed_nodes"), "must be an array of node indices");
+    for (size_t k = 0; k < fixed->as_array().size(); ++k) {
+      const Json& e = fixed->as_array()[k];
+      if (!e.is_number() || e.as_number() < 0 || e.as_number() != std::floor(e.as_number()) ||
+          e.as_number() > 1e9)
+        f.fail(f.path("fixed_nodes") + "[" + std::to_string(k) + "]",
+               "must be a non-negative integer node index");
+      o.fixed_nodes.push_back(static_cast<int>(e.as_number()));
+    }
+  }
+  f.finish();
+  return o;
+}
+
+CollisionSpec parse_collision(const Json& j, const std::string& source) {
+  Fields f(j, "collision", source);
+  CollisionSpec c;
+  c.budget_seconds = f.number("budget_seconds", c.budget_seconds, 0, 1e3, true);
+  if (f.boolean("unlimited", false)) c.budget_seconds = kInf;
+  const double tests = f.number("budget_tests", -1, -1, 1e15);
+  if (tests != -1 && (tests < 0 || tests != std::floor(tests)))
+    f.fail("collision.budget_tests", "must be a non-negative integer or -1");
+  c.budget_tests = static_cast<int64_t>(tests);
+  if (c.budget_tests >= 0 && f.get("budget_seconds") == nullptr) c.budget_seconds = kInf;
+  const std::string mode =
+      f.string("mode", "fifo", {"fifo", "fifo_literal", "depth_first", "priority"});
+  c.mode = mode == "depth_first" ? collision::TraversalMode::DepthFirst
+           : mode == "priority"  ? collision::TraversalMode::Priority
+                                 : collision::TraversalMode::BreadthFirstFifo;
+  c.literal = mode == "fifo_literal";
+  c.clock_check_interval = f.integer("clock_check_interval", c.clock_check_interval, 1, 1 << 20);
+  c.max_list_size = static_cast<std::size_t>(f.integer("max_list_size", 1 << 14, 8, 1 << 28));
+  c.depth_cap = f.integer("depth_cap", -1, -1, 64);
+  c.temporal_coherence = f.boolean("temporal_coherence", false);
+  c.layered = f.boolean("layered", false);
+  const std::string upd = f.string("sphere_update", "paper", {"paper", "conservative"});
+  c.update.mode = upd == "paper" ? collision::SphereUpdateMode::PaperRatio
+                                 : collision::SphereUpdateMode::DisplacementBound;
+  c.update.margin = f.number("sphere_margin", 0, 0, 1e3);
+  c.contact.stiffness = f.number("stiffness", 1e3, 0, 1e12, true);
+  const std::string dist =
+      f.string("distribution", "partition_of_unity", {"partition_of_unity", "paper_average"});
+  c.contact.distribution = dist == "paper_average" ? coupling::ContactDistribution::PaperAverage
+                                                   : coupling::ContactDistribution::PartitionOfUnity;
+  c.contact.use_untested = f.boolean("use_untested", true);
+  f.finish();
+  return c;
+}
+
+}  // namespace
+
+Scene parse_scene(const Json& json, const std::string& source,
+                  const std::filesystem::path& base_dir) {
+  Fields f(json, "", source);
+  Scene s;
+  s.base_dir = base_dir;
+  s.name = f.string("name", "scene");
+  s.frames = f.integer("frames", s.frames, 1, 100000000);
+  s.frame_rate = f.number("frame_rate", s.frame_rate, 0, 1e5, true);
+  s.gravity = f.vec3("gravity", s.gravity, 1e4);
+  s.target_fps = f.number("target_fps", 0, 0, 1e5);
+  const Json* objects = f.get("objects");
+  if (!objects || !objects->is_array() || objects->as_array().empty())
+    f.fail("objects", "must be a non-empty array of objects");
+  for (size_t i = 0; i < objects->as_array().size(); ++i)
+    s.objects.push_back(
+        parse_object(objects->as_array()[i], "objects[" + std::to_string(i) + "]", source));
+  std::set<std::string> names;
+  for (size_t i = 0; i < s.objects.size(); ++i)
+    if (!names.insert(s.objects[i].name).second)
+      f.fail("objects[" + std::to_string(i) + "].name",
+             "duplicate object name \"" + s.objects[i].name + "\"");
+  if (const Json* c = f.get("collision")) s.collision = parse_collision(*c, source);
+  if (const Json* o = f.get("output")) {
+    Fields out(*o, "output", source);
+    s.output.csv = out.boolean("csv", true);
+    s.output.vtu_every = out.integer("vtu_every", 0, 0, 1000000);
+    s.output.dense = out.boolean("dense", true);
+    s.output.spheres = out.boolean("spheres", true);
+    s.output.exact_reference = out.boolean("exact_reference", false);
+    out.finish();
+  }
+  f.finish();
+  // Resolve paths: against the scene's folder, then the repository root.
+  for (ObjectSpec& o : s.objects)
+    for (std::filesystem::path* p : {&o.mesh, &o.asset})
+      if (!p->empty() && p->is_relative()) {
+        const auto local = base_dir / *p;
+        *p = std::filesystem::exists(local) ? local : std::filesystem::path(ICD_SOURCE_DIR) / *p;
+      }
+  return s;
+}
+
+Scene load_scene(const std::filesystem::path& path) {
+  const Json j = read_json_file(path.string());
+  return parse_scene(j, path.string(), path.parent_path());
+}
+
+}  // namespace icd::runner

@@ -1,0 +1,243 @@
+#include "experiments/runner/world.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "collision/aabb_tree.hpp"
+#include "collision/sphere_update.hpp"
+#include "coupling/contact_response.hpp"
+#include "mesh/io/error.hpp"
+
+namespace icd::runner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Grows every parent sphere, bottom-up, until it encloses its children's
+// spheres (a layered hierarchy): sphere overlaps then never appear suddenly
+// below a pruned pair, so the penalty force is continuous in the positions.
+void enclose_children(collision::SphereTree& t) {
+  for (int i = t.num_nodes() - 1; i >= 0; --i) {
+    collision::Sphere& s = t.spheres[i];
+    for (int c = t.first_child[i]; c >= 0 && c < t.first_child[i] + t.child_count[i]; ++c) {
+      const collision::Sphere& k = t.spheres[c];
+      s.r = std::max(s.r, (k.center() - s.center()).norm() + k.r);
+    }
+  }
+}
+
+}  // namespace
+
+World::World(const Scene& scene, const std::filesystem::path& cache_dir,
+             const std::filesystem::path& tool_dir)
+    : m_scene(scene), m_plan(make_plan(scene)) {
+  m_objects.reserve(scene.objects.size());
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    RuntimeObject o;
+    o.spec = scene.objects[i];
+    o.plan = m_plan.objects[i];
+    o.asset = load_object_asset(o.spec, cache_dir, tool_dir);
+    place_object(o.asset, o.spec);
+    o.rest = o.asset.coarse.V;
+    o.positions = o.rest;
+    o.contact_forces = MatX3d::Zero(o.rest.rows(), 3);
+    if (o.plan.fem) {
+      fem::ModelOptions mo;
+      mo.damping = o.spec.damping;
+      mo.gravity = scene.gravity;
+      fem::Model model(o.rest, o.asset.coarse.T, o.spec.material, mo);
+      for (int n : o.spec.fixed_nodes)
+        if (n >= model.num_nodes())
+          throw InputError("object \"" + o.spec.name + "\": fixed node " + std::to_string(n) +
+                           " out of range (the coarse mesh has " +
+                           std::to_string(model.num_nodes()) + " nodes)");
+      model.set_fixed_nodes(o.spec.fixed_nodes);
+      fem::SimulatorOptions so;
+      so.integrator = o.spec.integrator;
+      so.max_step = 1.0 / scene.frame_rate;
+      so.frequency_reuse_time = 1.0 / scene.frame_rate;  // one estimate per frame
+      if (m_plan.response) so.frequency.contact_stiffness = scene.collision.contact.stiffness;
+      o.sim = std::make_unique<fem::Simulator>(std::move(model), so);
+      MatX3d v(o.rest.rows(), 3);
+      v.rowwise() = o.spec.velocity.transpose();
+      for (int n : o.spec.fixed_nodes) v.row(n).setZero();
+      o.sim->set_velocities(v);
+    }
+    if (o.plan.dense_update) o.dense = o.asset.dense.V;
+    m_objects.push_back(std::move(o));
+  }
+  m_min_node_mass = std::numeric_limits<double>::infinity();
+  for (const RuntimeObject& o : m_objects)
+    if (o.sim) m_min_node_mass = std::min(m_min_node_mass, o.sim->model().mass().minCoeff());
+  m_results.resize(m_plan.pairs.size());
+  m_fronts.resize(m_plan.pairs.size());
+}
+
+int World::contact_cycles(double dt) const {
+  if (!m_plan.response) return 1;
+  const double k = std::max(m_node_stiffness, m_scene.collision.contact.stiffness);
+  const double omega = std::sqrt(k / m_min_node_mass);
+  return std::clamp(static_cast<int>(std::ceil(omega * dt)), 1, kMaxContactCycles);
+}
+
+void World::update_dense(RuntimeObject& o) {
+  if (o.dense.rows() != o.asset.dense.V.rows()) o.dense.resize(o.asset.dense.V.rows(), 3);
+  coupling::apply(o.asset.links, o.positions, o.dense);
+}
+
+void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
+  Clock::time_point t0 = Clock::now();
+  // 1. Deformation: FEM for deformable objects (with last frame's contact
+  //    forces), rigid motion for kinematic ones.
+  for (RuntimeObject& o : m_objects) {
+    if (o.plan.fem) {
+      if (m_plan.response) o.sim->set_external_forces(o.contact_forces);
+      const fem::AdvanceReport rep = o.sim->advance(h);
+      o.positions = o.sim->positions();
+      m.substeps += rep.substeps;
+      m.min_step = std::min(m.min_step, rep.step);
+      if (last) m.energy += o.sim->total_energy();
+    } else if (o.plan.kinematic) {
+      o.positions.rowwise() += (h * o.spec.velocity).transpose();
+    }
+  }
+  m.times.fem += seconds_since(t0);
+
+  // 2. Dense meshes follow through the rigid links (only where consumed).
+  if (last) {
+    t0 = Clock::now();
+    for (RuntimeObject& o : m_objects)
+      if (o.plan.dense_update) update_dense(o);
+    m.times.links += seconds_since(t0);
+  }
+
+  // 3. Sphere trees follow the coarse nodes (paper 4.4).
+  t0 = Clock::now();
+  for (RuntimeObject& o : m_objects)
+    if (o.plan.sphere_update)
+    {
+      collision::update_spheres(o.asset.tree, o.rest, o.positions, m_scene.collision.update);
+      if (m_scene.collision.layered) enclose_children(o.asset.tree);
+    }
+  m.times.sphere_update += seconds_since(t0);
+
+  // 4. Interruptible collision queries, one per candidate pair.
+  t0 = Clock::now();
+  const CollisionSpec& cs = m_scene.collision;
+  if (last) {
+    m.pair_list = m.collision_list = 0;
+    m.completed_level = std::numeric_limits<int>::max();
+  }
+  for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+    const auto [i, j] = m_plan.pairs[p];
+    collision::CollisionRequest req =
+        cs.literal ? collision::CollisionRequest::paper_reference(budget)
+                   : collision::CollisionRequest{};
+    req.budget_seconds = budget;
+    req.budget_tests = cs.budget_tests;
+    if (!cs.literal) {
+      req.mode = cs.mode;
+      req.clock_check_interval = cs.clock_check_interval;
+    }
+    req.max_list_size = cs.max_list_size;
+    if (cs.depth_cap >= 0) req.depth_cap = cs.depth_cap;
+    if (cs.temporal_coherence) {
+      req.record_front = true;
+      if (!m_fronts[p].empty()) req.start_front = &m_fronts[p];
+    }
+    collision::CollisionResult& r = m_results[p];
+    collision::collide(m_objects[i].asset.tree, m_objects[j].asset.tree, req, r);
+    if (cs.temporal_coherence) m_fronts[p] = r.front;
+    if (last) {
+      m.pair_list += static_cast<int64_t>(r.untested.size());
+      m.collision_list += static_cast<int64_t>(r.colliding.size());
+      m.completed_level = std::min(m.completed_level, r.completed_level);
+    }
+    m.tests += r.tests;
+    m.interrupted += r.interrupted ? 1 : 0;
+  }
+  if (m_plan.pairs.empty()) m.completed_level = 0;
+  m.times.collision += seconds_since(t0);
+
+  // 5. Penalty response onto the coarse nodes, applied in the next frame.
+  t0 = Clock::now();
+  if (m_plan.response) {
+    for (RuntimeObject& o : m_objects) o.contact_forces.setZero();
+    m_node_stiffness = 0;
+    for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+      const auto [i, j] = m_plan.pairs[p];
+      RuntimeObject& a = m_objects[i];
+      RuntimeObject& b = m_objects[j];
+      coupling::ContactOptions co = cs.contact;
+      const Eigen::Vector3d ca = a.positions.colwise().mean().transpose();
+      const Eigen::Vector3d cb = b.positions.colwise().mean().transpose();
+      co.coincident_direction = cb - ca;
+      const coupling::ContactStats st = coupling::apply_contact_forces(
+          a.asset.tree, b.asset.tree, m_results[p], co, a.contact_forces, b.contact_forces);
+      m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
+      m.max_penetration = std::max(m.max_penetration, st.max_penetration);
+      if (last) {
+        m.active_pairs += st.active_pairs;
+        m.contact_force += st.total_force_a.norm();
+      }
+    }
+  }
+  m.times.response += seconds_since(t0);
+
+}
+
+FrameMetrics World::step(double budget) {
+  const Clock::time_point frame_start = Clock::now();
+  const double dt = 1.0 / m_scene.frame_rate;
+  FrameMetrics m;
+  m.frame = m_frame;
+  m.min_step = std::numeric_limits<double>::infinity();
+
+  // The contact response is explicit and staggered: forces computed from one
+  // query act until the next. Its stiffness k on a node of mass m oscillates
+  // at omega = sqrt(k / m), stable only if the query interval h obeys
+  // omega h <= 1 (a margin under the explicit limit 2). So a frame runs as
+  // many detection/response cycles as that needs; FEM sub-steps inside each.
+  const int cycles = contact_cycles(dt);
+  m.cycles = cycles;
+  const double h = dt / cycles;
+  m.budget = budget >= 0 ? budget : m_scene.collision.budget_seconds;
+  for (int c = 0; c < cycles; ++c) {
+    const bool last = c + 1 == cycles;
+    if (budget < 0 && m_scene.target_fps > 0 && !m_plan.pairs.empty()) {
+      // Real-time mode: collision detection gets what is left of the frame.
+      const double left = (c + 1) * (1.0 / m_scene.target_fps) / cycles - seconds_since(frame_start);
+      m.budget = std::max(1e-6, left / static_cast<double>(m_plan.pairs.size()));
+    }
+    cycle(h, m.budget, last, m);
+  }
+
+  // Exact reference: intersecting dense triangles (for accuracy studies).
+  if (m_plan.exact_reference) {
+    m.exact_contacts = 0;
+    for (const auto& [i, j] : m_plan.pairs) {
+      const RuntimeObject& a = m_objects[i];
+      const RuntimeObject& b = m_objects[j];
+      const collision::AabbTree ta(a.dense, a.asset.dense.F);
+      const collision::AabbTree tb(b.dense, b.asset.dense.F);
+      m.exact_contacts += static_cast<int>(
+          collision::intersecting_triangle_pairs(ta, a.dense, a.asset.dense.F, tb, b.dense,
+                                                 b.asset.dense.F)
+              .size());
+    }
+  }
+
+  if (!std::isfinite(m.min_step)) m.min_step = 0;
+  ++m_frame;
+  m_time += dt;
+  m.time = m_time;
+  m.wall = seconds_since(frame_start);
+  return m;
+}
+
+}  // namespace icd::runner

@@ -1,0 +1,94 @@
+#pragma once
+/// The simulation loop of a scene (paper sections 3.2, 4 and 5): FEM on the
+/// coarse meshes, sphere-tree update, interruptible collision detection,
+/// penalty response, rigid links, each stage only where the plan needs it.
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "collision/traversal.hpp"
+#include "experiments/runner/object_asset.hpp"
+#include "experiments/runner/plan.hpp"
+#include "fem/simulator.hpp"
+
+namespace icd::runner {
+
+/// Wall time of each stage in one frame, seconds.
+struct StageTimes {
+  double fem = 0, links = 0, sphere_update = 0, collision = 0, response = 0, output = 0;
+  double total() const { return fem + links + sphere_update + collision + response + output; }
+};
+
+/// Metrics of one frame (summed over object pairs where that makes sense).
+struct FrameMetrics {
+  int frame = 0;
+  double time = 0;             ///< simulated time at the end of the frame, s
+  StageTimes times;
+  double wall = 0;             ///< wall time of the whole frame, s
+  double budget = 0;           ///< collision budget given to each query, s (inf = none)
+  int64_t pair_list = 0;       ///< PAIRLIST size at the end of the queries (untested pairs)
+  int64_t collision_list = 0;  ///< COLLISIONLIST size (colliding leaf pairs)
+  int64_t tests = 0;           ///< sphere tests done
+  int interrupted = 0;         ///< queries interrupted by their budget
+  int completed_level = 0;     ///< smallest completed level over the queries
+  int active_pairs = 0;        ///< sphere pairs that produced a force
+  double max_penetration = 0;  ///< deepest sphere penetration, m
+  double contact_force = 0;    ///< |total contact force| on the first object of each pair, N (sum)
+  int cycles = 1;              ///< detection/response cycles in the frame (stable penalty)
+  int substeps = 0;            ///< FEM sub-steps summed over objects
+  double min_step = 0;         ///< smallest FEM step used, s
+  double energy = 0;           ///< total mechanical energy of the deformable objects, J
+  int exact_contacts = -1;     ///< exact intersecting dense triangle pairs (-1: not computed)
+};
+
+/// One object at run time.
+struct RuntimeObject {
+  ObjectSpec spec;
+  ObjectPlan plan;
+  ObjectAsset asset;
+  std::unique_ptr<fem::Simulator> sim;  ///< deformable objects only (not movable: held by pointer)
+  MatX3d positions;       ///< current coarse positions (#V x 3)
+  MatX3d rest;            ///< rest coarse positions, placed in the scene
+  MatX3d contact_forces;  ///< forces from the last collision response (#V x 3)
+  MatX3d dense;           ///< current dense positions (when the plan updates them)
+};
+
+/// A scene being simulated.
+class World {
+ public:
+  /// Loads every object (see load_object_asset) and sets up the plan.
+  World(const Scene& scene, const std::filesystem::path& cache_dir,
+        const std::filesystem::path& tool_dir);
+
+  const Scene& scene() const { return m_scene; }
+  const StagePlan& plan() const { return m_plan; }
+  std::vector<RuntimeObject>& objects() { return m_objects; }
+  /// The last query of each collision pair (same order as plan().pairs).
+  const std::vector<collision::CollisionResult>& results() const { return m_results; }
+
+  /// Advances one frame of 1 / frame_rate simulated seconds. `budget` is the
+  /// collision budget per query (seconds); negative uses the scene's.
+  FrameMetrics step(double budget = -1);
+
+ private:
+  void update_dense(RuntimeObject& o);
+  /// One detection/response cycle of length h (s) inside a frame.
+  void cycle(double h, double budget, bool last, FrameMetrics& m);
+  /// Detection/response cycles a frame of dt needs for a stable penalty.
+  int contact_cycles(double dt) const;
+
+  static constexpr int kMaxContactCycles = 64;
+
+  Scene m_scene;
+  StagePlan m_plan;
+  std::vector<RuntimeObject> m_objects;
+  std::vector<collision::CollisionResult> m_results;
+  std::vector<std::vector<collision::NodePair>> m_fronts;
+  double m_min_node_mass = 1;    ///< smallest lumped node mass of the deformable objects, kg
+  double m_node_stiffness = 0;   ///< largest per-node penalty stiffness of the last response, N/m
+  int m_frame = 0;
+  double m_time = 0;
+};
+
+}  // namespace icd::runner
