@@ -1,0 +1,334 @@
+// Hole fairing needs CGAL's Eigen-based sparse solver.
+#ifndef CGAL_EIGEN3_ENABLED
+#define CGAL_EIGEN3_ENABLED
+#endif
+
+#include "mesh/pipeline/repair.hpp"
+
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "mesh/io/error.hpp"
+#include "mesh/pipeline/cgal_convert.hpp"
+
+namespace icd::mesh {
+namespace PMP = CGAL::Polygon_mesh_processing;
+using detail::CgalMesh;
+using detail::Point;
+
+namespace {
+
+std::string fmt_point(const Eigen::RowVector3d& p) {
+  std::ostringstream s;
+  s.precision(6);
+  s << "(" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+  return s.str();
+}
+
+std::string fmt_point(const Point& p) { return fmt_point(Eigen::RowVector3d(p.x(), p.y(), p.z())); }
+
+double signed_volume(const CgalMesh& m) {
+  double vol = 0.0;
+  for (auto f : m.faces()) {
+    auto h = m.halfedge(f);
+    const Point &a = m.point(m.source(h)), &b = m.point(m.target(h)),
+                &c = m.point(m.target(m.next(h)));
+    vol += CGAL::scalar_product(a - CGAL::ORIGIN, CGAL::cross_product(b - CGAL::ORIGIN,
+                                                                       c - CGAL::ORIGIN)) / 6.0;
+  }
+  return vol;
+}
+
+/// Boundary loops: (number of edges, diameter, a halfedge on it).
+struct Loop {
+  int edges = 0;
+  double diameter = 0.0;
+  CgalMesh::Halfedge_index h;
+};
+
+std::vector<Loop> boundary_loops(CgalMesh& m) {
+  std::vector<CgalMesh::Halfedge_index> starts;
+  PMP::extract_boundary_cycles(m, std::back_inserter(starts));
+  std::vector<Loop> loops;
+  for (auto h0 : starts) {
+    std::vector<Point> pts;
+    for (auto h : CGAL::halfedges_around_face(h0, m)) pts.push_back(m.point(m.source(h)));
+    Loop l;
+    l.edges = static_cast<int>(pts.size());
+    l.h = h0;
+    for (size_t i = 0; i < pts.size(); ++i)
+      for (size_t j = i + 1; j < pts.size(); ++j)
+        l.diameter = std::max(l.diameter, std::sqrt(CGAL::squared_distance(pts[i], pts[j])));
+    loops.push_back(l);
+  }
+  return loops;
+}
+
+}  // namespace
+
+std::string RepairReport::to_string() const {
+  std::ostringstream s;
+  s << "input " << input_vertices << " vertices, " << input_faces << " faces\n";
+  if (merged_duplicate_vertices) s << "merged duplicate vertices: " << merged_duplicate_vertices << "\n";
+  if (removed_degenerate_faces) s << "removed degenerate faces: " << removed_degenerate_faces << "\n";
+  if (removed_duplicate_faces) s << "removed duplicate faces: " << removed_duplicate_faces << "\n";
+  if (removed_unreferenced_vertices)
+    s << "removed unreferenced vertices: " << removed_unreferenced_vertices << "\n";
+  if (reoriented_faces) s << "re-oriented faces: " << reoriented_faces << "\n";
+  if (reversed_to_outward) s << "reversed to face outward\n";
+  if (holes_filled) s << "filled holes: " << holes_filled << " (" << hole_faces_added << " faces)\n";
+  s << "output " << output_vertices << " vertices, " << output_faces << " faces, " << components
+    << " component(s), volume " << volume << "\n";
+  return s.str();
+}
+
+RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& options,
+                            const std::string& name) {
+  if (options.max_hole_edges < 0 || !(options.max_hole_diameter >= 0.0) ||
+      !(options.min_volume_fraction >= 0.0))
+    throw ParameterError("repair_surface: max_hole_edges, max_hole_diameter and "
+                         "min_volume_fraction must be >= 0");
+  RepairResult result;
+  RepairReport& rep = result.report;
+  const int nv = static_cast<int>(input.V.rows());
+  const int nf = static_cast<int>(input.F.rows());
+  rep.input_vertices = nv;
+  rep.input_faces = nf;
+  if (nv < 4 || nf < 4)
+    throw InputError(name + ": " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                     " faces cannot bound a volume");
+  for (int i = 0; i < nv; ++i)
+    if (!input.V.row(i).allFinite())
+      throw InputError(name + ": vertex " + std::to_string(i) + " has a non-finite coordinate");
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (input.F(f, k) < 0 || input.F(f, k) >= nv)
+        throw InputError(name + ": face " + std::to_string(f) + " refers to vertex " +
+                         std::to_string(input.F(f, k)) + ", outside [0, " + std::to_string(nv) + ")");
+
+  // 1. Merge exactly duplicated vertices (first occurrence wins).
+  std::map<std::array<double, 3>, int> unique;
+  std::vector<int> remap(nv);
+  std::vector<int> first_of;  // new index -> an original index
+  for (int i = 0; i < nv; ++i) {
+    const auto [it, inserted] =
+        unique.try_emplace({input.V(i, 0), input.V(i, 1), input.V(i, 2)}, static_cast<int>(first_of.size()));
+    if (inserted) first_of.push_back(i);
+    remap[i] = it->second;
+  }
+  rep.merged_duplicate_vertices = nv - static_cast<int>(first_of.size());
+
+  // 2. Drop faces with a repeated vertex, and repeated faces (same vertex set).
+  std::vector<std::array<int, 3>> faces;
+  std::vector<int> face_origin;  // output face -> input face
+  std::set<std::array<int, 3>> seen;
+  for (int f = 0; f < nf; ++f) {
+    std::array<int, 3> t{remap[input.F(f, 0)], remap[input.F(f, 1)], remap[input.F(f, 2)]};
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      ++rep.removed_degenerate_faces;
+      continue;
+    }
+    std::array<int, 3> key = t;
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) {
+      ++rep.removed_duplicate_faces;
+      continue;
+    }
+    faces.push_back(t);
+    face_origin.push_back(f);
+  }
+
+  // 3. Drop unreferenced vertices.
+  std::vector<int> used(first_of.size(), -1);
+  std::vector<Point> points;
+  for (auto& t : faces)
+    for (int& v : t) {
+      if (used[v] < 0) {
+        used[v] = static_cast<int>(points.size());
+        const int o = first_of[v];
+        points.emplace_back(input.V(o, 0), input.V(o, 1), input.V(o, 2));
+      }
+      v = used[v];
+    }
+  rep.removed_unreferenced_vertices = static_cast<int>(first_of.size() - points.size());
+  std::vector<int> original_vertex(points.size());
+  for (size_t v = 0; v < used.size(); ++v)
+    if (used[v] >= 0) original_vertex[used[v]] = first_of[v];
+  if (points.size() < 4 || faces.size() < 4)
+    throw InputError(name + ": only " + std::to_string(faces.size()) +
+                     " non-degenerate faces remain; the surface cannot bound a volume");
+
+  // 4. Flat input (zero volume): all vertices in one plane.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  for (const Point& p : points) {
+    const Eigen::Vector3d x(p.x(), p.y(), p.z());
+    mean += x;
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  mean /= static_cast<double>(points.size());
+  const double diag = (hi - lo).norm();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Point& p : points) {
+    const Eigen::Vector3d x = Eigen::Vector3d(p.x(), p.y(), p.z()) - mean;
+    cov += x * x.transpose();
+  }
+  cov /= static_cast<double>(points.size());
+  const double thickness = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues()[0]));
+  if (!(thickness > 1e-9 * diag))
+    throw InputError(name + ": zero volume: all " + std::to_string(points.size()) +
+                     " vertices lie in one plane (thickness " + std::to_string(thickness) +
+                     ", diagonal " + std::to_string(diag) + ")");
+
+  // 5. Non-manifold edges (more than two faces).
+  {
+    std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+    for (size_t f = 0; f < faces.size(); ++f)
+      for (int k = 0; k < 3; ++k)
+        edge_faces[std::minmax(faces[f][k], faces[f][(k + 1) % 3])].push_back(static_cast<int>(f));
+    int bad = 0;
+    std::string first;
+    for (const auto& [e, fs] : edge_faces)
+      if (fs.size() > 2) {
+        if (bad++ == 0) {
+          std::ostringstream s;
+          s << "non-manifold edge between input vertices " << original_vertex[e.first] << " "
+            << fmt_point(Eigen::RowVector3d(points[e.first].x(), points[e.first].y(), points[e.first].z()))
+            << " and " << original_vertex[e.second] << " shared by " << fs.size() << " faces (input faces";
+          for (int f : fs) s << " " << face_origin[f];
+          s << ")";
+          first = s.str();
+        }
+      }
+    if (bad > 0)
+      throw InputError(name + ": " + first + (bad > 1 ? "; " + std::to_string(bad - 1) + " more" : ""));
+  }
+
+  // 6. Consistent orientation of the soup; it splits non-manifold vertices.
+  std::vector<std::vector<std::size_t>> polygons(faces.size());
+  for (size_t f = 0; f < faces.size(); ++f)
+    polygons[f] = {static_cast<size_t>(faces[f][0]), static_cast<size_t>(faces[f][1]),
+                   static_cast<size_t>(faces[f][2])};
+  const std::vector<std::vector<std::size_t>> before = polygons;
+  const size_t n_points = points.size();
+  PMP::orient_polygon_soup(points, polygons);
+  if (points.size() != n_points) {
+    const Point& p = points[n_points];
+    int orig = -1;
+    for (size_t v = 0; v < n_points; ++v)
+      if (points[v] == p) orig = original_vertex[v];
+    throw InputError(name + ": non-manifold vertex " + std::to_string(orig) + " at " + fmt_point(p) +
+                     " (its faces form " + std::to_string(points.size() - n_points + 1) +
+                     " separate fans); " + std::to_string(points.size() - n_points) +
+                     " vertex split(s) needed in total");
+  }
+  for (size_t f = 0; f < polygons.size(); ++f) {
+    const auto& a = before[f];
+    const auto& b = polygons[f];
+    const bool same = (a[0] == b[0] && a[1] == b[1]) || (a[0] == b[1] && a[1] == b[2]) ||
+                      (a[0] == b[2] && a[1] == b[0]);
+    rep.reoriented_faces += same ? 0 : 1;
+  }
+  CgalMesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+
+  // 7. Geometrically degenerate faces (zero area, not caught by indices).
+  {
+    bool any = false;
+    for (auto f : mesh.faces())
+      if (PMP::is_degenerate_triangle_face(f, mesh)) any = true;
+    if (any) {
+      const auto n_before = mesh.number_of_faces();
+      PMP::remove_degenerate_faces(mesh);
+      mesh.collect_garbage();
+      rep.removed_degenerate_faces += static_cast<int>(n_before - mesh.number_of_faces());
+    }
+  }
+
+  // 8. Fill small holes.
+  for (const Loop& l : boundary_loops(mesh)) {
+    if (l.edges > options.max_hole_edges || l.diameter > options.max_hole_diameter * diag) continue;
+    std::vector<CgalMesh::Face_index> patch;
+    std::vector<CgalMesh::Vertex_index> new_vertices;
+    if (options.fair_holes)
+      PMP::triangulate_refine_and_fair_hole(mesh, l.h, std::back_inserter(patch),
+                                            std::back_inserter(new_vertices));
+    else
+      PMP::triangulate_hole(mesh, l.h, std::back_inserter(patch));
+    ++rep.holes_filled;
+    rep.hole_faces_added += static_cast<int>(patch.size());
+  }
+  {
+    const std::vector<Loop> left = boundary_loops(mesh);
+    if (!left.empty()) {
+      const auto big = std::max_element(left.begin(), left.end(),
+                                        [](const Loop& a, const Loop& b) { return a.edges < b.edges; });
+      std::ostringstream s;
+      s << name << ": open surface: " << left.size() << " boundary loop(s) remain after filling "
+        << rep.holes_filled << " small hole(s); the largest has " << big->edges << " edges and diameter "
+        << big->diameter << " (limits: " << options.max_hole_edges << " edges, "
+        << options.max_hole_diameter * diag << ") and passes through " << fmt_point(mesh.point(mesh.source(big->h)));
+      throw InputError(s.str());
+    }
+  }
+  mesh.collect_garbage();
+
+  // 9. Self-intersections.
+  if (options.check_self_intersections && PMP::does_self_intersect(mesh)) {
+    std::vector<std::pair<CgalMesh::Face_index, CgalMesh::Face_index>> pairs;
+    PMP::self_intersections(mesh, std::back_inserter(pairs));
+    std::ostringstream s;
+    s << name << ": the surface intersects itself: " << pairs.size() << " intersecting face pair(s)";
+    if (!pairs.empty()) {
+      const auto centroid = [&](CgalMesh::Face_index f) {
+        auto h = mesh.halfedge(f);
+        return CGAL::centroid(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)),
+                              mesh.point(mesh.target(mesh.next(h))));
+      };
+      s << ", e.g. repaired faces " << pairs[0].first.idx() << " near " << fmt_point(centroid(pairs[0].first))
+        << " and " << pairs[0].second.idx() << " near " << fmt_point(centroid(pairs[0].second));
+    }
+    throw InputError(s.str());
+  }
+
+  // 10. Outward orientation of each component.
+  const double vol_before = signed_volume(mesh);
+  PMP::orient_to_bound_a_volume(mesh);
+  const double vol = signed_volume(mesh);
+  rep.reversed_to_outward = (vol_before != vol);
+  rep.volume = vol;
+  if (!(vol > options.min_volume_fraction * diag * diag * diag))
+    throw InputError(name + ": zero volume: the repaired surface encloses " + std::to_string(vol) +
+                     " (bounding-box diagonal " + std::to_string(diag) + ")");
+  {
+    auto fcc = mesh.add_property_map<CgalMesh::Face_index, std::size_t>("f:cc").first;
+    rep.components = static_cast<int>(PMP::connected_components(mesh, fcc));
+    mesh.remove_property_map(fcc);
+  }
+
+  result.mesh = detail::from_cgal(mesh);
+  rep.output_vertices = static_cast<int>(result.mesh.V.rows());
+  rep.output_faces = static_cast<int>(result.mesh.F.rows());
+  return result;
+}
+
+}  // namespace icd::mesh

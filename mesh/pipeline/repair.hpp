@@ -1,0 +1,66 @@
+#pragma once
+/// Stage 1 of the preprocessing pipeline (issue 4): turn a raw triangle soup
+/// into a closed, manifold, outward-oriented, non-self-intersecting surface,
+/// or refuse it with an InputError that says where it fails.
+#include <string>
+
+#include "mesh/io/types.hpp"
+
+namespace icd::mesh {
+
+/// Options of repair_surface().
+struct RepairOptions {
+  /// Holes whose boundary loop has at most this many edges are filled...
+  int max_hole_edges = 200;
+  /// ...and whose diameter (largest distance between two loop vertices) is at
+  /// most this fraction of the bounding-box diagonal. Larger holes are refused.
+  double max_hole_diameter = 0.1;
+  /// Refine and fair the hole patch (CGAL triangulate_refine_and_fair_hole);
+  /// false: plain minimal-area triangulation (triangulate_hole).
+  bool fair_holes = true;
+  /// A mesh whose enclosed volume is below this fraction of diagonal^3 is refused.
+  double min_volume_fraction = 1e-9;
+  /// Self-intersection check (CGAL does_self_intersect); disabling it is only
+  /// for callers that check themselves.
+  bool check_self_intersections = true;
+};
+
+/// What repair_surface() did, in counts.
+struct RepairReport {
+  int input_vertices = 0, input_faces = 0;
+  int merged_duplicate_vertices = 0;   ///< vertices with exactly equal coordinates merged
+  int removed_degenerate_faces = 0;    ///< repeated vertex or zero area
+  int removed_duplicate_faces = 0;     ///< same vertex set as an earlier face
+  int removed_unreferenced_vertices = 0;
+  int reoriented_faces = 0;            ///< faces flipped to make orientation consistent
+  bool reversed_to_outward = false;    ///< whole surface (or components) flipped outward
+  int holes_filled = 0;
+  int hole_faces_added = 0;
+  int components = 0;                  ///< connected components of the output
+  int output_vertices = 0, output_faces = 0;
+  double volume = 0.0;                 ///< enclosed volume of the output (model units^3)
+
+  /// One line per non-zero count, for the tool's summary.
+  std::string to_string() const;
+};
+
+/// Result of repair_surface().
+struct RepairResult {
+  SurfaceMesh mesh;  ///< closed, manifold, outward-oriented, no self-intersection
+  RepairReport report;
+};
+
+/// Repairs `input` (V #V x 3, F #F x 3; orientation and duplicates arbitrary):
+/// merges exactly duplicated vertices, removes degenerate and duplicate faces
+/// and unreferenced vertices, orients the faces consistently (CGAL
+/// orient_polygon_soup), fills holes below the size limits, orients each
+/// component outward (CGAL orient_to_bound_a_volume).
+/// Throws InputError, prefixed with `name`, when the input has out-of-range
+/// indices or non-finite coordinates, is flat (zero volume), has a
+/// non-manifold edge or vertex (named, with its position), keeps boundary
+/// loops after hole filling (count, size, a vertex on the largest), or
+/// self-intersects (number of intersecting face pairs and the first pair).
+RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& options = {},
+                            const std::string& name = "surface");
+
+}  // namespace icd::mesh

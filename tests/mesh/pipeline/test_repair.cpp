@@ -1,0 +1,167 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include "mesh/io/error.hpp"
+#include "mesh/io/primitives.hpp"
+#include "mesh/pipeline/repair.hpp"
+#include "mesh/pipeline/pipeline_test_utils.hpp"
+
+namespace icd::mesh {
+namespace {
+
+using test::closed_and_oriented;
+using test::enclosed_volume;
+
+// Expects repair_surface(m) to throw InputError whose message contains every
+// fragment; prints the message for the log.
+void expect_refused(const SurfaceMesh& m, std::initializer_list<const char*> fragments,
+                    const RepairOptions& o = {}) {
+  try {
+    repair_surface(m, o, "in.off");
+    ADD_FAILURE() << "no exception";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("in.off: ", 0), 0u) << msg;
+    for (const char* f : fragments) EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
+    std::cout << "  message: " << msg << "\n";
+  }
+}
+
+TEST(Repair, CleanSphereIsUnchanged) {
+  const SurfaceMesh s = make_icosphere(2);
+  const RepairResult r = repair_surface(s);
+  EXPECT_EQ(r.mesh.V.rows(), s.V.rows());
+  EXPECT_EQ(r.mesh.F.rows(), s.F.rows());
+  EXPECT_EQ(r.report.merged_duplicate_vertices + r.report.removed_degenerate_faces +
+                r.report.removed_duplicate_faces + r.report.reoriented_faces + r.report.holes_filled,
+            0);
+  EXPECT_FALSE(r.report.reversed_to_outward);
+  EXPECT_EQ(r.report.components, 1);
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  EXPECT_NEAR(r.report.volume, enclosed_volume(s.V, s.F), 1e-12);
+}
+
+TEST(Repair, FillsSmallHole) {
+  const SurfaceMesh s = make_icosphere(3);
+  std::set<int> drop;  // the fan of vertex 0 (valence 5): a 5-edge hole
+  for (int f = 0; f < s.F.rows(); ++f)
+    if ((s.F.row(f).array() == 0).any()) drop.insert(f);
+  ASSERT_EQ(drop.size(), 5u);
+  const RepairResult r = repair_surface(test::without_faces(s, drop));
+  EXPECT_EQ(r.report.holes_filled, 1);
+  EXPECT_GE(r.report.hole_faces_added, 3);
+  EXPECT_EQ(r.report.removed_unreferenced_vertices, 1);
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  // The patch closes the surface: the volume is within 0.5% of the intact sphere.
+  const double intact = enclosed_volume(s.V, s.F);
+  EXPECT_NEAR(enclosed_volume(r.mesh.V, r.mesh.F) / intact, 1.0, 5e-3);
+  EXPECT_NEAR(r.report.volume, enclosed_volume(r.mesh.V, r.mesh.F), 1e-12);
+}
+
+TEST(Repair, ReorientsFlippedFacesAndInvertedSurface) {
+  const SurfaceMesh s = make_icosphere(2);
+  SurfaceMesh flipped = s;
+  int k = 0;
+  for (int f = 0; f < s.F.rows(); f += 3, ++k) std::swap(flipped.F(f, 1), flipped.F(f, 2));
+  const RepairResult r = repair_surface(flipped);
+  const int nf = static_cast<int>(s.F.rows());
+  EXPECT_TRUE(r.report.reoriented_faces == k || r.report.reoriented_faces == nf - k)
+      << r.report.reoriented_faces;
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  EXPECT_NEAR(enclosed_volume(r.mesh.V, r.mesh.F), enclosed_volume(s.V, s.F), 1e-12);
+
+  SurfaceMesh inverted = s;  // consistently oriented, but inward
+  inverted.F.col(1).swap(inverted.F.col(2));
+  const RepairResult ri = repair_surface(inverted);
+  EXPECT_TRUE(ri.report.reversed_to_outward);
+  EXPECT_NEAR(enclosed_volume(ri.mesh.V, ri.mesh.F), enclosed_volume(s.V, s.F), 1e-12);
+}
+
+TEST(Repair, MergesDuplicateVerticesAndDropsBadFaces) {
+  const SurfaceMesh s = make_torus(1.0, 0.3, 16, 8);
+  // Triangle soup: every face has its own three vertices.
+  SurfaceMesh soup;
+  const int nf = static_cast<int>(s.F.rows());
+  soup.V.resize(3 * nf, 3);
+  soup.F.resize(nf + 2, 3);
+  for (int f = 0; f < nf; ++f)
+    for (int c = 0; c < 3; ++c) {
+      soup.V.row(3 * f + c) = s.V.row(s.F(f, c));
+      soup.F(f, c) = 3 * f + c;
+    }
+  soup.F.row(nf) << 3, 4, 5;  // duplicate of face 1
+  soup.F.row(nf + 1) << 0, 0, 1;  // repeated vertex: degenerate
+  const RepairResult r = repair_surface(soup);
+  EXPECT_EQ(r.report.merged_duplicate_vertices, 3 * nf - s.V.rows());
+  EXPECT_EQ(r.report.removed_duplicate_faces, 1);
+  EXPECT_EQ(r.report.removed_degenerate_faces, 1);
+  EXPECT_EQ(r.mesh.V.rows(), s.V.rows());
+  EXPECT_EQ(r.mesh.F.rows(), s.F.rows());
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  EXPECT_NEAR(r.report.volume, enclosed_volume(s.V, s.F), 1e-12);
+}
+
+TEST(Repair, RefusesLargeHole) {
+  const SurfaceMesh s = make_icosphere(3);
+  std::set<int> drop;
+  for (int f = 0; f < s.F.rows(); ++f)
+    if ((s.V.row(s.F(f, 0)) + s.V.row(s.F(f, 1)) + s.V.row(s.F(f, 2)))(2) / 3 > 0.6) drop.insert(f);
+  expect_refused(test::without_faces(s, drop), {"open surface", "1 boundary loop", "edges"});
+}
+
+TEST(Repair, RefusesNonManifoldEdge) {
+  SurfaceMesh b = make_box_surface({0, 0, 0}, {1, 1, 1});
+  // A fin: a third triangle on the box edge between vertices F(0,0) and F(0,1).
+  SurfaceMesh m;
+  m.V.resize(9, 3);
+  m.V << b.V, Eigen::RowVector3d(-1, -1, 3);
+  m.F.resize(13, 3);
+  m.F << b.F, b.F(0, 0), b.F(0, 1), 8;
+  expect_refused(m, {"non-manifold edge", "shared by 3 faces"});
+}
+
+TEST(Repair, RefusesNonManifoldVertex) {
+  // Two tetrahedra touching at one vertex: every edge is fine, the vertex is not.
+  const TetMesh t = make_unit_tet();
+  SurfaceMesh m;
+  m.V.resize(7, 3);
+  m.V << t.V, -t.V.bottomRows(3);
+  m.F.resize(8, 3);
+  m.F << t.F, t.F;
+  for (int f = 4; f < 8; ++f)
+    for (int c = 0; c < 3; ++c)
+      if (m.F(f, c) != 0) m.F(f, c) += 3;
+  expect_refused(m, {"non-manifold vertex 0"});
+}
+
+TEST(Repair, RefusesSelfIntersection) {
+  const SurfaceMesh a = make_icosphere(2);
+  SurfaceMesh m;
+  m.V.resize(2 * a.V.rows(), 3);
+  m.V << a.V, a.V.rowwise() + Eigen::RowVector3d(1.0, 0.2, 0.1);
+  m.F.resize(2 * a.F.rows(), 3);
+  m.F << a.F, a.F.array() + static_cast<int>(a.V.rows());
+  expect_refused(m, {"intersects itself", "intersecting face pair"});
+}
+
+TEST(Repair, RefusesZeroVolume) {
+  SurfaceMesh flat = make_icosphere(2);
+  flat.V.col(2).setZero();  // squashed into the plane z = 0
+  expect_refused(flat, {"zero volume"});
+}
+
+TEST(Repair, RefusesBadIndicesAndCoordinates) {
+  SurfaceMesh s = make_icosphere(1);
+  s.F(7, 2) = 1000;
+  expect_refused(s, {"face 7", "1000"});
+  s = make_icosphere(1);
+  s.V(3, 1) = std::nan("");
+  expect_refused(s, {"vertex 3", "non-finite"});
+}
+
+}  // namespace
+}  // namespace icd::mesh
