@@ -332,6 +332,7 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
 thread_local PairQueue t_queue;
 thread_local PairStack t_stack;
 thread_local std::vector<HeapItem> t_heap;
+thread_local std::vector<WorkPair> t_seeds;
 
 }  // namespace
 
@@ -369,7 +370,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
                 b.first_child.data(), b.child_count.data(), a.level.data(), b.level.data(), request.depth_cap};
   // Seeds: the root pair (Fig. 7: p.1 = root of a, p.2 = root of b, split p.2
   // first), or the previous front, splitting the shallower node first.
-  std::vector<WorkPair> seeds;
+  std::vector<WorkPair>& seeds = t_seeds;
+  seeds.clear();
   if (request.start_front) {
     seeds.reserve(request.start_front->size());
     for (const NodePair& p : *request.start_front) {

@@ -96,8 +96,8 @@ int main(int argc, char** argv) {
   // Workload: two deep octree trees over overlapping icospheres: a full
   // traversal takes longer than the largest budget.
   std::printf("building trees...\n");
-  const Object a = icosphere_object(6, 1.0, {0, 0, 0}, 8);
-  const Object b = icosphere_object(6, 1.0, {0.02, 0.01, 0.0}, 8);
+  const Object a = icosphere_object(6, 1.0, {0, 0, 0}, 9);
+  const Object b = icosphere_object(6, 1.0, {0.01, 0.005, 0.0}, 9);
   CollisionResult result;
   {
     const auto t0 = Clock::now();
