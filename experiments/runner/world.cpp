@@ -82,7 +82,7 @@ int World::contact_cycles(double dt) const {
   if (!m_plan.response) return 1;
   const double k = std::max(m_node_stiffness, m_scene.collision.contact.stiffness);
   const double omega = std::sqrt(k / m_min_node_mass);
-  return std::clamp(static_cast<int>(std::ceil(omega * dt)), 1, kMaxContactCycles);
+  return std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1, kMaxContactCycles);
 }
 
 void World::update_dense(RuntimeObject& o) {
@@ -151,6 +151,12 @@ void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
       if (!m_fronts[p].empty()) req.start_front = &m_fronts[p];
     }
     collision::CollisionResult& r = m_results[p];
+    if (m_plan.broad_phase && !collision::overlap(m_objects[i].asset.tree.spheres[0],
+                                                  m_objects[j].asset.tree.spheres[0])) {
+      // Broad phase: root spheres apart, nothing to refine.
+      r = collision::CollisionResult{};
+      continue;
+    }
     collision::collide(m_objects[i].asset.tree, m_objects[j].asset.tree, req, r);
     if (cs.temporal_coherence) m_fronts[p] = r.front;
     if (last) {
@@ -201,7 +207,7 @@ FrameMetrics World::step(double budget) {
   // The contact response is explicit and staggered: forces computed from one
   // query act until the next. Its stiffness k on a node of mass m oscillates
   // at omega = sqrt(k / m), stable only if the query interval h obeys
-  // omega h <= 1 (a margin under the explicit limit 2). So a frame runs as
+  // omega h <= kContactOmegaStep (under the explicit limit 2). So a frame runs as
   // many detection/response cycles as that needs; FEM sub-steps inside each.
   const int cycles = contact_cycles(dt);
   m.cycles = cycles;

@@ -79,6 +79,9 @@ class World {
   int contact_cycles(double dt) const;
 
   static constexpr int kMaxContactCycles = 64;
+  /// Largest omega h of the staggered penalty (explicit limit 2; smaller
+  /// values inject less energy per contact).
+  static constexpr double kContactOmegaStep = 0.25;
 
   Scene m_scene;
   StagePlan m_plan;

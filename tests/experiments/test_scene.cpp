@@ -1,0 +1,149 @@
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "experiments/runner/plan.hpp"
+#include "experiments/runner/scene.hpp"
+#include "mesh/io/error.hpp"
+
+namespace icd::runner {
+namespace {
+
+Scene parse(const std::string& text) { return parse_scene(parse_json(text, "s.json"), "s.json", "."); }
+
+const char* kSphere = R"({"name": "a", "primitive": {"type": "sphere"}})";
+
+std::string with_objects(const std::string& objects, const std::string& extra = "") {
+  return "{\"objects\": [" + objects + "]" + (extra.empty() ? "" : ", " + extra) + "}";
+}
+
+TEST(Scene, ParsesDefaultsAndFields) {
+  const Scene s = parse(with_objects(
+      R"({"name": "a", "primitive": {"type": "sphere", "radius": 0.2}, "velocity": [1, 0, 0],
+          "material": {"model": "corotational", "young": 2e5, "poisson": 0.45, "density": 900,
+                       "rayleigh": [0.1, 0.001]}, "integrator": "symplectic_euler"})",
+      R"("frames": 7, "collision": {"budget_tests": 100, "mode": "priority"})"));
+  ASSERT_EQ(s.objects.size(), 1u);
+  const ObjectSpec& o = s.objects[0];
+  EXPECT_EQ(s.frames, 7);
+  EXPECT_DOUBLE_EQ(o.primitive->radius, 0.2);
+  EXPECT_EQ(o.material.model, fem::MaterialModel::Corotational);
+  EXPECT_DOUBLE_EQ(o.material.poisson, 0.45);
+  EXPECT_DOUBLE_EQ(o.damping.beta, 0.001);
+  EXPECT_EQ(o.integrator, fem::Integrator::SymplecticEuler);
+  EXPECT_EQ(s.collision.budget_tests, 100);
+  EXPECT_EQ(s.collision.mode, collision::TraversalMode::Priority);
+  EXPECT_TRUE(std::isinf(s.collision.budget_seconds));  // a test budget alone
+}
+
+// Every bad field gets an InputError naming the file and the field.
+TEST(Scene, EachBadFieldGetsAClearError) {
+  const struct {
+    std::string text;
+    const char* field;
+    const char* what;
+  } cases[] = {
+      {"{}", "objects", "non-empty array"},
+      {with_objects(""), "objects", "non-empty array"},
+      {with_objects(R"({"name": "a"})"), "objects[0]", "exactly one of"},
+      {with_objects(R"({"mesh": "x.off", "primitive": {}})"), "objects[0]", "exactly one of"},
+      {with_objects(R"({"primitive": {}, "material": {"poisson": 0.5}})"),
+       "objects[0].material.poisson", "(-1, 0.5)"},
+      {with_objects(R"({"primitive": {}, "material": {"young": -1}})"),
+       "objects[0].material.young", "must be in"},
+      {with_objects(R"({"primitive": {}, "material": {"density": 0}})"),
+       "objects[0].material.density", "must be in"},
+      {with_objects(R"({"primitive": {}, "material": {"rayleigh": [1]}})"),
+       "objects[0].material.rayleigh", "[alpha, beta]"},
+      {with_objects(R"({"primitive": {}, "integrator": "euler"})"), "objects[0].integrator",
+       "must be one of"},
+      {with_objects(R"({"primitive": {}, "kind": "static", "velocity": [1, 0, 0]})"),
+       "objects[0].velocity", "static"},
+      {with_objects(R"({"primitive": {}, "velocity": [1, 0]})"), "objects[0].velocity",
+       "array of 3"},
+      {with_objects(R"({"primitive": {}, "fixed_nodes": [1, -2]})"), "objects[0].fixed_nodes[1]",
+       "non-negative integer"},
+      {with_objects(R"({"primitive": {"type": "cone"}})"), "objects[0].primitive.type",
+       "must be one of"},
+      {with_objects(R"({"primitive": {}, "colour": "red"})"), "objects[0].colour",
+       "unknown field"},
+      {with_objects(std::string(kSphere) + "," + kSphere), "objects[1].name", "duplicate"},
+      {with_objects(kSphere, R"("frames": 0)"), "frames", "must be in"},
+      {with_objects(kSphere, R"("frames": 2.5)"), "frames", "integer"},
+      {with_objects(kSphere, R"("frame_rate": 0)"), "frame_rate", "must be in"},
+      {with_objects(kSphere, R"("collision": {"budget_seconds": -1})"),
+       "collision.budget_seconds", "must be in"},
+      {with_objects(kSphere, R"("collision": {"budget_seconds": 0})"),
+       "collision.budget_seconds", "must be in"},
+      {with_objects(kSphere, R"("collision": {"budget_tests": -5})"), "collision.budget_tests",
+       "must be in"},
+      {with_objects(kSphere, R"("collision": {"stiffness": 0})"), "collision.stiffness",
+       "must be in"},
+      {with_objects(kSphere, R"("collision": {"mode": "random"})"), "collision.mode",
+       "must be one of"},
+      {with_objects(kSphere, R"("output": {"vtu_every": -1})"), "output.vtu_every", "must be in"},
+      {with_objects(kSphere, R"("output": {"csv": "yes"})"), "output.csv", "true or false"},
+  };
+  for (const auto& c : cases) {
+    try {
+      parse(c.text);
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("s.json: ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(std::string(c.field) + ":"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(c.what), std::string::npos) << msg;
+    }
+  }
+}
+
+// --dry-run plans: each scene runs only the stages it needs.
+TEST(Plan, OneObjectSceneHasNoCollisionPipeline) {
+  const Scene s = parse(with_objects(kSphere, R"("output": {"vtu_every": 0})"));
+  const StagePlan p = make_plan(s);
+  EXPECT_TRUE(p.objects[0].fem);
+  EXPECT_FALSE(p.objects[0].sphere_tree);
+  EXPECT_FALSE(p.objects[0].sphere_update);
+  EXPECT_FALSE(p.objects[0].dense_update);  // nothing consumes the dense mesh
+  EXPECT_TRUE(p.pairs.empty());
+  EXPECT_FALSE(p.response);
+  const auto lines = p.describe(s);
+  EXPECT_EQ(lines[0], "a: load, fem (stvk, rk4)");
+  EXPECT_EQ(lines[1], "collision: none");
+}
+
+TEST(Plan, RigidObstacleGetsNoFemButCollides) {
+  const Scene s = parse(with_objects(
+      R"({"name": "ball", "primitive": {}}, {"name": "wall", "primitive": {"type": "box"}, "kind": "static"})",
+      R"("output": {"vtu_every": 5})"));
+  const StagePlan p = make_plan(s);
+  EXPECT_TRUE(p.objects[0].fem);
+  EXPECT_FALSE(p.objects[1].fem);
+  EXPECT_FALSE(p.objects[1].kinematic);
+  EXPECT_TRUE(p.objects[1].sphere_tree);
+  EXPECT_FALSE(p.objects[1].sphere_update);  // never moves
+  EXPECT_FALSE(p.objects[1].dense_update);
+  EXPECT_TRUE(p.objects[0].dense_update);    // written to VTU
+  ASSERT_EQ(p.pairs.size(), 1u);
+  EXPECT_TRUE(p.response);
+  EXPECT_FALSE(p.broad_phase);
+  const auto lines = p.describe(s);
+  EXPECT_EQ(lines[1], "wall: load, static, sphere tree");
+}
+
+TEST(Plan, TwoDeformableObjectsRunEverything) {
+  const Scene s = parse(with_objects(
+      R"({"name": "a", "primitive": {}}, {"name": "b", "primitive": {}, "integrator": "backward_euler"},
+         {"name": "c", "primitive": {}, "kind": "rigid", "velocity": [0, 0, -1]})",
+      R"("output": {"exact_reference": true})"));
+  const StagePlan p = make_plan(s);
+  EXPECT_EQ(p.pairs.size(), 3u);
+  EXPECT_TRUE(p.broad_phase);
+  EXPECT_TRUE(p.objects[2].kinematic);
+  EXPECT_TRUE(p.objects[2].sphere_update);
+  for (const ObjectPlan& o : p.objects) EXPECT_TRUE(o.dense_update);  // exact reference needs them
+  EXPECT_EQ(p.describe(s)[1], "b: load, fem (stvk, backward_euler), sphere tree, sphere update, rigid links (dense mesh)");
+}
+
+}  // namespace
+}  // namespace icd::runner
