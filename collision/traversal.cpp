@@ -38,6 +38,15 @@ class PairQueue {
     --m_size;
     return p;
   }
+  /// Room for `extra` more pairs without growing.
+  void ensure(std::size_t extra) {
+    while (m_size + extra > m_buf.size()) grow();
+  }
+  /// Branch-free conditional push (after ensure()).
+  void push_if(const WorkPair& p, bool keep) {
+    m_buf[(m_head + m_size) & m_mask] = p;
+    m_size += keep;
+  }
   template <class F>
   void for_each(F&& f) const {
     for (std::size_t k = 0; k < m_size; ++k) f(m_buf[(m_head + k) & m_mask]);
@@ -59,22 +68,29 @@ class PairQueue {
 // LIFO with the same interface.
 class PairStack {
  public:
-  void clear() { m_buf.clear(); }
-  bool empty() const { return m_buf.empty(); }
-  std::size_t size() const { return m_buf.size(); }
-  void push(const WorkPair& p) { m_buf.push_back(p); }
-  WorkPair pop() {
-    const WorkPair p = m_buf.back();
-    m_buf.pop_back();
-    return p;
+  void clear() { m_size = 0; }
+  bool empty() const { return m_size == 0; }
+  std::size_t size() const { return m_size; }
+  void push(const WorkPair& p) {
+    ensure(1);
+    m_buf[m_size++] = p;
+  }
+  WorkPair pop() { return m_buf[--m_size]; }
+  void ensure(std::size_t extra) {
+    if (m_size + extra > m_buf.size()) m_buf.resize(std::max<std::size_t>(1024, 2 * (m_size + extra)));
+  }
+  void push_if(const WorkPair& p, bool keep) {
+    m_buf[m_size] = p;
+    m_size += keep;
   }
   template <class F>
   void for_each(F&& f) const {
-    for (auto it = m_buf.rbegin(); it != m_buf.rend(); ++it) f(*it);
+    for (std::size_t k = m_size; k-- > 0;) f(m_buf[k]);
   }
 
  private:
   std::vector<WorkPair> m_buf;
+  std::size_t m_size = 0;
 };
 
 // Seconds to copy one pending pair into the result at an interruption,
@@ -123,6 +139,10 @@ class Budget {
     }
     m_next = m_timed ? 0 : m_max_tests;  // a timed query reads the clock before its first test
   }
+  // True when tests number `tests` .. `tests + count - 1` trigger no budget
+  // event (no clock read due, test budget not reached): they may run unchecked.
+  bool batch_ok(int64_t tests, int64_t count) const { return tests + count <= m_next; }
+
   // Call before test number `tests` with `pending` pairs that an interruption
   // would have to copy out; returns false (and sets the reason) to stop. The
   // time to copy the pending pairs is reserved out of the budget.
@@ -236,6 +256,25 @@ void run_literal(const Trees& t, List& list, Budget& budget, bool record_front, 
   list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
 }
 
+// Tests the children [first, end) of the split node against the other node
+// of `p` and queues the overlapping pairs (SplitB: the children are b's).
+template <bool SplitB, class List>
+inline void expand_batch(const Trees& t, const WorkPair& p, int32_t first, int32_t end, List& list,
+                         CollisionResult& res) {
+  const Sphere o = SplitB ? t.sa[p.a] : t.sb[p.b];
+  const Sphere* kids = SplitB ? t.sb : t.sa;
+  const bool other_expandable = SplitB ? t.expandable_a(p.a) : t.expandable_b(p.b);
+  const int32_t next_flag = SplitB ? 0 : 1;
+  for (int32_t c = first; c < end; ++c) {
+    const Sphere& s = kids[c];
+    const double dx = o.x - s.x, dy = o.y - s.y, dz = o.z - s.z, rr = o.r + s.r;
+    const bool ov = dx * dx + dy * dy + dz * dz <= rr * rr;
+    const int32_t a = SplitB ? p.a : c, b = SplitB ? c : p.b;
+    if (other_expandable || (SplitB ? t.expandable_b(c) : t.expandable_a(c))) list.push_if({a, b, next_flag}, ov);
+    else if (ov) settle(t, a, b, res);
+  }
+}
+
 // Fast path: children are tested as they are generated; the list holds only
 // overlapping pairs that still need splitting.
 template <class List>
@@ -248,6 +287,16 @@ void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, Col
     const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a];
     const int32_t end = first + (split_b ? t.ccb[p.b] : t.cca[p.a]);
     const int32_t next_flag = split_b ? 0 : 1;
+    if (!record_front && budget.batch_ok(res.tests, end - first)) {
+      // Batch: no budget event inside; children tested against the fixed
+      // sphere with branch-free pushes of the overlapping ones.
+      list.ensure(static_cast<std::size_t>(end - first));
+      res.tests += end - first;
+      if (split_b) expand_batch<true>(t, p, first, end, list, res);
+      else expand_batch<false>(t, p, first, end, list, res);
+      res.peak_list_size = std::max(res.peak_list_size, list.size());
+      continue;
+    }
     for (int32_t c = first; c < end; ++c) {
       const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
       if (!budget.allow(res.tests, list.size(), reason)) {
