@@ -1,0 +1,62 @@
+// Determinism of the threaded element loops: bitwise-identical results for
+// 1 and 2 threads (forces, energy, differential, and whole simulations).
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "fem/forces.hpp"
+#include "fem/simulator.hpp"
+#include "fem_test_utils.hpp"
+
+namespace icd::fem {
+namespace {
+
+bool bitwise_equal(const MatX3d& a, const MatX3d& b) {
+  return a.rows() == b.rows() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
+}
+
+class ParallelPerModel : public ::testing::TestWithParam<MaterialModel> {};
+
+TEST_P(ParallelPerModel, ForcesEnergyAndDifferentialAreBitwiseIdenticalFor1And2Threads) {
+  const TetMeshData d = test::box_data(40, 4, 4);  // 3840 tets: several 512-element chunks
+  const MatX3d x = d.rest_positions + 0.003 * test::random_field(d.num_nodes, 11);
+  const MatX3d dx = test::random_field(d.num_nodes, 12);
+  ElasticForces one(d, test::material(GetParam()));
+  ForceOptions two_threads;
+  two_threads.num_threads = 2;
+  ElasticForces two(d, test::material(GetParam()), two_threads);
+  MatX3d f1(d.num_nodes, 3), f2(d.num_nodes, 3), df1(d.num_nodes, 3), df2(d.num_nodes, 3);
+  const double e1 = one.compute_with_energy(x, f1);
+  const double e2 = two.compute_with_energy(x, f2);
+  EXPECT_TRUE(bitwise_equal(f1, f2));
+  EXPECT_EQ(std::memcmp(&e1, &e2, sizeof(double)), 0);
+  one.differential(x, dx, df1);
+  two.differential(x, dx, df2);
+  EXPECT_TRUE(bitwise_equal(df1, df2));
+  // The results are not trivially zero, and a different input changes them
+  // (so the comparison could fail).
+  EXPECT_GT(f1.norm(), 0.0);
+  MatX3d f3(d.num_nodes, 3);
+  two.compute(x + 1e-9 * dx, f3);
+  EXPECT_FALSE(bitwise_equal(f1, f3));
+}
+
+INSTANTIATE_TEST_SUITE_P(AllModels, ParallelPerModel, ::testing::ValuesIn(test::all_models()), test::model_name);
+
+TEST(Parallel, SimulationIsBitwiseIdenticalFor1And2Threads) {
+  MatX3d result[2];
+  for (int threads : {1, 2}) {
+    SimulatorOptions o;
+    o.integrator = Integrator::RK4;
+    // 1620 tets: four 512-element chunks.
+    Simulator sim(test::cantilever(3, test::material(MaterialModel::Corotational, 1e6, 0.3), 9.81,
+                                   {1.0, 1e-4}, threads),
+                  o);
+    sim.advance(1.0 / 120);
+    result[threads - 1] = sim.positions();
+  }
+  EXPECT_TRUE(bitwise_equal(result[0], result[1]));
+}
+
+}  // namespace
+}  // namespace icd::fem
