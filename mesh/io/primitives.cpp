@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <numbers>
 #include <string>
@@ -71,22 +72,37 @@ TetMesh make_box_tet_mesh(const BoxMeshOptions& o) {
 MatX3i boundary_faces(const Eigen::Ref<const MatX4i>& T) {
   // Local faces of a positively oriented tet (v0..v3), each outward.
   static constexpr int faces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-  std::map<std::array<int, 3>, int> count;
-  for (int e = 0; e < T.rows(); ++e)
-    for (const auto& f : faces) {
-      std::array<int, 3> key{T(e, f[0]), T(e, f[1]), T(e, f[2])};
+  // Sort (sorted corner triple, 4 * tet + local face) records; a face whose
+  // triple occurs once is on the boundary. O(#T log #T), no node allocations.
+  struct Record {
+    std::array<int, 3> key;
+    int64_t slot;
+  };
+  const int64_t n = 4 * static_cast<int64_t>(T.rows());
+  std::vector<Record> records(static_cast<size_t>(n));
+  for (Eigen::Index e = 0; e < T.rows(); ++e)
+    for (int f = 0; f < 4; ++f) {
+      std::array<int, 3> key{T(e, faces[f][0]), T(e, faces[f][1]), T(e, faces[f][2])};
       std::sort(key.begin(), key.end());
-      ++count[key];
+      records[4 * e + f] = {key, 4 * e + f};
     }
-  std::vector<std::array<int, 3>> out;
-  for (int e = 0; e < T.rows(); ++e)
-    for (const auto& f : faces) {
-      std::array<int, 3> key{T(e, f[0]), T(e, f[1]), T(e, f[2])};
-      std::sort(key.begin(), key.end());
-      if (count[key] == 1) out.push_back({T(e, f[0]), T(e, f[1]), T(e, f[2])});
+  std::sort(records.begin(), records.end(),
+            [](const Record& a, const Record& b) { return a.key < b.key; });
+  std::vector<char> on_boundary(static_cast<size_t>(n), 0);
+  for (size_t i = 0; i < records.size();) {
+    size_t j = i + 1;
+    while (j < records.size() && records[j].key == records[i].key) ++j;
+    if (j == i + 1) on_boundary[records[i].slot] = 1;
+    i = j;
+  }
+  MatX3i F(std::count(on_boundary.begin(), on_boundary.end(), 1), 3);
+  Eigen::Index row = 0;
+  for (int64_t slot = 0; slot < n; ++slot)
+    if (on_boundary[slot]) {
+      const Eigen::Index e = slot / 4;
+      const int* f = faces[slot % 4];
+      F.row(row++) << T(e, f[0]), T(e, f[1]), T(e, f[2]);
     }
-  MatX3i F(static_cast<Eigen::Index>(out.size()), 3);
-  for (size_t i = 0; i < out.size(); ++i) F.row(i) << out[i][0], out[i][1], out[i][2];
   return F;
 }
 

@@ -3,7 +3,9 @@
 #include <Eigen/Dense>
 
 #include <map>
+#include <random>
 #include <utility>
+#include <vector>
 
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
@@ -72,6 +74,38 @@ TEST(Primitives, BoxSurfaceAndTorus) {
   EXPECT_TRUE(closed_and_oriented(torus.F));
   const double exact = 2 * M_PI * M_PI * 2.0 * 0.25;
   EXPECT_NEAR(enclosed_volume(torus.V, torus.F), exact, 0.01 * exact);
+}
+
+// Brute force: a face of tet e is on the boundary iff no other tet has all
+// three of its vertices; faces listed by (tet, local face) as documented.
+TEST(Primitives, BoundaryFacesMatchBruteForceOnPerforatedBox) {
+  BoxMeshOptions o;
+  o.nx = 4;
+  o.ny = 3;
+  o.nz = 2;
+  const TetMesh full = make_box_tet_mesh(o);
+  std::mt19937 rng(0);
+  std::vector<int> kept;
+  for (int e = 0; e < full.T.rows(); ++e)
+    if (rng() % 3 != 0) kept.push_back(e);
+  MatX4i T(static_cast<Eigen::Index>(kept.size()), 4);
+  for (size_t i = 0; i < kept.size(); ++i) T.row(i) = full.T.row(kept[i]);
+  static constexpr int local[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  std::vector<Eigen::RowVector3i> expected;
+  for (int e = 0; e < T.rows(); ++e)
+    for (const auto& f : local) {
+      bool shared = false;
+      for (int g = 0; g < T.rows() && !shared; ++g) {
+        if (g == e) continue;
+        int hits = 0;
+        for (int k = 0; k < 3; ++k) hits += (T.row(g).array() == T(e, f[k])).any() ? 1 : 0;
+        shared = hits == 3;
+      }
+      if (!shared) expected.emplace_back(T(e, f[0]), T(e, f[1]), T(e, f[2]));
+    }
+  const MatX3i F = boundary_faces(T);
+  ASSERT_EQ(F.rows(), static_cast<Eigen::Index>(expected.size()));
+  for (Eigen::Index i = 0; i < F.rows(); ++i) EXPECT_EQ(F.row(i), expected[i]) << i;
 }
 
 TEST(Primitives, BadParametersThrow) {
