@@ -3,14 +3,18 @@
 // Run: build/experiments/tools/bench_mesh_io [--benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "icd/config.hpp"
+#include "mesh/io/primitives.hpp"
 #include "mesh/io/surface_reader.hpp"
 #include "mesh/io/vtk_writer.hpp"
 #include "mesh/io/vtu_reader.hpp"
@@ -80,6 +84,48 @@ void BM_VtuWriteRead(benchmark::State& state) {
   std::filesystem::remove(out);
 }
 
+// Baseline for boundary_faces: the first implementation, counting faces in a
+// std::map (the library now sorts face records).
+icd::MatX3i boundary_faces_map(const icd::MatX4i& T) {
+  static constexpr int faces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  std::map<std::array<int, 3>, int> count;
+  for (int e = 0; e < T.rows(); ++e)
+    for (const auto& f : faces) {
+      std::array<int, 3> key{T(e, f[0]), T(e, f[1]), T(e, f[2])};
+      std::sort(key.begin(), key.end());
+      ++count[key];
+    }
+  std::vector<std::array<int, 3>> out;
+  for (int e = 0; e < T.rows(); ++e)
+    for (const auto& f : faces) {
+      std::array<int, 3> key{T(e, f[0]), T(e, f[1]), T(e, f[2])};
+      std::sort(key.begin(), key.end());
+      if (count[key] == 1) out.push_back({T(e, f[0]), T(e, f[1]), T(e, f[2])});
+    }
+  icd::MatX3i F(static_cast<Eigen::Index>(out.size()), 3);
+  for (size_t i = 0; i < out.size(); ++i) F.row(i) << out[i][0], out[i][1], out[i][2];
+  return F;
+}
+
+icd::TetMesh bench_box() {
+  icd::BoxMeshOptions o;
+  o.nx = 25;
+  o.ny = 20;
+  o.nz = 20;  // 60,000 tets
+  return icd::make_box_tet_mesh(o);
+}
+
+void BM_BoundaryFaces_Sorted(benchmark::State& state) {
+  const icd::TetMesh m = bench_box();
+  for (auto _ : state) benchmark::DoNotOptimize(icd::boundary_faces(m.T).data());
+}
+
+void BM_BoundaryFaces_MapBaseline(benchmark::State& state) {
+  const icd::TetMesh m = bench_box();
+  if (boundary_faces_map(m.T) != icd::boundary_faces(m.T)) return state.SkipWithError("differ");
+  for (auto _ : state) benchmark::DoNotOptimize(boundary_faces_map(m.T).data());
+}
+
 BENCHMARK_CAPTURE(BM_ParseOff_Ours, bunny, "bunny00.off")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ParseOff_IostreamBaseline, bunny, "bunny00.off")
     ->Unit(benchmark::kMillisecond);
@@ -89,6 +135,8 @@ BENCHMARK_CAPTURE(BM_ParseOff_Ours, dragon, "ChineseDragon-10kv.off")
 BENCHMARK_CAPTURE(BM_ParseOff_IostreamBaseline, dragon, "ChineseDragon-10kv.off")
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VtuWriteRead)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BoundaryFaces_Sorted)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BoundaryFaces_MapBaseline)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
