@@ -10,124 +10,15 @@
 #include "mesh/io/detail/file_bytes.hpp"
 #include "mesh/io/detail/input_error.hpp"
 #include "mesh/io/detail/text_scan.hpp"
-#include "mesh/io/detail/xml_text.hpp"
+#include "mesh/io/detail/xml_scanner.hpp"
 #include "mesh/io/primitives.hpp"
 
 namespace icd {
 namespace {
 
+using detail::Tag;
 using detail::throw_input_error;
-
-// One XML tag: <name a="v" ...>, </name> or <name .../>.
-struct Tag {
-  std::string_view name;
-  bool closing = false;
-  bool self_closing = false;
-  std::vector<std::pair<std::string, std::string>> attributes;
-  size_t begin = 0;  // offset of '<'
-  size_t end = 0;    // offset after '>'
-
-  const std::string* find(std::string_view key) const {
-    for (const auto& [k, v] : attributes)
-      if (k == key) return &v;
-    return nullptr;
-  }
-};
-
-class XmlScanner {
- public:
-  XmlScanner(std::string_view text, std::string_view source) : m_text(text), m_source(source) {}
-
-  int64_t line_at(size_t offset) const {
-    return 1 +
-           std::count(m_text.begin(),
-                      m_text.begin() + static_cast<std::ptrdiff_t>(std::min(offset, m_text.size())),
-                      '\n');
-  }
-  [[noreturn]] void fail(size_t offset, const std::string& what) const {
-    throw_input_error(m_source, line_at(offset), what);
-  }
-
-  // The next element tag at or after m_pos; skips declarations, comments and
-  // text. False at the end of the text.
-  bool next(Tag& tag) {
-    while (true) {
-      const size_t lt = m_text.find('<', m_pos);
-      if (lt == std::string_view::npos) return false;
-      if (m_text.compare(lt, 4, "<!--") == 0) {
-        const size_t e = m_text.find("-->", lt + 4);
-        if (e == std::string_view::npos) fail(lt, "unterminated XML comment");
-        m_pos = e + 3;
-        continue;
-      }
-      if (m_text.compare(lt, 2, "<?") == 0 || m_text.compare(lt, 2, "<!") == 0) {
-        const size_t e = m_text.find('>', lt);
-        if (e == std::string_view::npos) fail(lt, "unterminated XML declaration");
-        m_pos = e + 1;
-        continue;
-      }
-      parse_tag(lt, tag);
-      m_pos = tag.end;
-      return true;
-    }
-  }
-  size_t position() const { return m_pos; }
-  void seek(size_t pos) { m_pos = pos; }
-  std::string_view text() const { return m_text; }
-
- private:
-  void parse_tag(size_t lt, Tag& tag) {
-    tag = Tag{};
-    tag.begin = lt;
-    size_t p = lt + 1;
-    const auto at_end = [&] { return p >= m_text.size(); };
-    if (!at_end() && m_text[p] == '/') {
-      tag.closing = true;
-      ++p;
-    }
-    const size_t name_start = p;
-    while (!at_end() && !detail::is_space(m_text[p]) && m_text[p] != '>' && m_text[p] != '/') ++p;
-    tag.name = m_text.substr(name_start, p - name_start);
-    if (tag.name.empty()) fail(lt, "malformed XML tag");
-    while (true) {
-      while (!at_end() && detail::is_space(m_text[p])) ++p;
-      if (at_end()) fail(lt, "unterminated XML tag <" + std::string(tag.name) + ">");
-      if (m_text[p] == '>') {
-        tag.end = p + 1;
-        return;
-      }
-      if (m_text[p] == '/') {
-        if (p + 1 >= m_text.size() || m_text[p + 1] != '>')
-          fail(p, "malformed XML tag <" + std::string(tag.name) + ">");
-        tag.self_closing = true;
-        tag.end = p + 2;
-        return;
-      }
-      const size_t key_start = p;
-      while (!at_end() && m_text[p] != '=' && !detail::is_space(m_text[p]) && m_text[p] != '>') ++p;
-      const std::string key(m_text.substr(key_start, p - key_start));
-      while (!at_end() && detail::is_space(m_text[p])) ++p;
-      if (at_end() || m_text[p] != '=')
-        fail(p, "attribute '" + key + "' of <" + std::string(tag.name) + "> has no value");
-      ++p;
-      while (!at_end() && detail::is_space(m_text[p])) ++p;
-      if (at_end() || (m_text[p] != '"' && m_text[p] != '\''))
-        fail(p, "attribute '" + key + "' value is not quoted");
-      const char q = m_text[p++];
-      const size_t close = m_text.find(q, p);
-      if (close == std::string_view::npos) fail(p, "unterminated attribute '" + key + "'");
-      std::string value;
-      if (!detail::xml_unescape(m_text.substr(p, close - p), value))
-        fail(p, "attribute '" + key + "' has a malformed XML entity");
-      tag.attributes.emplace_back(key, std::move(value));
-      p = close + 1;
-    }
-  }
-
-  std::string_view m_text;
-  std::string_view m_source;
-  size_t m_pos = 0;
-};
+using detail::XmlScanner;
 
 int64_t int_attribute(const XmlScanner& xml, const Tag& tag, std::string_view key) {
   const std::string* v = tag.find(key);
