@@ -4,8 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "fem/constitutive.hpp"
+#include "fem/element_kernels.hpp"
 #include "fem/polar.hpp"
 #include "mesh/io/error.hpp"
 
@@ -227,7 +229,68 @@ double ElasticForces::compute_impl(const Eigen::Ref<const MatX3d>& x, Eigen::Ref
 }
 
 void ElasticForces::compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
-  compute_impl<false>(x, f);
+  check_shape(x, "positions");
+  check_shape(f, "forces");
+  if (x.outerStride() != 3 || f.outerStride() != 3) {
+    compute_impl<false>(x, f);
+    return;
+  }
+  // The hot path: scalar kernels (element_kernels.hpp), one instantiation per model.
+  const double* xp = x.data();
+  const int* T = m_mesh.tets.data();
+  const double* dinv = m_mesh.dm_inv.data()->data();
+  const double* vol = m_mesh.rest_volume.data();
+  const bool direct = m_options.num_threads == 1;
+  double* fp = f.data();
+  double* buf = m_element_forces.data();
+  const double mu = m_mu, lambda = m_lambda;
+  Eigen::Quaterniond* rot = m_rotations.data();
+  const int max_it = m_options.polar_max_iterations;
+  const double tol = m_options.polar_tolerance;
+  auto run = [&](auto model_tag) {
+    constexpr MaterialModel kModel = decltype(model_tag)::value;
+    for_chunks([&](int begin, int end) {
+      for (int e = begin; e < end; ++e) {
+        const int* t = T + 4 * e;
+        const double* D = dinv + 9 * static_cast<size_t>(e);
+        double F[9], P[9], H[9];
+        kernels::deformation_gradient(xp + 3 * t[0], xp + 3 * t[1], xp + 3 * t[2], xp + 3 * t[3], D, F);
+        if constexpr (kModel == MaterialModel::Linear) kernels::linear_stress(F, mu, lambda, P);
+        else if constexpr (kModel == MaterialModel::StVK) kernels::stvk_stress(F, mu, lambda, P);
+        else if constexpr (kModel == MaterialModel::StableNeoHookean)
+          kernels::stable_neo_hookean_stress(F, mu, lambda, P);
+        else kernels::corotational_stress(F, mu, lambda, rot[e], max_it, tol, P);
+        kernels::nodal_forces(P, D, vol[e], H);
+        double* out;
+        double local[12];
+        out = direct ? local : buf + 12 * static_cast<size_t>(e);
+        for (int r = 0; r < 3; ++r) {
+          out[3 + r] = H[3 * r];
+          out[6 + r] = H[3 * r + 1];
+          out[9 + r] = H[3 * r + 2];
+          out[r] = -(H[3 * r] + H[3 * r + 1] + H[3 * r + 2]);
+        }
+        if (direct)
+          for (int a = 0; a < 4; ++a) {
+            double* fa = fp + 3 * t[a];
+            fa[0] += local[3 * a];
+            fa[1] += local[3 * a + 1];
+            fa[2] += local[3 * a + 2];
+          }
+      }
+      return 0.0;
+    });
+  };
+  if (direct) f.setZero();
+  switch (m_material.model) {
+    case MaterialModel::Linear: run(std::integral_constant<MaterialModel, MaterialModel::Linear>{}); break;
+    case MaterialModel::Corotational: run(std::integral_constant<MaterialModel, MaterialModel::Corotational>{}); break;
+    case MaterialModel::StVK: run(std::integral_constant<MaterialModel, MaterialModel::StVK>{}); break;
+    case MaterialModel::StableNeoHookean:
+      run(std::integral_constant<MaterialModel, MaterialModel::StableNeoHookean>{});
+      break;
+  }
+  if (!direct) gather(fp);
 }
 
 double ElasticForces::compute_with_energy(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
@@ -240,28 +303,40 @@ ElementHealth ElasticForces::health(const Eigen::Ref<const MatX3d>& x) {
   check_shape(x, "positions");
   const double* xp = x.data();
   const long xs = x.outerStride();
+  const int* T = m_mesh.tets.data();
+  const double* dinv = m_mesh.dm_inv.data()->data();
   ElementHealth h;
   h.min_det_f = std::numeric_limits<double>::infinity();
-  auto run = [&](const auto& ev) {
-    // Sequential: the energy sum order is the chunked order of the force loop.
-    for (int c = 0; c * kChunk < m_mesh.num_tets(); ++c) {
-      double sum = 0;
-      for (int e = c * kChunk; e < std::min(m_mesh.num_tets(), (c + 1) * kChunk); ++e) {
-        const Matrix3d F = edge_matrix(xp, xs, m_mesh.tets.data() + 4 * e) * m_mesh.dm_inv[e];
-        const double J = F.determinant();
-        if (J < h.min_det_f || (std::isnan(J) && h.min_det_f_element < 0)) {
-          h.min_det_f = J;
-          h.min_det_f_element = e;
-        }
-        const double w = m_mesh.rest_volume[e] * ev.energy(e, F);
-        if (!std::isfinite(w) && h.first_nonfinite_element < 0) h.first_nonfinite_element = e;
-        sum += w;
+  const CorotationalEval corot{{m_mu, m_lambda}, m_rotations.data(), m_options.polar_max_iterations,
+                               m_options.polar_tolerance};
+  // Sequential; energies summed per chunk in the chunk order of the force loop.
+  for (int c = 0; c * kChunk < m_mesh.num_tets(); ++c) {
+    double sum = 0;
+    for (int e = c * kChunk; e < std::min(m_mesh.num_tets(), (c + 1) * kChunk); ++e) {
+      const int* t = T + 4 * e;
+      double F[9];
+      kernels::deformation_gradient(xp + xs * t[0], xp + xs * t[1], xp + xs * t[2], xp + xs * t[3],
+                                    dinv + 9 * static_cast<size_t>(e), F);
+      const double J = kernels::determinant(F);
+      if (J < h.min_det_f || (std::isnan(J) && h.min_det_f_element < 0)) {
+        h.min_det_f = J;
+        h.min_det_f_element = e;
       }
-      h.energy += sum;
+      double psi = 0;
+      switch (m_material.model) {
+        case MaterialModel::Linear: psi = kernels::linear_energy(F, m_mu, m_lambda); break;
+        case MaterialModel::StVK: psi = kernels::stvk_energy(F, m_mu, m_lambda); break;
+        case MaterialModel::StableNeoHookean: psi = kernels::stable_neo_hookean_energy(F, J, m_mu, m_lambda); break;
+        case MaterialModel::Corotational:
+          psi = corot.energy(e, Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(F));
+          break;
+      }
+      const double w = m_mesh.rest_volume[e] * psi;
+      if (!std::isfinite(w) && h.first_nonfinite_element < 0) h.first_nonfinite_element = e;
+      sum += w;
     }
-    return 0.0;
-  };
-  [&]() -> double { ICD_FEM_DISPATCH(run) }();
+    h.energy += sum;
+  }
   return h;
 }
 

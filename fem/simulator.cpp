@@ -1,5 +1,6 @@
 #include "fem/simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -18,6 +19,8 @@ Simulator::Simulator(Model model, const SimulatorOptions& options)
   if (!(options.safety_factor > 0 && options.safety_factor <= 1)) bad("safety_factor", options.safety_factor, "(0, 1]");
   if (!(options.fixed_step >= 0) || !std::isfinite(options.fixed_step)) bad("fixed_step", options.fixed_step, ">= 0 s");
   if (!(options.max_step > 0) || !std::isfinite(options.max_step)) bad("max_step", options.max_step, "> 0 s");
+  if (options.frequency_refresh_iterations < 1)
+    bad("frequency_refresh_iterations", options.frequency_refresh_iterations, ">= 1");
   if (options.check_interval < 1) bad("check_interval", options.check_interval, ">= 1");
   if (!(options.max_energy_growth > 0)) bad("max_energy_growth", options.max_energy_growth, "> 0");
   if (options.max_retries < 0) bad("max_retries", options.max_retries, ">= 0");
@@ -50,7 +53,10 @@ double Simulator::stable_step_limit() {
   // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time).
   const bool fresh = m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
   if (fresh) return m_cached_limit;
-  m_frequency = estimate_max_frequency(m_model, m_state.x, m_options.frequency, &m_warm_mode);
+  FrequencyOptions fo = m_options.frequency;
+  if (m_warm_mode.size() == 3 * m_model.num_nodes())
+    fo.max_iterations = std::min(fo.max_iterations, m_options.frequency_refresh_iterations);
+  m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode);
   m_estimate_time = m_time;
   m_cached_limit = m_frequency.omega_max <= 0  // all fixed
                        ? std::numeric_limits<double>::infinity()

@@ -28,6 +28,9 @@ struct SimulatorOptions {
   /// Largest step (s), also the backward Euler step when fixed_step is 0.
   double max_step = 1e-2;
   FrequencyOptions frequency;  ///< includes the added contact stiffness
+  /// Lanczos iterations of the per-frame re-estimate once a previous Ritz
+  /// vector exists (warm start; the first estimate uses frequency.max_iterations).
+  int frequency_refresh_iterations = 8;
   /// Reuse the last largest-eigenfrequency estimate for calls of advance() /
   /// step() within this much simulated time (s, >= 0; 0 = estimate at every
   /// call). For callers that advance in many short pieces (the runner's

@@ -1,0 +1,121 @@
+#pragma once
+/// Scalar, fully inlined per-element kernels of the explicit force loop: the
+/// same laws as constitutive.hpp written on plain 3x3 arrays (row-major,
+/// a[3 r + c]) so that the compiler keeps everything in registers. The Eigen
+/// versions in constitutive.hpp remain the reference (tangents, stiffness),
+/// and the tests compare both through finite differences.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "fem/polar.hpp"
+
+#if defined(__GNUC__)
+#define ICD_FEM_INLINE inline __attribute__((always_inline))
+#else
+#define ICD_FEM_INLINE inline
+#endif
+
+namespace icd::fem::kernels {
+
+/// F = Ds Dm^-1 from the four node positions p0..p3 and Dm^-1 stored column-major (Eigen).
+ICD_FEM_INLINE void deformation_gradient(const double* p0, const double* p1, const double* p2, const double* p3,
+                                         const double* dinv, double* F) {
+  const double d[9] = {p1[0] - p0[0], p2[0] - p0[0], p3[0] - p0[0], p1[1] - p0[1], p2[1] - p0[1],
+                       p3[1] - p0[1], p1[2] - p0[2], p2[2] - p0[2], p3[2] - p0[2]};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      F[3 * r + c] = d[3 * r] * dinv[3 * c] + d[3 * r + 1] * dinv[1 + 3 * c] + d[3 * r + 2] * dinv[2 + 3 * c];
+}
+
+/// H = -V P Dm^-T (row-major), the nodal forces of nodes 1..3 are its columns.
+ICD_FEM_INLINE void nodal_forces(const double* P, const double* dinv, double volume, double* H) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      H[3 * r + c] = -volume * (P[3 * r] * dinv[c] + P[3 * r + 1] * dinv[c + 3] + P[3 * r + 2] * dinv[c + 6]);
+}
+
+ICD_FEM_INLINE void linear_stress(const double* F, double mu, double lambda, double* P) {
+  const double t = lambda * (F[0] + F[4] + F[8] - 3.0) - 2.0 * mu;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) P[3 * r + c] = mu * (F[3 * r + c] + F[3 * c + r]);
+  P[0] += t;
+  P[4] += t;
+  P[8] += t;
+}
+
+ICD_FEM_INLINE void stvk_stress(const double* F, double mu, double lambda, double* P) {
+  double E[9];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) E[3 * r + c] = 0.5 * (F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c]);
+  E[0] -= 0.5;
+  E[4] -= 0.5;
+  E[8] -= 0.5;
+  const double t = lambda * (E[0] + E[4] + E[8]);
+  double S[9];
+  for (int k = 0; k < 9; ++k) S[k] = 2.0 * mu * E[k];
+  S[0] += t;
+  S[4] += t;
+  S[8] += t;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      P[3 * r + c] = F[3 * r] * S[c] + F[3 * r + 1] * S[3 + c] + F[3 * r + 2] * S[6 + c];
+}
+
+ICD_FEM_INLINE void stable_neo_hookean_stress(const double* F, double mu, double lambda, double* P) {
+  // Cofactor: columns f1 x f2, f2 x f0, f0 x f1 of F's columns f0, f1, f2.
+  const double C[9] = {F[4] * F[8] - F[7] * F[5], F[5] * F[6] - F[8] * F[3], F[3] * F[7] - F[6] * F[4],
+                       F[7] * F[2] - F[1] * F[8], F[8] * F[0] - F[2] * F[6], F[6] * F[1] - F[0] * F[7],
+                       F[1] * F[5] - F[4] * F[2], F[2] * F[3] - F[5] * F[0], F[0] * F[4] - F[3] * F[1]};
+  const double J = F[0] * C[0] + F[3] * C[3] + F[6] * C[6];
+  const double s = (lambda + mu) * (J - 1.0) - mu;
+  for (int k = 0; k < 9; ++k) P[k] = mu * F[k] + s * C[k];
+}
+
+/// Corotational: R from the warm-started polar iteration (q in/out).
+ICD_FEM_INLINE void corotational_stress(const double* F, double mu, double lambda, Eigen::Quaterniond& q,
+                                        int max_iterations, double tolerance, double* P) {
+  const Eigen::Matrix3d Fm = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(F);
+  polar_rotation(Fm, q, max_iterations, tolerance);
+  const Eigen::Matrix3d R = q.toRotationMatrix();
+  double tr = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) tr += R(r, c) * F[3 * r + c];
+  const double t = lambda * (tr - 3.0);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) P[3 * r + c] = 2.0 * mu * (F[3 * r + c] - R(r, c)) + t * R(r, c);
+}
+
+ICD_FEM_INLINE double determinant(const double* F) {
+  return F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+         F[2] * (F[3] * F[7] - F[4] * F[6]);
+}
+
+ICD_FEM_INLINE double linear_energy(const double* F, double mu, double lambda) {
+  double sq = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      const double e = 0.5 * (F[3 * r + c] + F[3 * c + r]) - (r == c ? 1.0 : 0.0);
+      sq += e * e;
+    }
+  const double tr = F[0] + F[4] + F[8] - 3.0;
+  return mu * sq + 0.5 * lambda * tr * tr;
+}
+
+ICD_FEM_INLINE double stvk_energy(const double* F, double mu, double lambda) {
+  double sq = 0, tr = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      const double e = 0.5 * (F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c]) - (r == c ? 0.5 : 0.0);
+      sq += e * e;
+      if (r == c) tr += e;
+    }
+  return mu * sq + 0.5 * lambda * tr * tr;
+}
+
+ICD_FEM_INLINE double stable_neo_hookean_energy(const double* F, double J, double mu, double lambda) {
+  double ic = 0;
+  for (int k = 0; k < 9; ++k) ic += F[k] * F[k];
+  return 0.5 * mu * (ic - 3.0) - mu * (J - 1.0) + 0.5 * (lambda + mu) * (J - 1.0) * (J - 1.0);
+}
+
+}  // namespace icd::fem::kernels
