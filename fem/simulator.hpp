@@ -36,7 +36,10 @@ struct SimulatorOptions {
   /// call). For callers that advance in many short pieces (the runner's
   /// detection/response cycles); the health checks still guard every step.
   double frequency_reuse_time = 0;
-  int check_interval = 1;      ///< sub-steps between health checks (>= 1)
+  /// Sub-steps between health checks (>= 1). A check costs about one force
+  /// evaluation; a blow-up is caught at most this many steps late and rolled
+  /// back to the last checked state.
+  int check_interval = 4;
   /// A check fails when KE + W grows by more than this fraction of
   /// (KE + W + |work of the loads|) since the last check (explicit blow-up).
   double max_energy_growth = 1.0;
