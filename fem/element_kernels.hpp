@@ -4,10 +4,11 @@
 /// a[3 r + c]) so that the compiler keeps everything in registers. The Eigen
 /// versions in constitutive.hpp remain the reference (tangents, stiffness),
 /// and the tests compare both through finite differences.
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "fem/polar.hpp"
 
 #if defined(__GNUC__)
 #define ICD_FEM_INLINE inline __attribute__((always_inline))
@@ -71,18 +72,80 @@ ICD_FEM_INLINE void stable_neo_hookean_stress(const double* F, double mu, double
   for (int k = 0; k < 9; ++k) P[k] = mu * F[k] + s * C[k];
 }
 
+/// Rotation matrix (row-major) of the unit quaternion (w, x, y, z).
+ICD_FEM_INLINE void quaternion_matrix(double w, double x, double y, double z, double* R) {
+  R[0] = 1 - 2 * (y * y + z * z);
+  R[1] = 2 * (x * y - w * z);
+  R[2] = 2 * (x * z + w * y);
+  R[3] = 2 * (x * y + w * z);
+  R[4] = 1 - 2 * (x * x + z * z);
+  R[5] = 2 * (y * z - w * x);
+  R[6] = 2 * (x * z - w * y);
+  R[7] = 2 * (y * z + w * x);
+  R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/// Scalar version of polar_rotation() (fem/polar.hpp), same iteration and
+/// exit rule: q (in/out, warm start) and R (out, row-major) of F.
+ICD_FEM_INLINE void polar_rotation(const double* F, Eigen::Quaterniond& q, int max_iterations, double tolerance,
+                                   double* R) {
+  double qw = q.w(), qx = q.x(), qy = q.y(), qz = q.z();
+  bool fresh = false;
+  for (int it = 0; it < max_iterations; ++it) {
+    quaternion_matrix(qw, qx, qy, qz, R);
+    fresh = true;
+    double A[9];  // R^T F
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) A[3 * r + c] = R[r] * F[c] + R[3 + r] * F[3 + c] + R[6 + r] * F[6 + c];
+    const double a0 = A[7] - A[5], a1 = A[2] - A[6], a2 = A[3] - A[1];
+    const double tr = A[0] + A[4] + A[8];
+    // N = tr(S) I - S, S = sym(A).
+    const double n00 = tr - A[0], n11 = tr - A[4], n22 = tr - A[8];
+    const double n01 = -0.5 * (A[1] + A[3]), n02 = -0.5 * (A[2] + A[6]), n12 = -0.5 * (A[5] + A[7]);
+    const double c00 = n11 * n22 - n12 * n12, c01 = n02 * n12 - n01 * n22, c02 = n01 * n12 - n02 * n11;
+    const double c11 = n00 * n22 - n02 * n02, c12 = n01 * n02 - n00 * n12, c22 = n00 * n11 - n01 * n01;
+    const double det = n00 * c00 + n01 * c01 + n02 * c02;
+    const double scale = std::abs(tr) + 1e-300;
+    double w0, w1, w2;
+    if (n00 > 1e-8 * scale && c22 > 1e-8 * scale * scale && det > 1e-8 * scale * scale * scale) {
+      const double inv = 1.0 / det;
+      w0 = inv * (c00 * a0 + c01 * a1 + c02 * a2);
+      w1 = inv * (c01 * a0 + c11 * a1 + c12 * a2);
+      w2 = inv * (c02 * a0 + c12 * a1 + c22 * a2);
+    } else {
+      const double inv = 1.0 / (scale + 1e-9);
+      w0 = a0 * inv;
+      w1 = a1 * inv;
+      w2 = a2 * inv;
+    }
+    const double angle2 = w0 * w0 + w1 * w1 + w2 * w2;
+    if (!(angle2 > tolerance * tolerance)) break;  // also exits on NaN
+    // q <- normalize(q * (1, w/2)).
+    const double ux = 0.5 * w0, uy = 0.5 * w1, uz = 0.5 * w2;
+    const double nw = qw - (qx * ux + qy * uy + qz * uz);
+    const double nx = qw * ux + qx + (qy * uz - qz * uy);
+    const double ny = qw * uy + qy + (qz * ux - qx * uz);
+    const double nz = qw * uz + qz + (qx * uy - qy * ux);
+    const double norm = 1.0 / std::sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
+    qw = nw * norm;
+    qx = nx * norm;
+    qy = ny * norm;
+    qz = nz * norm;
+    fresh = false;
+  }
+  if (!fresh) quaternion_matrix(qw, qx, qy, qz, R);
+  q = Eigen::Quaterniond(qw, qx, qy, qz);
+}
+
 /// Corotational: R from the warm-started polar iteration (q in/out).
 ICD_FEM_INLINE void corotational_stress(const double* F, double mu, double lambda, Eigen::Quaterniond& q,
                                         int max_iterations, double tolerance, double* P) {
-  const Eigen::Matrix3d Fm = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(F);
-  polar_rotation(Fm, q, max_iterations, tolerance);
-  const Eigen::Matrix3d R = q.toRotationMatrix();
+  double R[9];
+  polar_rotation(F, q, max_iterations, tolerance, R);
   double tr = 0;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) tr += R(r, c) * F[3 * r + c];
+  for (int k = 0; k < 9; ++k) tr += R[k] * F[k];
   const double t = lambda * (tr - 3.0);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) P[3 * r + c] = 2.0 * mu * (F[3 * r + c] - R(r, c)) + t * R(r, c);
+  for (int k = 0; k < 9; ++k) P[k] = 2.0 * mu * (F[k] - R[k]) + t * R[k];
 }
 
 ICD_FEM_INLINE double determinant(const double* F) {
