@@ -9,6 +9,6 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build/release"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DICD_BUILD_TESTS=OFF -DICD_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build "$build" -j2 --target icd-main
+cmake --build "$build" -j2 --target icd-main icd-preprocess
 results="$root/results/main"
 "$build/bin/icd-main" --out "$results" "$@"

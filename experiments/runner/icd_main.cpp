@@ -1,36 +1,48 @@
-// icd-main: the project's main job (README command 1).
-// Stage reached so far: load the paper's two real meshes and report their
-// statistics. It becomes the default bunny-dragon scene once the runner exists.
+// icd-main: the project's main job (README command 1): the default
+// bunny-dragon scene of the paper (experiments/scenes/bunny_dragon.json),
+// preprocessing the real meshes on first use.
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <sstream>
 #include <string>
-#include <vector>
 
+#include "experiments/runner/run.hpp"
 #include "icd/config.hpp"
-#include "mesh/io/atomic_write.hpp"
-#include "mesh/io/mesh_stats.hpp"
-#include "mesh/io/surface_reader.hpp"
 
 namespace {
 
 void usage() {
   std::printf(
-      "usage: icd-main [--out DIR] [--data DIR]\n"
-      "  --out DIR   results folder (default: results/main)\n"
-      "  --data DIR  folder with bunny00.off and ChineseDragon-10kv.off (default: %s)\n",
-      ICD_DATA_DIR);
+      "usage: icd-main [--out DIR] [--scene FILE] [--frames N]\n"
+      "  --out DIR     results folder (default: results/main)\n"
+      "  --scene FILE  scene to run (default: %s/experiments/scenes/bunny_dragon.json)\n"
+      "  --frames N    override the scene's frame count\n",
+      ICD_SOURCE_DIR);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::filesystem::path out = "results/main", data = ICD_DATA_DIR;
+  std::filesystem::path out = "results/main";
+  std::filesystem::path scene_path =
+      std::filesystem::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
+  int frames = -1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if ((a == "--out" || a == "--data") && i + 1 < argc) {
-      (a == "--out" ? out : data) = argv[++i];
+    if (a == "--out" && i + 1 < argc) {
+      out = argv[++i];
+    } else if (a == "--scene" && i + 1 < argc) {
+      scene_path = argv[++i];
+    } else if (a == "--frames" && i + 1 < argc) {
+      try {
+        frames = std::stoi(argv[++i]);
+      } catch (const std::exception&) {
+        frames = -2;
+      }
+      if (frames < 0) {
+        std::fprintf(stderr, "icd-main: --frames: expected a non-negative integer\n");
+        return 2;
+      }
     } else if (a == "--help" || a == "-h") {
       usage();
       return 0;
@@ -41,30 +53,18 @@ int main(int argc, char** argv) {
     }
   }
   try {
-    std::ostringstream csv;
-    csv << "mesh,vertices,faces,edges,area,volume,boundary_edges,nonmanifold_edges,"
-           "duplicate_vertices,degenerate_faces,components,euler_characteristic,"
-           "bbox_x,bbox_y,bbox_z\n";
-    std::printf("%-24s %8s %8s %9s %9s %6s %6s\n", "mesh", "verts", "faces", "bnd.edges",
-                "nonmanif", "comps", "chi");
-    for (const char* name : {"bunny00.off", "ChineseDragon-10kv.off"}) {
-      const auto path = data / name;
-      const icd::SurfaceMesh m = icd::read_surface_mesh(path);
-      const icd::SurfaceStats s = icd::compute_surface_stats(m);
-      const Eigen::Vector3d ext = s.bbox_max - s.bbox_min;
-      std::printf("%-24s %8lld %8lld %9lld %9lld %6lld %6lld\n", name,
-                  static_cast<long long>(s.vertices), static_cast<long long>(s.faces),
-                  static_cast<long long>(s.boundary_edges),
-                  static_cast<long long>(s.nonmanifold_edges), static_cast<long long>(s.components),
-                  static_cast<long long>(s.euler_characteristic));
-      csv << name << ',' << s.vertices << ',' << s.faces << ',' << s.edges << ',' << s.area << ','
-          << s.volume << ',' << s.boundary_edges << ',' << s.nonmanifold_edges << ','
-          << s.duplicate_vertices << ',' << s.degenerate_faces << ',' << s.components << ','
-          << s.euler_characteristic << ',' << ext.x() << ',' << ext.y() << ',' << ext.z() << '\n';
-    }
-    std::filesystem::create_directories(out);
-    icd::write_file_atomically(out / "mesh_stats.csv", csv.str());
-    std::printf("results: %s\n", std::filesystem::absolute(out / "mesh_stats.csv").c_str());
+    const icd::runner::Scene scene = icd::runner::load_scene(scene_path);
+    std::printf("scene \"%s\" (%s)\n", scene.name.c_str(), scene_path.c_str());
+    for (const std::string& line : icd::runner::make_plan(scene).describe(scene))
+      std::printf("  %s\n", line.c_str());
+    icd::runner::RunOptions opt;
+    opt.out_dir = out;
+    opt.cache_dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
+    opt.tool_dir = std::filesystem::canonical("/proc/self/exe").parent_path();
+    opt.frames = frames;
+    icd::runner::run_scene(scene, opt);
+    std::printf("results: %s (frames.csv; vtu/*.pvd for ParaView)\n",
+                std::filesystem::absolute(out).c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "icd-main: %s\n", e.what());
     return 1;

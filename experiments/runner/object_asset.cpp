@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <numbers>
 #include <vector>
@@ -45,20 +48,25 @@ Eigen::VectorXi surface_nodes_of(const TetMesh& m) {
   return Eigen::Map<Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size()));
 }
 
-void finish_asset(ObjectAsset& a, int levels) {
-  a.surface_nodes = surface_nodes_of(a.coarse);
-  a.links = coupling::build_rigid_links(a.dense.V, a.coarse.V, a.surface_nodes);
+// Octree sphere tree (CGAL-free) tied to the nearest coarse surface nodes.
+void build_octree_spheres(ObjectAsset& a, int depth) {
   collision::OctreeTreeOptions to;
-  to.levels = levels;
-  a.tree = collision::build_octree_tree(a.dense.V, a.dense.F, to);
+  to.levels = depth + 1;
+  a.spheres = collision::build_octree_tree(a.dense.V, a.dense.F, to);
   std::vector<int> candidates(a.surface_nodes.data(),
                               a.surface_nodes.data() + a.surface_nodes.size());
-  collision::associate_nearest_nodes(a.tree, a.coarse.V, {}, candidates);
+  collision::associate_nearest_nodes(a.spheres, a.coarse.V, {}, candidates);
+}
+
+void finish_asset(ObjectAsset& a, int depth) {
+  a.surface_nodes = surface_nodes_of(a.coarse);
+  a.links = coupling::build_rigid_links(a.dense.V, a.coarse.V, a.surface_nodes);
+  build_octree_spheres(a, depth);
 }
 
 }  // namespace
 
-ObjectAsset make_primitive_asset(const PrimitiveSpec& spec, int levels) {
+ObjectAsset make_primitive_asset(const PrimitiveSpec& spec, int depth) {
   ObjectAsset a;
   if (spec.type == "box") {
     const Eigen::Vector3d half = spec.extent / 2;
@@ -118,7 +126,7 @@ ObjectAsset make_primitive_asset(const PrimitiveSpec& spec, int levels) {
     if (keep.empty()) throw ParameterError("primitive sphere: too few cells for a coarse mesh");
     a.coarse = compact(grid.V, keep);
   }
-  finish_asset(a, levels);
+  finish_asset(a, depth);
   return a;
 }
 
@@ -141,22 +149,64 @@ void place_object(ObjectAsset& a, const ObjectSpec& spec) {
   // Links store coefficients in the local frame of their three nodes: a
   // rotation and translation leave them unchanged, a scale multiplies them.
   a.links.coeffs *= s;
-  for (auto* spheres : {&a.tree.spheres, &a.tree.rest_spheres})
+  for (auto* spheres : {&a.spheres.spheres, &a.spheres.rest_spheres})
     for (collision::Sphere& sp : *spheres) {
       const Eigen::Vector3d c =
           R * ((sp.center() - centre.transpose()) * s) + spec.position;
       sp = {c.x(), c.y(), c.z(), sp.r * s};
     }
-  for (double& d : a.tree.assoc_rest_dist) d *= s;
+  for (double& d : a.spheres.assoc_rest_dist) d *= s;
 }
 
 ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::path& cache_dir,
                               const std::filesystem::path& tool_dir) {
-  (void)cache_dir;
-  (void)tool_dir;
-  if (spec.primitive) return make_primitive_asset(*spec.primitive, spec.preprocess.tree_levels);
-  throw InputError("object \"" + spec.name +
-                   "\": loading asset bundles and raw meshes is not available yet");
+  const PreprocessSpec& pre = spec.preprocess;
+  if (spec.primitive) return make_primitive_asset(*spec.primitive, pre.tree_depth);
+  if (!spec.asset.empty()) return coupling::read_asset_bundle(spec.asset);
+
+  // A raw mesh: preprocess it into the cache on first use. The cache folder is
+  // named by a hash of the file's bytes and the options, so any change to
+  // either makes a new bundle.
+  std::ifstream in(spec.mesh, std::ios::binary);
+  if (!in) throw InputError("object \"" + spec.name + "\": cannot open mesh " + spec.mesh.string());
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  const bool octree = pre.tree_builder == "octree";
+  std::ostringstream args;
+  args << " --coarse-tets " << pre.coarse_tets << " --sphere-depth " << pre.tree_depth
+       << " --sphere-branching " << pre.tree_branching << (octree ? " --no-spheres" : "");
+  const std::string key = bytes.str() + args.str();
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx",
+                static_cast<unsigned long long>(coupling::fnv1a64(key.data(), key.size())));
+  const std::filesystem::path folder =
+      cache_dir / (spec.mesh.stem().string() + "-" + hash);
+  if (!std::filesystem::exists(folder / coupling::kBundleDataFile)) {
+    const std::filesystem::path tool = tool_dir / "icd-preprocess";
+    if (!std::filesystem::exists(tool))
+      throw InputError("object \"" + spec.name + "\": " + spec.mesh.string() +
+                       " needs preprocessing but " + tool.string() +
+                       " is missing (build the icd-preprocess target)");
+    const std::filesystem::path tmp = folder.string() + ".part";
+    std::filesystem::remove_all(tmp);
+    std::filesystem::create_directories(cache_dir);
+    std::fprintf(stderr, "[icd] preprocessing %s (first use, cached in %s)\n",
+                 spec.mesh.c_str(), folder.c_str());
+    std::ostringstream command;  // (a stream: GCC 12 warns falsely on long string sums)
+    command << '"' << tool.string() << "\" \"" << spec.mesh.string() << "\" -o \"" << tmp.string()
+            << "\" -q" << args.str();
+    const std::string cmd = command.str();
+    if (std::system(cmd.c_str()) != 0) {
+      std::filesystem::remove_all(tmp);
+      throw InputError("object \"" + spec.name + "\": preprocessing " + spec.mesh.string() +
+                       " failed (command: " + cmd + ")");
+    }
+    std::filesystem::remove_all(folder);
+    std::filesystem::rename(tmp, folder);
+  }
+  ObjectAsset a = coupling::read_asset_bundle(folder);
+  if (octree) build_octree_spheres(a, pre.tree_depth);
+  return a;
 }
 
 }  // namespace icd::runner

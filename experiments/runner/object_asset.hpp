@@ -5,26 +5,21 @@
 /// bundle (preprocessing a raw mesh into the cache on first use).
 #include <filesystem>
 
-#include "collision/sphere_tree.hpp"
-#include "coupling/rigid_links.hpp"
+#include "coupling/asset_bundle.hpp"
 #include "experiments/runner/scene.hpp"
 #include "mesh/io/types.hpp"
 
 namespace icd::runner {
 
-/// One object's data, in the scene's units (metres) once placed.
-struct ObjectAsset {
-  SurfaceMesh dense;            ///< the rendered / contact surface
-  TetMesh coarse;               ///< the reduced model (rest positions)
-  Eigen::VectorXi surface_nodes;  ///< coarse nodes on the coarse surface (reduced coordinates Q)
-  coupling::RigidLinks links;   ///< dense vertex -> three coarse surface nodes
-  collision::SphereTree tree;   ///< wrapped sphere tree with node association
-};
+/// One object's data, in the scene's units (metres) once placed: the same
+/// structure the asset bundles hold (dense surface, coarse mesh, reduced
+/// coordinates Q, rigid links, sphere tree with its node association).
+using ObjectAsset = coupling::AssetBundle;
 
 /// Builds a primitive object: a dense icosphere (or box surface) over a
 /// structured coarse tet mesh (for a sphere: the cells of a grid inside the
-/// ball), octree sphere tree with `levels` levels, links and association.
-ObjectAsset make_primitive_asset(const PrimitiveSpec& spec, int levels);
+/// ball), octree sphere tree `depth` levels below the root, links and association.
+ObjectAsset make_primitive_asset(const PrimitiveSpec& spec, int depth);
 
 /// Loads the asset of an object spec: generated primitive, bundle folder, or
 /// raw mesh preprocessed into `cache_dir` by the icd-preprocess tool found in

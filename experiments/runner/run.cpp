@@ -42,7 +42,7 @@ void write_frame_vtu(World& world, int frame, const std::filesystem::path& dir,
       const auto [i, j] = world.plan().pairs[p];
       const collision::CollisionResult& r = world.results()[p];
       for (int side = 0; side < 2; ++side) {
-        const collision::SphereTree& tree = objects[side ? j : i].asset.tree;
+        const collision::SphereTree& tree = objects[side ? j : i].asset.spheres;
         std::vector<int> ids;
         std::vector<double> leaf;
         for (const auto* list : {&r.colliding, &r.untested})

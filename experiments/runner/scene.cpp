@@ -150,7 +150,7 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
   if (const Json* pre = f.get("preprocess")) {
     Fields p(*pre, f.path("preprocess"), source);
     o.preprocess.coarse_tets = p.integer("coarse_tets", o.preprocess.coarse_tets, 10, 1000000);
-    o.preprocess.tree_levels = p.integer("tree_levels", o.preprocess.tree_levels, 1, 8);
+    o.preprocess.tree_depth = p.integer("tree_depth", o.preprocess.tree_depth, 0, 7);
     o.preprocess.tree_branching = p.integer("tree_branching", o.preprocess.tree_branching, 2, 64);
     o.preprocess.tree_builder =
         p.string("tree_builder", o.preprocess.tree_builder, {"medial", "octree"});

@@ -40,7 +40,7 @@ struct PrimitiveSpec {
 /// Off-line preprocessing options for a raw mesh (passed to icd-preprocess).
 struct PreprocessSpec {
   int coarse_tets = 1500;     ///< target coarse tet count
-  int tree_levels = 3;        ///< sphere tree depth, counting the root
+  int tree_depth = 3;         ///< sphere-tree levels below the root (paper: 3)
   int tree_branching = 8;     ///< sphere tree branching factor
   std::string tree_builder = "medial";  ///< "medial" (adaptive medial axis) or "octree"
 };

@@ -121,8 +121,8 @@ void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
   for (RuntimeObject& o : m_objects)
     if (o.plan.sphere_update)
     {
-      collision::update_spheres(o.asset.tree, o.rest, o.positions, m_scene.collision.update);
-      if (m_scene.collision.layered) enclose_children(o.asset.tree);
+      collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_scene.collision.update);
+      if (m_scene.collision.layered) enclose_children(o.asset.spheres);
     }
   m.times.sphere_update += seconds_since(t0);
 
@@ -151,13 +151,13 @@ void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
       if (!m_fronts[p].empty()) req.start_front = &m_fronts[p];
     }
     collision::CollisionResult& r = m_results[p];
-    if (m_plan.broad_phase && !collision::overlap(m_objects[i].asset.tree.spheres[0],
-                                                  m_objects[j].asset.tree.spheres[0])) {
+    if (m_plan.broad_phase && !collision::overlap(m_objects[i].asset.spheres.spheres[0],
+                                                  m_objects[j].asset.spheres.spheres[0])) {
       // Broad phase: root spheres apart, nothing to refine.
       r = collision::CollisionResult{};
       continue;
     }
-    collision::collide(m_objects[i].asset.tree, m_objects[j].asset.tree, req, r);
+    collision::collide(m_objects[i].asset.spheres, m_objects[j].asset.spheres, req, r);
     if (cs.temporal_coherence) m_fronts[p] = r.front;
     if (last) {
       m.pair_list += static_cast<int64_t>(r.untested.size());
@@ -184,7 +184,7 @@ void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
       const Eigen::Vector3d cb = b.positions.colwise().mean().transpose();
       co.coincident_direction = cb - ca;
       const coupling::ContactStats st = coupling::apply_contact_forces(
-          a.asset.tree, b.asset.tree, m_results[p], co, a.contact_forces, b.contact_forces);
+          a.asset.spheres, b.asset.spheres, m_results[p], co, a.contact_forces, b.contact_forces);
       m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
       m.max_penetration = std::max(m.max_penetration, st.max_penetration);
       if (last) {

@@ -25,10 +25,10 @@ TEST(HeadOn, SoftSpheresBounceApartSymmetrically) {
     "objects": [
       {"name": "left", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 5},
        "position": [-0.12, 0, 0], "velocity": [0.6, 0, 0],
-       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_levels": 4}},
+       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_depth": 3}},
       {"name": "right", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 5},
        "position": [0.12, 0, 0], "velocity": [-0.6, 0, 0],
-       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_levels": 4}}
+       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_depth": 3}}
     ],
     "collision": {"budget_tests": 1000000, "stiffness": 2000, "layered": true},
     "output": {"csv": false}
