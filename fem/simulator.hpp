@@ -30,7 +30,7 @@ struct SimulatorOptions {
   FrequencyOptions frequency;  ///< includes the added contact stiffness
   /// Lanczos iterations of the per-frame re-estimate once a previous Ritz
   /// vector exists (warm start; the first estimate uses frequency.max_iterations).
-  int frequency_refresh_iterations = 8;
+  int frequency_refresh_iterations = 4;
   /// Reuse the last largest-eigenfrequency estimate for calls of advance() /
   /// step() within this much simulated time (s, >= 0; 0 = estimate at every
   /// call). For callers that advance in many short pieces (the runner's
