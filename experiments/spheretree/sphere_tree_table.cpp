@@ -1,4 +1,5 @@
-// sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]
+// sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
+//                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -62,16 +63,31 @@ void print_table(const std::string& model, const std::string& method, double sec
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::cerr << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]\n";
+    std::cerr << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
+                 " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]\n";
     return 2;
   }
   const fs::path results = argv[1];
   std::string models_arg = "bunny,dragon";
-  double time_limit = 60.0;
+  icd::mesh::SphereTreeOptions options;
+  options.branching = 8;
+  options.depth = 3;
+  options.max_spheres_per_level = {1, 8, 64, 445};
+  bool with_octree = true;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
-    if (key == "--models") models_arg = argv[i + 1];
-    else if (key == "--time-limit") time_limit = std::atof(argv[i + 1]);
+    const char* value = argv[i + 1];
+    if (key == "--models") models_arg = value;
+    else if (key == "--time-limit") options.time_limit = std::atof(value);
+    else if (key == "--medial-spacing") options.medial_spacing = std::atof(value);
+    else if (key == "--cover-spacing") options.cover_spacing = std::atof(value);
+    else if (key == "--joint") options.joint_leaf_refinement = std::atoi(value) != 0;
+    else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
+    else if (key == "--octree") with_octree = std::atoi(value) != 0;
+    else {
+      std::cerr << "unknown option " << key << "\n";
+      return 2;
+    }
   }
   fs::create_directories(results);
   const char* env = std::getenv("ICD_DATA_DIR");
@@ -97,11 +113,6 @@ int main(int argc, char** argv) {
     }
     const icd::SurfaceMesh mesh = icd::read_surface_mesh(path);
 
-    icd::mesh::SphereTreeOptions options;
-    options.branching = 8;
-    options.depth = 3;
-    options.max_spheres_per_level = {1, 8, 64, 445};
-    options.time_limit = time_limit;
     const icd::mesh::SphereTreeBuild ours = icd::mesh::build_sphere_tree(mesh, options);
     icd::collision::validate(ours.tree);
 
@@ -112,10 +123,10 @@ int main(int argc, char** argv) {
     const double octree_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     print_table(model.name, "medial", ours.seconds, icd::mesh::evaluate_sphere_tree(mesh, ours.tree));
-    print_table(model.name, "octree", octree_s, icd::mesh::evaluate_sphere_tree(mesh, octree));
-    std::printf("# %s: %lld coverage samples, %d medial spheres (%d refinement points)%s\n", model.name.c_str(),
-                static_cast<long long>(ours.samples.points.rows()), ours.num_medial_spheres,
-                ours.num_refinement_points, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+    if (with_octree) print_table(model.name, "octree", octree_s, icd::mesh::evaluate_sphere_tree(mesh, octree));
+    std::printf("# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f s%s\n",
+                model.name.c_str(), static_cast<long long>(ours.samples.points.rows()), ours.num_medial_spheres,
+                ours.num_refinement_points, ours.medial_seconds, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     std::fflush(stdout);
     write_tree(results, model.name + "_medial", ours.tree);
     write_tree(results, model.name + "_octree", octree);

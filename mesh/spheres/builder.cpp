@@ -73,6 +73,89 @@ std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, in
   return count;
 }
 
+/// Jointly re-optimises the leaf level across sibling groups (a leaf may take
+/// samples from a neighbour of its parent), then restores the wrapped-tree
+/// invariant bottom-up: each inner node's samples become the union of its
+/// children's, and its sphere is re-centred and refitted to cover them.
+void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense, const MeshOracle& oracle,
+                   const SurfaceSamples& dense_samples, const MatX3i& F, const ReductionOptions& reduction,
+                   std::vector<std::vector<Node>>& levels, const std::vector<std::vector<int>>& parent_of) {
+  std::vector<Node>& leaves = levels.back();
+  std::vector<FittedSphere> spheres;
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    FittedSphere s = leaves[i].sphere;
+    s.members = leaves[i].medial;
+    spheres.push_back(std::move(s));
+  }
+  refine_jointly(coarse, spheres, reduction);
+
+  // Dense samples go to the best sphere among their current leaf and the
+  // owners of the coarse samples at their triangle's corners (the first #V
+  // coarse samples are the mesh vertices).
+  std::vector<int> coarse_owner(static_cast<size_t>(coarse.points.rows()), -1);
+  for (size_t j = 0; j < spheres.size(); ++j) {
+    for (int m : spheres[j].members) coarse_owner[static_cast<size_t>(m)] = static_cast<int>(j);
+  }
+  std::vector<int> dense_owner(static_cast<size_t>(dense.points.rows()), -1);
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    for (int s : leaves[i].sphere.members) dense_owner[static_cast<size_t>(s)] = static_cast<int>(i);
+  }
+  auto reassign = [&]() {
+    for (auto& sp : spheres) sp.members.clear();
+    for (size_t s = 0; s < dense_owner.size(); ++s) {
+      int best = dense_owner[s];
+      if (best < 0) continue;
+      const Eigen::Vector3d p = dense.points.row(static_cast<Eigen::Index>(s));
+      auto cost = [&](int j) {
+        return (p - spheres[static_cast<size_t>(j)].center).norm() - spheres[static_cast<size_t>(j)].depth;
+      };
+      double best_cost = cost(best);
+      const int tri = dense_samples.face[static_cast<Eigen::Index>(s)];
+      for (int k = 0; k < 3 && tri >= 0; ++k) {
+        const int v = F(tri, k);
+        const int j = v < static_cast<int>(coarse_owner.size()) ? coarse_owner[static_cast<size_t>(v)] : -1;
+        if (j < 0) continue;
+        const double c = cost(j);
+        if (c < best_cost) best_cost = c, best = j;
+      }
+      dense_owner[s] = best;
+      spheres[static_cast<size_t>(best)].members.push_back(static_cast<int>(s));
+    }
+  };
+  reassign();
+  for (auto& sp : spheres) {
+    if (!sp.members.empty()) polish_sphere(dense, oracle, sp);
+  }
+  reassign();
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    FittedSphere& sp = spheres[i];
+    if (sp.members.empty()) {  // lost everything: keep the old leaf (still valid, covers its old share)
+      continue;
+    }
+    double r = 0;
+    for (int m : sp.members) r = std::max(r, (dense.points.row(m).transpose() - sp.center).norm() + dense.gap[m]);
+    sp.radius = r;
+    sp.error = r - sp.depth;
+    leaves[i].sphere = sp;
+  }
+  // Bottom-up: inner nodes cover the union of their children's samples.
+  for (size_t l = levels.size() - 1; l >= 1; --l) {
+    std::vector<Node>& parents = levels[l - 1];
+    std::vector<std::vector<int>> unions(parents.size());
+    for (size_t i = 0; i < levels[l].size(); ++i) {
+      const auto& m = levels[l][i].sphere.members;
+      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
+      u.insert(u.end(), m.begin(), m.end());
+    }
+    for (size_t p = 0; p < parents.size(); ++p) {
+      std::sort(unions[p].begin(), unions[p].end());
+      unions[p].erase(std::unique(unions[p].begin(), unions[p].end()), unions[p].end());
+      parents[p].sphere.members = std::move(unions[p]);
+      polish_sphere(dense, oracle, parents[p].sphere);
+    }
+  }
+}
+
 }  // namespace
 
 SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOptions& options) {
@@ -96,6 +179,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   out.num_medial_spheres = static_cast<int>(medial.radii.size());
   out.num_refinement_points = medial.num_inserted;
   const PointGrid grid(medial.centers, scale / 64.0);
+  out.medial_seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
   // The medial samples drive the placement; their margin is that of the coverage samples.
   const Eigen::VectorXd medial_gap = Eigen::VectorXd::Constant(medial_samples.points.rows(), out.samples.gap.maxCoeff());
@@ -116,6 +200,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   {
     std::vector<FittedSphere> one{root.sphere};
     assign_and_refit(dense, all_dense, one);
+    polish_sphere(dense, oracle, one.front());
     root.sphere = one.front();
   }
 
@@ -140,20 +225,20 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     for (size_t p = 0; p < parents.size(); ++p) {
       std::vector<FittedSphere> kids = choices[p].configs[static_cast<size_t>(count[p] - 1)];
       std::vector<std::vector<int>> kid_medial;
-      for (auto& k : kids) kid_medial.push_back(k.members);
+      for (size_t k = 0; k < kids.size(); ++k) {
+        kids[k].tag = static_cast<int>(k);
+        kid_medial.push_back(kids[k].members);
+      }
       // The parent's coverage samples are divided among the children, and each
       // child's radius refitted to cover its share with margin.
       std::vector<FittedSphere> fitted = kids;
       assign_and_refit(dense, parents[p].sphere.members, fitted);
+      for (auto& f : fitted) polish_sphere(dense, oracle, f);
+      assign_and_refit(dense, parents[p].sphere.members, fitted);
       for (auto& f : fitted) {
         Node n;
         n.sphere = std::move(f);
-        for (size_t k = 0; k < kids.size(); ++k) {
-          if (kids[k].center == n.sphere.center && kids[k].depth == n.sphere.depth) {
-            n.medial = kid_medial[k];
-            break;
-          }
-        }
+        if (n.sphere.tag >= 0) n.medial = kid_medial[static_cast<size_t>(n.sphere.tag)];
         if (n.medial.empty()) n.medial = parents[p].medial;  // keep the subtree placeable
         children.push_back(std::move(n));
         parent_index.push_back(static_cast<int>(p));
@@ -161,6 +246,9 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     }
     levels.push_back(std::move(children));
     parent_of.push_back(std::move(parent_index));
+  }
+  if (options.joint_leaf_refinement && levels.size() > 2) {
+    refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
   }
 
   // Flatten breadth-first: level by level, children of a node contiguous.

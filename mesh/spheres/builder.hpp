@@ -26,13 +26,17 @@ struct SphereTreeOptions {
   std::vector<int> max_spheres_per_level;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
-  double cover_spacing = 1.0 / 700.0;
+  double cover_spacing = 1.0 / 550.0;
   /// Spacing of the samples whose Voronoi diagram gives the medial axis and
   /// on which the spheres are placed (relative, >= cover_spacing).
-  double medial_spacing = 1.0 / 120.0;
+  double medial_spacing = 1.0 / 25.0;
   int refinement_iterations = 2;          ///< adaptive medial-axis rounds (>= 0)
   double refinement_tolerance = 0.002;    ///< medial sphere error that triggers refinement (relative)
   int lloyd_iterations = 8;               ///< see ReductionOptions
+  /// After the top-down pass, optimise the leaves jointly (a leaf may take
+  /// samples of a neighbour of its parent) and refit the inner nodes
+  /// bottom-up so that each still covers the union of its children's samples.
+  bool joint_leaf_refinement = false;
   /// Wall-clock budget (seconds, > 0). Past it the optimisation stops early
   /// (no more refinement or Lloyd rounds); the tree stays valid and covering.
   double time_limit = 60.0;
@@ -49,6 +53,7 @@ struct SphereTreeBuild {
   int num_medial_spheres = 0;          ///< medial spheres (Voronoi + cover) after refinement
   int num_refinement_points = 0;       ///< points added by the adaptive refinement
   double seconds = 0;                  ///< wall-clock build time
+  double medial_seconds = 0;           ///< of which sampling + medial axis
   bool hit_time_limit = false;         ///< true when the optimisation was cut short
 };
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <vector>
 
 #include <CGAL/Delaunay_triangulation_3.h>
@@ -24,6 +25,24 @@ using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
 
 Eigen::Vector3d to_eigen(const Point& p) { return {p.x(), p.y(), p.z()}; }
 
+/// Circumcentre of a tetrahedron, or false when it is (nearly) flat: solves
+/// 2 (p_i - p_0) . x = |p_i - p_0|^2 for x = centre - p_0.
+bool circumcenter(const Eigen::Vector3d p[4], Eigen::Vector3d& center) {
+  Eigen::Matrix3d A;
+  Eigen::Vector3d b;
+  double scale = 0;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d d = p[i + 1] - p[0];
+    A.row(i) = 2.0 * d.transpose();
+    b[i] = d.squaredNorm();
+    scale = std::max(scale, d.norm());
+  }
+  const double det = A.determinant();
+  if (!(std::abs(det) > 1e-10 * 8.0 * scale * scale * scale)) return false;
+  center = p[0] + A.inverse() * b;
+  return center.allFinite();
+}
+
 /// One inner Voronoi vertex: circumcentre, circumradius, and the samples
 /// (vertex infos) of its Delaunay cell.
 struct InnerVertex {
@@ -36,13 +55,13 @@ struct InnerVertex {
 std::vector<InnerVertex> inner_vertices(const Delaunay& dt, const MeshOracle& oracle) {
   std::vector<InnerVertex> out;
   for (auto cell = dt.finite_cells_begin(); cell != dt.finite_cells_end(); ++cell) {
-    const Point c = CGAL::circumcenter(cell->vertex(0)->point(), cell->vertex(1)->point(),
-                                       cell->vertex(2)->point(), cell->vertex(3)->point());
-    const Eigen::Vector3d center = to_eigen(c);
-    if (!center.allFinite() || !oracle.inside(center)) continue;
+    Eigen::Vector3d corners[4];
+    for (int k = 0; k < 4; ++k) corners[k] = to_eigen(cell->vertex(k)->point());
+    Eigen::Vector3d center;
+    if (!circumcenter(corners, center) || !oracle.inside(center)) continue;
     InnerVertex v;
     v.center = center;
-    v.circumradius = std::sqrt(CGAL::squared_distance(c, cell->vertex(0)->point()));
+    v.circumradius = (center - corners[0]).norm();
     v.inscribed = oracle.distance(center);
     for (int k = 0; k < 4; ++k) v.corner[k] = cell->vertex(k)->info();
     out.push_back(v);

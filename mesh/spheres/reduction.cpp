@@ -90,6 +90,7 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
                         const ReductionOptions& options) {
   assert(!members.empty());
   FittedSphere out;
+  out.tag = hint != nullptr ? hint->tag : -1;
   out.members = members;
   std::sort(out.members.begin(), out.members.end());
   const std::vector<Eigen::Vector3d> hull = extreme_points(problem.points, members);
@@ -136,12 +137,80 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
   return out;
 }
 
+void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, FittedSphere& sphere,
+                   int max_evaluations) {
+  if (sphere.members.empty()) return;
+  const std::vector<Eigen::Vector3d> hull = extreme_points(problem.points, sphere.members);
+  double gmax = 0;
+  for (int s : sphere.members) gmax = std::max(gmax, problem.gap[s]);
+  auto cost = [&](const Eigen::Vector3d& c, double depth) { return max_distance(hull, c) + gmax - depth; };
+  Eigen::Vector3d center = sphere.center;
+  double depth = oracle.inside(center) ? oracle.distance(center) : 0.0;
+  double best = cost(center, depth);
+  double step = 0.25 * sphere.radius;
+  const double min_step = 1e-3 * sphere.radius;
+  int evaluations = 0;
+  while (step > min_step && evaluations < max_evaluations) {
+    bool improved = false;
+    for (int axis = 0; axis < 3 && !improved; ++axis) {
+      for (int sign = -1; sign <= 1 && !improved; sign += 2) {
+        Eigen::Vector3d trial = center;
+        trial[axis] += sign * step;
+        ++evaluations;
+        // Cheap lower bound first: the depth cannot exceed the old one by more than the step.
+        if (max_distance(hull, trial) + gmax - (depth + step) >= best) continue;
+        if (!oracle.inside(trial)) continue;
+        const double d = oracle.distance(trial);
+        const double c = cost(trial, d);
+        if (c < best) best = c, center = trial, depth = d, improved = true;
+      }
+    }
+    if (!improved) step *= 0.5;
+  }
+  sphere.center = center;
+  sphere.depth = depth;
+  refit_radius(problem, sphere);
+}
+
 void assign_and_refit(const ReductionProblem& problem, const std::vector<int>& members,
                       std::vector<FittedSphere>& spheres) {
   if (spheres.empty()) return;
   const std::vector<int> owner = assign(problem, members, spheres);
   distribute(members, owner, spheres);
   for (auto& s : spheres) refit_radius(problem, s);
+}
+
+void refine_jointly(const ReductionProblem& problem, std::vector<FittedSphere>& spheres,
+                    const ReductionOptions& options) {
+  std::vector<int> members;
+  for (const auto& s : spheres) members.insert(members.end(), s.members.begin(), s.members.end());
+  std::sort(members.begin(), members.end());
+  if (members.empty()) return;
+  auto score = [](const std::vector<FittedSphere>& set) {
+    double worst = 0, sum = 0;
+    int used = 0;
+    for (const auto& s : set) {
+      if (s.members.empty()) continue;
+      worst = std::max(worst, s.error), sum += s.error, ++used;
+    }
+    return worst + sum / std::max(used, 1);
+  };
+  std::vector<FittedSphere> best = spheres;
+  double best_score = score(spheres);
+  for (int it = 0; it < options.lloyd_iterations; ++it) {
+    if (std::chrono::steady_clock::now() > options.deadline) break;
+    const std::vector<int> owner = assign(problem, members, spheres);
+    for (auto& s : spheres) s.members.clear();
+    for (size_t m = 0; m < members.size(); ++m) spheres[static_cast<size_t>(owner[m])].members.push_back(members[m]);
+    for (auto& s : spheres) {
+      if (s.members.empty()) continue;
+      const FittedSphere hint = s;
+      s = fit_sphere(problem, s.members, &hint, options);
+    }
+    const double sc = score(spheres);
+    if (sc < best_score) best_score = sc, best = spheres;
+  }
+  spheres = best;
 }
 
 std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem& problem,

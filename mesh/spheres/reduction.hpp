@@ -23,6 +23,7 @@ struct FittedSphere {
   /// is at most radius - depth beyond the surface along the ray from the centre).
   double error = 0;
   std::vector<int> members;  ///< sample indices the sphere covers (sorted)
+  int tag = -1;              ///< caller's label, kept by every function here
 };
 
 /// The fixed data of a reduction: samples with their coverage margins, and
@@ -52,6 +53,14 @@ struct ReductionOptions {
 FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>& members,
                         const FittedSphere* hint, const ReductionOptions& options);
 
+/// Moves the centre of `sphere` (members given) off the medial candidates
+/// to lower its error bound max |s - c| + gap[s] - distance(c, surface):
+/// compass search (6 axis steps, halved on failure, starting at a quarter of
+/// the radius) with the exact distance from `oracle`, the centre kept inside.
+/// Then refits the radius exactly over all members.
+void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, FittedSphere& sphere,
+                   int max_evaluations = 80);
+
 /// Reduces the medial set to k = 1 .. max_k spheres that together cover
 /// `members` (non-empty): greedy splitting (a new sphere at the medial ball
 /// touching the worst-covered sample) followed after each split by Lloyd
@@ -64,6 +73,14 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
 std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem& problem,
                                                          const std::vector<int>& members, int max_k,
                                                          const ReductionOptions& options);
+
+/// Lloyd rounds over an existing sphere set (no splitting): the samples of
+/// all spheres are reassigned (rule of reduce_to_spheres) and each centre
+/// refitted; keeps the best configuration (lowest worst + mean error).
+/// Spheres that lose all their samples keep their place with empty members.
+/// Used to optimise a whole tree level jointly across sibling groups.
+void refine_jointly(const ReductionProblem& problem, std::vector<FittedSphere>& spheres,
+                    const ReductionOptions& options);
 
 /// Divides `members` among `spheres` (the rule of reduce_to_spheres: sample
 /// s goes to the sphere minimizing |s - c| - depth) and refits every radius
