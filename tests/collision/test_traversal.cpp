@@ -112,6 +112,31 @@ TEST(Traversal, InterruptedAtAnyTestBudgetIsConservativeOnThePairTree) {
   }
 }
 
+TEST(Traversal, InterruptedByTheClockIsConservativeOnThePairTree) {
+  // Wherever the clock stops the query, the answer must cover every leaf pair
+  // of the full traversal (the stop point varies from run to run; the
+  // property may not).
+  const Scene s = torus_and_sphere(4, false);
+  const auto full_set = as_set(collide(s.a, s.b, CollisionRequest{}).colliding);
+  int interrupted = 0;
+  for (CollisionRequest r : all_modes()) {
+    for (ClockSource clock : {ClockSource::SteadyClock, ClockSource::CycleCounter}) {
+      for (double budget : {1e-7, 1e-6, 3e-6, 1e-5, 3e-5, 1e-4}) {
+        r.budget_seconds = budget;
+        r.clock = clock;
+        r.clock_check_interval = 1 + static_cast<int>(budget * 1e6) % 7;
+        const CollisionResult res = collide(s.a, s.b, r);
+        if (res.interrupted) {
+          ++interrupted;
+          EXPECT_EQ(res.stop_reason, StopReason::TimeBudget);
+        }
+        expect_cut_covers(s.a, s.b, full_set, res);
+      }
+    }
+  }
+  EXPECT_GT(interrupted, 0);
+}
+
 TEST(Traversal, BreadthFirstRefinesLevelByLevel) {
   const Scene s = torus_and_sphere(4, false);
   CollisionRequest r = CollisionRequest::paper_reference(std::numeric_limits<double>::infinity());
