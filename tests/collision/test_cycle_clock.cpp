@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+
 #include "collision/cycle_clock.hpp"
 
 namespace icd::collision {
