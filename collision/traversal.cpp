@@ -404,8 +404,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
   if (request.budget_tests < -1) throw ParameterError("CollisionRequest::budget_tests must be >= 0, or -1 for none");
   if (request.clock_check_interval < 1) throw ParameterError("CollisionRequest::clock_check_interval must be >= 1");
   if (request.depth_cap < 0) throw ParameterError("CollisionRequest::depth_cap must be >= 0");
-  if (request.mode == TraversalMode::Priority && request.max_list_size < 16)
-    throw ParameterError("CollisionRequest::max_list_size must be >= 16");
+  if (request.mode == TraversalMode::Priority && request.max_list_size < 8)
+    throw ParameterError("CollisionRequest::max_list_size must be >= 8");
   if (a.num_nodes() == 0 || b.num_nodes() == 0) throw ParameterError("collide: empty sphere tree");
   res.colliding.clear();
   res.untested.clear();

@@ -59,9 +59,10 @@ struct CollisionRequest {
   /// Nodes at this level or deeper are not split (treated as leaves; pairs
   /// stopped there are reported in `untested`). Default: no cap.
   int depth_cap = std::numeric_limits<int>::max();
-  /// Priority mode: largest number of pairs held in the list (>= 16). When
-  /// children would not fit, the lower-priority half of the list is moved,
-  /// unrefined, to `untested` (the least valuable work is given up first).
+  /// Priority mode: largest number of pairs held in the list (>= 8, and at
+  /// least the largest child count, else one node's children overshoot it).
+  /// When children would not fit, the lower-priority half of the list is
+  /// moved, unrefined, to `untested` (the least valuable work is given up first).
   std::size_t max_list_size = 1 << 14;
   PriorityKey priority = PriorityKey::LargestSphere;
   /// Temporal coherence: if non-null, start from these pairs (normally the
