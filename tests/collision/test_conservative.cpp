@@ -105,6 +105,29 @@ TEST(Conservative, OverlappingIcospheresAtRest) {
   check_all_budgets(build_octree_tree(a.V, a.F, o), build_octree_tree(b.V, b.F, o), contact_points(a.V, a.F, b.V, b.F));
 }
 
+TEST(Conservative, OracleDetectsTreesThatStopCoveringTheSurface) {
+  // Mutation check of the oracle itself: with the leaf spheres of one tree
+  // shrunk, some true contact point must fall outside every reported pair.
+  const SurfaceMesh a = make_icosphere(3);
+  const SurfaceMesh b = translated(make_icosphere(3, 0.8), {1.2, 0.3, -0.2});
+  OctreeTreeOptions o;
+  o.levels = 4;
+  SphereTree ta = build_octree_tree(a.V, a.F, o);
+  const SphereTree tb = build_octree_tree(b.V, b.F, o);
+  for (int i = 0; i < ta.num_nodes(); ++i)
+    if (ta.is_leaf(i)) ta.spheres[i].r *= 0.5;
+  const CollisionResult res = collide(ta, tb, CollisionRequest{});
+  int lost = 0;
+  for (const auto& p : contact_points(a.V, a.F, b.V, b.F)) {
+    bool covered = false;
+    for (const NodePair& q : res.colliding)
+      covered = covered || ((p - ta.spheres[q.a].center()).norm() <= ta.spheres[q.a].r &&
+                            (p - tb.spheres[q.b].center()).norm() <= tb.spheres[q.b].r);
+    lost += !covered;
+  }
+  EXPECT_GT(lost, 0);
+}
+
 TEST(Conservative, InterlockedToriAtRest) {
   const SurfaceMesh a = make_torus(1.0, 0.3, 32, 12);
   SurfaceMesh b = make_torus(1.0, 0.3, 32, 12);
