@@ -12,6 +12,7 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
@@ -95,6 +96,8 @@ std::string RepairReport::to_string() const {
   if (reoriented_faces) s << "re-oriented faces: " << reoriented_faces << "\n";
   if (reversed_to_outward) s << "reversed to face outward\n";
   if (holes_filled) s << "filled holes: " << holes_filled << " (" << hole_faces_added << " faces)\n";
+  if (self_intersections_repaired)
+    s << "repaired self-intersections: " << self_intersections_repaired << " face pair(s)\n";
   s << "output " << output_vertices << " vertices, " << output_faces << " faces, " << components
     << " component(s), volume " << volume << "\n";
   return s.str();
@@ -292,22 +295,38 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
   }
   mesh.collect_garbage();
 
-  // 9. Self-intersections.
+  // 9. Self-intersections: try CGAL's local repair (remove the faces around
+  // the intersections, fill/smooth the holes), refuse if any remain.
   if (options.check_self_intersections && PMP::does_self_intersect(mesh)) {
     std::vector<std::pair<CgalMesh::Face_index, CgalMesh::Face_index>> pairs;
     PMP::self_intersections(mesh, std::back_inserter(pairs));
-    std::ostringstream s;
-    s << name << ": the surface intersects itself: " << pairs.size() << " intersecting face pair(s)";
-    if (!pairs.empty()) {
-      const auto centroid = [&](CgalMesh::Face_index f) {
-        auto h = mesh.halfedge(f);
-        return CGAL::centroid(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)),
-                              mesh.point(mesh.target(mesh.next(h))));
-      };
-      s << ", e.g. repaired faces " << pairs[0].first.idx() << " near " << fmt_point(centroid(pairs[0].first))
-        << " and " << pairs[0].second.idx() << " near " << fmt_point(centroid(pairs[0].second));
+    const std::size_t found = pairs.size();
+    bool repaired = false;
+    if (options.remove_self_intersections) {
+      PMP::experimental::remove_self_intersections(mesh);
+      mesh.collect_garbage();
+      repaired = CGAL::is_closed(mesh) && CGAL::is_valid_polygon_mesh(mesh) && !PMP::does_self_intersect(mesh);
     }
-    throw InputError(s.str());
+    if (repaired) {
+      rep.self_intersections_repaired = static_cast<int>(found);
+    } else {
+      pairs.clear();
+      PMP::self_intersections(mesh, std::back_inserter(pairs));
+      std::ostringstream s;
+      s << name << ": the surface intersects itself: " << found << " intersecting face pair(s)";
+      if (options.remove_self_intersections)
+        s << "; local repair left " << pairs.size() << (CGAL::is_closed(mesh) ? "" : " and opened the surface");
+      if (!pairs.empty()) {
+        const auto centroid = [&](CgalMesh::Face_index f) {
+          auto h = mesh.halfedge(f);
+          return CGAL::centroid(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)),
+                                mesh.point(mesh.target(mesh.next(h))));
+        };
+        s << ", e.g. faces " << pairs[0].first.idx() << " near " << fmt_point(centroid(pairs[0].first))
+          << " and " << pairs[0].second.idx() << " near " << fmt_point(centroid(pairs[0].second));
+      }
+      throw InputError(s.str());
+    }
   }
 
   // 10. Outward orientation of each component.

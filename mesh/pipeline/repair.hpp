@@ -23,6 +23,9 @@ struct RepairOptions {
   /// Self-intersection check (CGAL does_self_intersect); disabling it is only
   /// for callers that check themselves.
   bool check_self_intersections = true;
+  /// Try CGAL's local self-intersection repair (experimental::remove_self_intersections:
+  /// removes the faces around each intersection and re-fills the hole) before refusing.
+  bool remove_self_intersections = true;
 };
 
 /// What repair_surface() did, in counts.
@@ -36,6 +39,7 @@ struct RepairReport {
   bool reversed_to_outward = false;    ///< whole surface (or components) flipped outward
   int holes_filled = 0;
   int hole_faces_added = 0;
+  int self_intersections_repaired = 0;  ///< intersecting face pairs removed by local repair
   int components = 0;                  ///< connected components of the output
   int output_vertices = 0, output_faces = 0;
   double volume = 0.0;                 ///< enclosed volume of the output (model units^3)
@@ -59,7 +63,8 @@ struct RepairResult {
 /// indices or non-finite coordinates, is flat (zero volume), has a
 /// non-manifold edge or vertex (named, with its position), keeps boundary
 /// loops after hole filling (count, size, a vertex on the largest), or
-/// self-intersects (number of intersecting face pairs and the first pair).
+/// self-intersects after the local repair (number of intersecting face pairs
+/// and the first pair).
 RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& options = {},
                             const std::string& name = "surface");
 

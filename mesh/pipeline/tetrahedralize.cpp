@@ -60,8 +60,10 @@ void seed(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, double s
   }
 }
 
+/// One Delaunay refinement at `size`; sliver optimisation only when `optimise`
+/// (it dominates the cost, so the size search runs without it).
 TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const TetrahedralizeOptions& o,
-                  double size) {
+                  double size, bool optimise) {
   namespace p = CGAL::parameters;
   CGAL::get_default_random() = CGAL::Random(o.random_seed);
   const Criteria criteria(p::facet_angle = o.facet_angle_deg, p::facet_size = o.facet_size_factor * size,
@@ -70,8 +72,8 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
   C3t3 c3t3;
   seed(c3t3, domain, surface, o.facet_size_factor * size);
   CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude());
-  if (o.perturb) CGAL::perturb_mesh_3(c3t3, domain, p::sliver_bound = o.sliver_bound_deg);
-  if (o.exude) CGAL::exude_mesh_3(c3t3, p::sliver_bound = o.sliver_bound_deg);
+  if (optimise && o.perturb) CGAL::perturb_mesh_3(c3t3, domain, p::sliver_bound = o.sliver_bound_deg);
+  if (optimise && o.exude) CGAL::exude_mesh_3(c3t3, p::sliver_bound = o.sliver_bound_deg);
 
   TetMesh out;
   std::unordered_map<Tr::Vertex_handle, int> id;
@@ -120,27 +122,33 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
 
   TetrahedralizeResult best;
   if (o.cell_size > 0.0) {
-    best.mesh = mesh_once(domain, surface, o, o.cell_size);
+    best.mesh = mesh_once(domain, surface, o, o.cell_size, true);
     best.cell_size = o.cell_size;
     best.passes = 1;
   } else {
-    // Regular tet of edge a: volume a^3 / (6 sqrt 2), circumradius a sqrt(6) / 4.
+    // Size search without sliver optimisation (which changes the count only
+    // slightly), then one optimised pass at the best size. Initial guess: a
+    // regular tet of edge a has volume a^3 / (6 sqrt 2) and circumradius
+    // a sqrt(6) / 4; refinement stops well below the bound, hence the factor.
     const double a = std::cbrt(6.0 * std::sqrt(2.0) * volume / o.target_tets);
-    double size = a * std::sqrt(6.0) / 4.0 * 1.5;  // Delaunay refinement stops well below the bound
-    double best_err = INFINITY;
+    double size = a * std::sqrt(6.0) / 4.0 * 2.0;
+    double best_err = INFINITY, best_size = size;
     for (int pass = 1; pass <= o.max_size_iterations; ++pass) {
-      TetMesh m = mesh_once(domain, surface, o, size);
-      const double n = static_cast<double>(m.T.rows());
+      const double n = static_cast<double>(mesh_once(domain, surface, o, size, false).T.rows());
       const double err = std::abs(n / o.target_tets - 1.0);
       if (err < best_err) {
         best_err = err;
-        best.mesh = std::move(m);
-        best.cell_size = size;
+        best_size = size;
       }
       best.passes = pass;
       if (err <= o.count_tolerance || n == 0) break;
-      size *= std::cbrt(n / o.target_tets);
+      // Count ~ size^-3 for volume-dominated meshes, flatter when the surface
+      // dominates; the exponent 1/2 undershoots less on thin shapes.
+      size *= std::pow(n / o.target_tets, 0.5);
     }
+    best.mesh = mesh_once(domain, surface, o, best_size, true);
+    best.cell_size = best_size;
+    ++best.passes;
   }
   if (best.mesh.T.rows() == 0)
     throw InputError("tetrahedralize_surface: the mesher produced no tetrahedron (cell size " +

@@ -13,7 +13,7 @@ namespace icd::mesh {
 struct TetrahedralizeOptions {
   int target_tets = 2000;            ///< wanted number of tets (used when cell_size == 0)
   double count_tolerance = 0.25;     ///< accept |#tets / target - 1| <= this
-  int max_size_iterations = 4;       ///< meshing passes of the size search
+  int max_size_iterations = 5;       ///< meshing passes of the size search (not optimised)
   double cell_size = 0.0;            ///< upper bound of tet circumradius (model units); 0: from target_tets
   double facet_size_factor = 1.0;    ///< facet size = factor * cell size
   double facet_distance_factor = 0.1;  ///< facet distance bound = factor * cell size
@@ -30,7 +30,7 @@ struct TetrahedralizeResult {
   TetMesh mesh;          ///< positive tets, outward boundary F, every vertex used
   TetQuality quality;
   double cell_size = 0;  ///< cell size of the pass that was kept
-  int passes = 0;        ///< meshing passes run
+  int passes = 0;        ///< meshing passes run (size search + the final optimised one)
 };
 
 /// Tetrahedralizes the region bounded by `surface` (closed, outward-oriented,

@@ -1,0 +1,89 @@
+#pragma once
+/// The whole off-line preparation of one deformable object (issue 4; paper
+/// sections 3.1, 4.4 and 5): repair -> simplify -> tetrahedralize -> rigid
+/// links -> sphere tree and sphere-to-node association, producing the asset
+/// bundle the simulator loads.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "collision/node_association.hpp"
+#include "collision/octree_tree.hpp"
+#include "coupling/asset_bundle.hpp"
+#include "coupling/rigid_links.hpp"
+#include "mesh/io/types.hpp"
+#include "mesh/pipeline/repair.hpp"
+#include "mesh/pipeline/simplify.hpp"
+#include "mesh/pipeline/tetrahedralize.hpp"
+#include "mesh/spheres/builder.hpp"
+
+namespace icd::mesh {
+
+/// Which sphere-tree builder the sphere stage runs.
+enum class SphereBuilder {
+  medial_axis,  ///< mesh/spheres build_sphere_tree (adaptive medial axis, paper 4.1)
+  octree,       ///< collision/octree_tree build_octree_tree (fast baseline)
+  none,         ///< no sphere tree in the bundle
+};
+
+/// Options of every stage; the defaults are the tool's defaults.
+struct PreprocessOptions {
+  RepairOptions repair;
+  SimplifyOptions simplify;
+  TetrahedralizeOptions tetrahedralize;
+  coupling::RigidLinkOptions links;
+  SphereBuilder sphere_builder = SphereBuilder::medial_axis;
+  /// Medial-axis builder options. Defaults here are lighter than the builder's
+  /// own (one Lloyd round, no adaptive refinement, coarser samples) to keep the
+  /// whole run within a minute, and without a wall-clock limit: a limit that
+  /// fires makes the output depend on machine load (not byte-reproducible).
+  SphereTreeOptions spheres;
+  collision::OctreeTreeOptions octree;  ///< octree builder options (levels = depth + 1)
+  collision::NodeAssociationOptions association;
+  bool compute_hausdorff = true;  ///< dense vs coarse surface distance for the summary
+  PreprocessOptions() {
+    spheres.time_limit = 1e9;
+    spheres.lloyd_iterations = 1;
+    spheres.refinement_iterations = 0;
+    spheres.medial_spacing = 1.0 / 80.0;
+    spheres.cover_spacing = 1.0 / 400.0;
+    octree.levels = spheres.depth + 1;
+  }
+};
+
+/// Time of one stage (seconds): wall clock and process CPU time (the machine
+/// may be shared; CPU time is the load-independent figure).
+struct StageTime {
+  std::string stage;
+  double seconds = 0.0;
+  double cpu_seconds = 0.0;
+};
+
+/// Everything preprocess() produced and measured.
+struct PreprocessResult {
+  coupling::AssetBundle bundle;  ///< dense = repaired input surface
+  RepairReport repair;
+  SimplifyReport simplify;
+  TetQuality quality;            ///< of bundle.coarse
+  double cell_size = 0.0;        ///< Mesh_3 cell size that was kept
+  int mesher_passes = 0;
+  int sphere_levels = 0;
+  bool sphere_time_limit_hit = false;  ///< the builder stopped early: output may vary between runs
+  /// Approximate symmetric Hausdorff distances (model units; -1 when not computed):
+  double hausdorff_dense_simplified = -1.0;  ///< repaired dense vs simplified surface
+  double hausdorff_dense_coarse = -1.0;      ///< repaired dense vs coarse tet boundary
+  double bbox_diagonal = 0.0;                ///< of the repaired dense surface
+  std::vector<StageTime> times;              ///< in stage order
+};
+
+/// Progress report: the stage name and a short message (start, pass, done).
+using ProgressFn = std::function<void(const std::string& stage, const std::string& message)>;
+
+/// Runs all stages on `dense` (a raw surface as read from file; `name` prefixes
+/// error messages). Deterministic for identical input and options unless the
+/// sphere builder hits its time limit (reported). Throws what the stages
+/// throw: InputError for unusable input, ParameterError for bad options.
+PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& options = {},
+                            const ProgressFn& progress = {}, const std::string& name = "surface");
+
+}  // namespace icd::mesh
