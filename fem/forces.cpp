@@ -8,6 +8,7 @@
 
 #include "fem/constitutive.hpp"
 #include "fem/element_kernels.hpp"
+#include "fem/lane_kernels.hpp"
 #include "fem/polar.hpp"
 #include "mesh/io/error.hpp"
 
@@ -104,6 +105,16 @@ ElasticForces::ElasticForces(TetMeshData mesh, const Material& material, const F
   for (int e = 0; e < m_mesh.num_tets(); ++e)  // ascending e: the sequential scatter order
     for (int a = 0; a < 4; ++a) m_node_slot[fill[m_mesh.tets(e, a)]++] = 12 * e + 3 * a;
   m_chunk_sum.resize((m_mesh.num_tets() + kChunk - 1) / kChunk);
+  static_assert(kChunk % lanes::kLanes == 0, "chunks hold whole lane blocks");
+  static_assert(sizeof(lanes::Block) == sizeof(double) * 10 * lanes::kLanes, "Block is plain doubles");
+  const int nblocks = (m_mesh.num_tets() + lanes::kLanes - 1) / lanes::kLanes;
+  m_lane_blocks.assign(static_cast<size_t>(nblocks) * 10 * lanes::kLanes, 0.0);
+  for (int e = 0; e < m_mesh.num_tets(); ++e) {
+    auto* b = reinterpret_cast<lanes::Block*>(m_lane_blocks.data()) + e / lanes::kLanes;
+    const int lane = e % lanes::kLanes;
+    for (int k = 0; k < 9; ++k) b->dinv[k][lane] = m_mesh.dm_inv[e].data()[k];
+    b->volume[lane] = m_mesh.rest_volume[e];
+  }
 }
 
 void ElasticForces::set_num_threads(int num_threads) {
@@ -247,8 +258,34 @@ void ElasticForces::compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d
   Eigen::Quaterniond* rot = m_rotations.data();
   const int max_it = m_options.polar_max_iterations;
   const double tol = m_options.polar_tolerance;
+  const auto* blocks = reinterpret_cast<const lanes::Block*>(m_lane_blocks.data());
   auto run = [&](auto model_tag) {
     constexpr MaterialModel kModel = decltype(model_tag)::value;
+    if constexpr (kModel != MaterialModel::Corotational) {
+      // 8 elements at a time in lane loops; scatter in element order.
+      for_chunks([&](int begin, int end) {
+        for (int e0 = begin; e0 < end; e0 += lanes::kLanes) {
+          const int count = std::min(lanes::kLanes, end - e0);
+          double out[lanes::kLanes][12];
+          lanes::block_forces<kModel>(xp, T + 4 * e0, count, blocks[e0 / lanes::kLanes], mu, lambda, out);
+          for (int l = 0; l < count; ++l) {
+            if (!direct) {
+              std::copy(out[l], out[l] + 12, buf + 12 * static_cast<size_t>(e0 + l));
+              continue;
+            }
+            const int* t = T + 4 * (e0 + l);
+            for (int a = 0; a < 4; ++a) {
+              double* fa = fp + 3 * t[a];
+              fa[0] += out[l][3 * a];
+              fa[1] += out[l][3 * a + 1];
+              fa[2] += out[l][3 * a + 2];
+            }
+          }
+        }
+        return 0.0;
+      });
+      return;
+    }
     for_chunks([&](int begin, int end) {
       for (int e = begin; e < end; ++e) {
         const int* t = T + 4 * e;

@@ -79,6 +79,7 @@ class ElasticForces {
   std::vector<double> m_element_forces;         // #T x 12 scratch for threaded scatter
   std::vector<int> m_node_offset, m_node_slot;  // node -> element slots (CSR, ascending element)
   std::vector<double> m_chunk_sum;
+  std::vector<double> m_lane_blocks;            // lanes::Block per 8 elements (SoA Dm^-1, volume)
 };
 
 }  // namespace icd::fem
