@@ -82,9 +82,11 @@ int main(int argc, char** argv) {
   const double kappa = 10 * (1 + kPoisson) / (12 + 11 * kPoisson);
   const double delta = -(q / (8 * kYoung * I) + q / (2 * kappa * G * A));  // L = 1
   const double f1 = 1.8751 * 1.8751 / (2 * M_PI) * std::sqrt(kYoung * I / (kDensity * A));
-  // Critical damping of the (locking-stiffened, <= 2x) first mode; settled to
-  // ~1e-5 after 0.4 s.
-  const RayleighDamping damping{2 * 2 * M_PI * f1 * 1.5, 0.0};
+  // alpha = 2 omega_1 with omega_1 of the 3840-tet mesh (~1.1x the beam value
+  // because of locking): critical there, underdamped (xi ~ 0.6-0.85) on the
+  // stiffer coarse meshes; every mesh decays at >= 35/s, settled to < 1e-4
+  // after 0.4 s.
+  const RayleighDamping damping{2 * 2 * M_PI * f1 * 1.1, 0.0};
   const double sim_time = 0.4;
 
   const std::vector<int> levels = quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 4};
