@@ -4,7 +4,12 @@
 // prefix, e.g. 30n = 30 ns/tet). Single thread unless the name says threads:2.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <numeric>
+#include <random>
+
 #include "fem/backward_euler.hpp"
+#include "fem/reorder.hpp"
 #include "fem/simulator.hpp"
 #include "fem/stable_step.hpp"
 #include "mesh/io/primitives.hpp"
@@ -89,6 +94,46 @@ void BM_Step(benchmark::State& state) {
   set_per_tet(state, m.T.rows());
   state.counters["step_s"] = h;
 }
+
+// Memory locality: the 30,720-tet bar (StVK) in generator order (0), with
+// nodes and elements randomly shuffled (1), and shuffled then reordered by
+// reverse Cuthill-McKee (2), as a mesh from the pipeline would be.
+void BM_ForcesOrdering(benchmark::State& state) {
+  TetMesh m = bar(2);
+  if (state.range(0) >= 1) {
+    std::vector<int> perm(m.V.rows()), eperm(m.T.rows());
+    std::iota(perm.begin(), perm.end(), 0);
+    std::iota(eperm.begin(), eperm.end(), 0);
+    std::mt19937 gen(0);
+    std::shuffle(perm.begin(), perm.end(), gen);
+    std::shuffle(eperm.begin(), eperm.end(), gen);
+    TetMesh s;
+    s.V.resize(m.V.rows(), 3);
+    for (int i = 0; i < m.V.rows(); ++i) s.V.row(perm[i]) = m.V.row(i);
+    s.T.resize(m.T.rows(), 4);
+    for (int e = 0; e < m.T.rows(); ++e)
+      for (int a = 0; a < 4; ++a) s.T(eperm[e], a) = perm[m.T(e, a)];
+    m = s;
+  }
+  if (state.range(0) == 2) {
+    const ReorderedMesh r = reorder_for_locality(m.V, m.T);
+    m.V = r.V;
+    m.T = r.T;
+  }
+  ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(MaterialModel::StVK)));
+  MatX3d x = m.V;
+  for (int i = 0; i < x.rows(); ++i) x(i, 2) += 0.05 * x(i, 0) * x(i, 0);
+  MatX3d f(x.rows(), 3);
+  for (auto _ : state) {
+    forces.compute(x, f);
+    benchmark::DoNotOptimize(f.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel(state.range(0) == 0 ? "generator order" : state.range(0) == 1 ? "shuffled" : "shuffled + RCM");
+  set_per_tet(state, m.T.rows());
+  state.counters["bandwidth"] = node_bandwidth(m.T);
+}
+BENCHMARK(BM_ForcesOrdering)->DenseRange(0, 2)->ArgName("order")->MinTime(0.2);
 
 // Single thread: rates from CPU time (robust on a shared machine).
 BENCHMARK(BM_Forces)
