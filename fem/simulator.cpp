@@ -80,12 +80,22 @@ void Simulator::refuse_if_above_limit(double h, double limit, const char* what) 
   throw ParameterError(os.str());
 }
 
-void Simulator::integrate(double h) {
+std::string Simulator::integrate(double h) {
   switch (m_options.integrator) {
     case Integrator::RK4: m_explicit.rk4(m_model, m_state, h); break;
     case Integrator::SymplecticEuler: m_explicit.symplectic_euler(m_model, m_state, h); break;
-    case Integrator::BackwardEuler: m_implicit.step(m_model, m_state, h, m_options.newton); break;
+    case Integrator::BackwardEuler: {
+      const NewtonReport rep = m_implicit.step(m_model, m_state, h, m_options.newton);
+      if (!rep.converged) {
+        std::ostringstream os;
+        os << "backward Euler Newton did not converge in " << rep.iterations << " iterations: residual "
+           << rep.residual << " N s, reference " << rep.reference << " N s";
+        return os.str();
+      }
+      break;
+    }
   }
+  return {};
 }
 
 Simulator::Check Simulator::check(const Check& before) {
@@ -147,13 +157,19 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
   while (t < total) {
     const int remaining = static_cast<int>(std::ceil((total - t) / h * (1 - 1e-12)));
     const double hh = (total - t) / std::max(remaining, 1);
-    integrate(hh);
+    const std::string step_failure = integrate(hh);
     ++steps;
     t = (remaining <= 1) ? total : t + hh;
     ++since_check;
-    if (since_check < m_options.check_interval && t < total) continue;
+    if (step_failure.empty() && since_check < m_options.check_interval && t < total) continue;
     since_check = 0;
-    const Check c = check(before);
+    Check c;
+    if (step_failure.empty()) {
+      c = check(before);
+    } else {
+      c.ok = false;
+      c.message = step_failure;
+    }
     if (c.ok) {
       good = m_state;
       t_good = t;

@@ -100,7 +100,8 @@ class Simulator {
     double kinetic = 0, elastic = 0, load = 0;
   };
   Check check(const Check& before);
-  void integrate(double h);
+  /// One step; returns an empty string, or why the step failed (Newton).
+  std::string integrate(double h);
   AdvanceReport run(double total, double h, AdvanceReport rep);
   void refuse_if_above_limit(double h, double limit, const char* what) const;
 
