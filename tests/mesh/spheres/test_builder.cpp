@@ -1,0 +1,211 @@
+// Sphere-tree builder on small meshes (sphere, box, torus): layout, coverage
+// of every level (margin bookkeeping and an independent dense random
+// sampling checked by brute force), error decreasing level to level,
+// determinism, and option checks.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <random>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "collision/sphere_tree.hpp"
+#include "mesh/io/error.hpp"
+#include "mesh/io/primitives.hpp"
+#include "mesh/spheres/builder.hpp"
+#include "mesh/spheres/evaluation.hpp"
+
+namespace {
+
+using namespace icd::mesh;
+
+struct Case {
+  std::string name;
+  icd::SurfaceMesh mesh;
+};
+
+std::vector<Case> cases() {
+  return {{"icosphere", icd::make_icosphere(2)},
+          {"box", icd::make_box_surface({0, 0, 0}, {2, 1, 0.6})},
+          {"torus", icd::make_torus(1.0, 0.3, 24, 12)}};
+}
+
+SphereTreeOptions small_options();
+
+/// The builds of cases(), made once per test program (each takes seconds).
+const SphereTreeBuild& cached_build(const Case& c) {
+  static std::map<std::string, SphereTreeBuild> builds;
+  auto it = builds.find(c.name);
+  if (it == builds.end()) it = builds.emplace(c.name, build_sphere_tree(c.mesh, small_options())).first;
+  return it->second;
+}
+
+SphereTreeOptions small_options() {
+  SphereTreeOptions o;
+  o.branching = 4;
+  o.depth = 2;
+  o.cover_spacing = 1.0 / 80;
+  o.medial_spacing = 1.0 / 20;
+  return o;
+}
+
+/// Random surface points, uniform by area (independent of the builder's lattice).
+icd::MatX3d dense_random_points(const icd::SurfaceMesh& m, int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<double> cumulative;
+  double total = 0;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+    total += 0.5 * (b - a).cross(c - a).norm();
+    cumulative.push_back(total);
+  }
+  std::uniform_real_distribution<double> u(0, 1);
+  icd::MatX3d P(count, 3);
+  for (int i = 0; i < count; ++i) {
+    const auto f = static_cast<Eigen::Index>(std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
+                                             cumulative.begin());
+    double s = u(rng), t = u(rng);
+    if (s + t > 1) s = 1 - s, t = 1 - t;
+    const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+    P.row(i) = a + s * (b - a) + t * (c - a);
+  }
+  return P;
+}
+
+TEST(SphereTreeBuilder, LayoutIsBreadthFirstWithContiguousChildren) {
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto& tree = build.tree;
+    EXPECT_NO_THROW(icd::collision::validate(tree));
+    ASSERT_EQ(tree.num_levels(), 3);
+    EXPECT_EQ(tree.level_offset[0], 0);
+    EXPECT_EQ(tree.level_offset[1], 1);
+    EXPECT_LE(tree.level_offset[2] - tree.level_offset[1], 4);
+    EXPECT_LE(tree.level_offset[3] - tree.level_offset[2], 16);
+    int expected_next = 1;
+    for (int i = 0; i < tree.num_nodes(); ++i) {
+      EXPECT_GE(tree.level[i], 0);
+      EXPECT_TRUE(i >= tree.level_offset[tree.level[i]] && i < tree.level_offset[tree.level[i] + 1]);
+      if (tree.child_count[i] == 0) {
+        EXPECT_EQ(tree.first_child[i], -1);
+        EXPECT_EQ(tree.level[i], 2) << "leaves are on the last level";
+        continue;
+      }
+      EXPECT_LE(tree.child_count[i], 4);
+      EXPECT_EQ(tree.first_child[i], expected_next) << "children must follow in breadth-first order";
+      expected_next += tree.child_count[i];
+      for (int k = 0; k < tree.child_count[i]; ++k) EXPECT_EQ(tree.level[tree.first_child[i] + k], tree.level[i] + 1);
+    }
+    EXPECT_EQ(expected_next, tree.num_nodes());
+  }
+}
+
+TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem) {
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto& tree = build.tree;
+    const auto& P = build.samples.points;
+    ASSERT_EQ(static_cast<int>(build.node_samples.size()), tree.num_nodes());
+    EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), P.rows());
+    for (int i = 0; i < tree.num_nodes(); ++i) {
+      const auto& s = tree.spheres[i];
+      for (int m : build.node_samples[i]) {
+        ASSERT_LE((P.row(m).transpose() - s.center()).norm() + build.samples.gap[m], s.r * (1 + 1e-12) + 1e-12);
+      }
+      if (tree.child_count[i] == 0) continue;
+      std::vector<int> joined;
+      for (int k = 0; k < tree.child_count[i]; ++k) {
+        const auto& cs = build.node_samples[tree.first_child[i] + k];
+        EXPECT_FALSE(cs.empty());
+        joined.insert(joined.end(), cs.begin(), cs.end());
+      }
+      std::sort(joined.begin(), joined.end());
+      EXPECT_EQ(joined, build.node_samples[i]) << "children must divide the samples of node " << i;
+    }
+  }
+}
+
+TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto& tree = build.tree;
+    const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
+    for (int l = 0; l < tree.num_levels(); ++l) {
+      int uncovered = 0;
+      for (Eigen::Index p = 0; p < P.rows(); ++p) {
+        bool covered = false;
+        for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
+          covered = (P.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
+        }
+        uncovered += covered ? 0 : 1;
+      }
+      EXPECT_EQ(uncovered, 0) << "level " << l;
+    }
+  }
+}
+
+TEST(SphereTreeBuilder, ErrorDecreasesFromLevelToLevel) {
+  EvaluationOptions eval;
+  eval.coverage_spacing = 10.0;
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
+    ASSERT_EQ(metrics.size(), 3u);
+    for (size_t l = 1; l < metrics.size(); ++l) {
+      // The sphere is already fitted exactly by its root (error = margin only).
+      const double slack = c.name == "icosphere" ? 0.01 * 2000 : 0.0;
+      EXPECT_LE(metrics[l].mean_error_162, metrics[l - 1].mean_error_162 + slack) << "level " << l;
+      EXPECT_LE(metrics[l].worst_error_162, metrics[l - 1].worst_error_162 + slack) << "level " << l;
+      if (c.name != "icosphere") {
+        EXPECT_LT(metrics[l].mean_error_162, 0.8 * metrics[l - 1].mean_error_162);
+      }
+      EXPECT_EQ(metrics[l].num_uncovered_samples, 0);
+      EXPECT_EQ(metrics[l].num_uncovered_vertices, 0);
+    }
+  }
+}
+
+TEST(SphereTreeBuilder, IsDeterministic) {
+  const Case torus = cases()[2];
+  const auto& a = cached_build(torus).tree;
+  const auto b = build_sphere_tree(torus.mesh, small_options()).tree;
+  ASSERT_EQ(a.num_nodes(), b.num_nodes());
+  for (int i = 0; i < a.num_nodes(); ++i) {
+    EXPECT_EQ(a.spheres[i].x, b.spheres[i].x);
+    EXPECT_EQ(a.spheres[i].y, b.spheres[i].y);
+    EXPECT_EQ(a.spheres[i].z, b.spheres[i].z);
+    EXPECT_EQ(a.spheres[i].r, b.spheres[i].r);
+  }
+  EXPECT_EQ(a.first_child, b.first_child);
+}
+
+TEST(SphereTreeBuilder, RespectsSphereCapsPerLevel) {
+  SphereTreeOptions o = small_options();
+  o.max_spheres_per_level = {1, 3, 7};
+  const auto build = build_sphere_tree(icd::make_torus(1.0, 0.3, 24, 12), o);
+  EXPECT_LE(build.tree.level_offset[2] - build.tree.level_offset[1], 3);
+  EXPECT_LE(build.tree.level_offset[3] - build.tree.level_offset[2], 7);
+  EXPECT_NO_THROW(icd::collision::validate(build.tree));
+}
+
+TEST(SphereTreeBuilder, RejectsBadOptionsAndMeshes) {
+  const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
+  SphereTreeOptions o = small_options();
+  o.branching = 1;
+  EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
+  o = small_options();
+  o.depth = -1;
+  EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
+  o = small_options();
+  o.time_limit = 0;
+  EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
+  EXPECT_THROW(build_sphere_tree(icd::SurfaceMesh{}, small_options()), icd::InputError);
+}
+
+}  // namespace

@@ -1,0 +1,87 @@
+// Evaluation metrics against closed forms for spheres around a cube: probe
+// errors (distance of outside probes to the cube), uncovered area (a sphere
+// cap cuts a disk out of each face), uncovered corners, child protrusion.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "collision/sphere_tree.hpp"
+#include "mesh/io/error.hpp"
+#include "mesh/io/primitives.hpp"
+#include "mesh/spheres/evaluation.hpp"
+
+namespace {
+
+using namespace icd::mesh;
+
+icd::collision::SphereTree two_level_tree(double root_r, const Eigen::Vector3d& child_c, double child_r) {
+  icd::collision::SphereTree t;
+  t.spheres = {{0, 0, 0, root_r}, {child_c.x(), child_c.y(), child_c.z(), child_r}};
+  t.rest_spheres = t.spheres;
+  t.first_child = {1, -1};
+  t.child_count = {1, 0};
+  t.level = {0, 1};
+  t.level_offset = {0, 1, 2};
+  return t;
+}
+
+/// Exact distance from an outside point to the cube [-h, h]^3.
+double cube_distance(const Eigen::Vector3d& p, double h) { return (p.cwiseAbs().array() - h).max(0.0).matrix().norm(); }
+
+TEST(Evaluation, ProbeErrorsMatchTheCubeDistance) {
+  const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});  // normalized: half side 1000
+  const auto tree = two_level_tree(1.2, {0.3, 0.1, 0}, 1.05);
+  EvaluationOptions options;
+  options.coverage_spacing = 20.0;
+  const auto metrics = evaluate_sphere_tree(cube, tree, options);
+  ASSERT_EQ(metrics.size(), 2u);
+  for (int subdivisions : {1, 2}) {
+    const icd::MatX3d dirs = probe_directions(subdivisions);
+    ASSERT_EQ(dirs.rows(), subdivisions == 1 ? 42 : 162);
+    for (int node = 0; node < 2; ++node) {
+      const auto& s = tree.spheres[node];
+      double expected = 0;
+      for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
+        const Eigen::Vector3d p = 1000.0 * (s.center() + s.r * dirs.row(d).transpose());
+        expected = std::max(expected, cube_distance(p, 1000.0));
+      }
+      const auto& m = metrics[static_cast<size_t>(node)];
+      EXPECT_NEAR(subdivisions == 1 ? m.worst_error_42 : m.worst_error_162, expected, 1e-6);
+      EXPECT_NEAR(subdivisions == 1 ? m.mean_error_42 : m.mean_error_162, expected, 1e-6);
+    }
+  }
+  // The child sticks out of the root by |c| + r_child - r_root.
+  EXPECT_NEAR(metrics[1].max_child_protrusion, 1000.0 * (std::sqrt(0.1) + 1.05 - 1.2), 1e-6);
+  EXPECT_EQ(metrics[0].max_child_protrusion, 0.0);
+}
+
+TEST(Evaluation, UncoveredAreaMatchesTheFaceDiskClosedForm) {
+  const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
+  const double R = 1.2;
+  const auto tree = two_level_tree(R, {0, 0, 0}, std::sqrt(3.0) + 1e-9);  // the child covers everything
+  EvaluationOptions options;
+  options.coverage_spacing = 5.0;
+  const auto metrics = evaluate_sphere_tree(cube, tree, options);
+  // Each face keeps a covered disk of radius sqrt(R^2 - 1) (< 1) around its centre.
+  const double rho2 = R * R - 1.0;
+  const double expected = 1.0 - M_PI * rho2 / 4.0;
+  EXPECT_NEAR(metrics[0].uncovered_area_fraction, expected, 0.005);
+  EXPECT_EQ(metrics[0].num_uncovered_vertices, 8);
+  EXPECT_NEAR(metrics[0].max_uncovered_gap, 1000.0 * (std::sqrt(3.0) - R), 1e-6);
+  EXPECT_EQ(metrics[1].num_uncovered_samples, 0);
+  EXPECT_EQ(metrics[1].uncovered_area_fraction, 0.0);
+  EXPECT_EQ(metrics[1].num_uncovered_vertices, 0);
+}
+
+TEST(Evaluation, RejectsBadOptionsAndTrees) {
+  const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
+  EvaluationOptions bad;
+  bad.coverage_spacing = 0;
+  EXPECT_THROW(evaluate_sphere_tree(cube, two_level_tree(2, {0, 0, 0}, 2), bad), icd::ParameterError);
+  auto tree = two_level_tree(2, {0, 0, 0}, 2);
+  tree.spheres[1].r = std::nan("");
+  EXPECT_THROW(evaluate_sphere_tree(cube, tree), icd::ParameterError);
+  EXPECT_THROW(evaluate_sphere_tree(cube, icd::collision::SphereTree{}), icd::ParameterError);
+}
+
+}  // namespace
