@@ -50,20 +50,27 @@ NewtonReport BackwardEulerStepper::step(Model& model, State& s, double h, const 
     apply_dirichlet(m_A, fixed);
     const Eigen::VectorXd rhs = -flat(r);
     rep.max_shift = std::max(rep.max_shift, solve_with_shift(m_solver, m_A, m_shifted, rhs, dv));
-    // Backtracking on the residual norm.
+    // Backtracking on the residual norm. No decrease at all means the
+    // round-off floor of the forces was reached: converged if the residual is
+    // within sqrt(tolerance) of the reference, failed otherwise.
     double t = 1.0;
-    for (int ls = 0; ls < 8; ++ls, t *= 0.5) {
+    bool accepted = false;
+    for (int ls = 0; ls < 8 && !accepted; ++ls, t *= 0.5) {
       v_try = v1;
       flat(v_try) += t * dv;
       x_try = s.x + h * v_try;
       const double rt = residual(x_try, v_try, r_try);
-      if (rt < rn || ls == 7) {
+      if (rt < rn) {
         v1.swap(v_try);
         x1.swap(x_try);
         r.swap(r_try);
         rn = rt;
-        break;
+        accepted = true;
       }
+    }
+    if (!accepted) {
+      rep.converged = rn <= std::sqrt(options.tolerance) * rep.reference;
+      break;
     }
   }
   rep.residual = rn;

@@ -28,8 +28,10 @@ struct NewtonReport {
 class BackwardEulerStepper {
  public:
   /// One step of size h (s). The reference scale of the residual is
-  /// |M v0| + h (|f_int(x0)| + |f_ext + M g|). On non-convergence the state is
-  /// still updated with the last iterate and the report says so.
+  /// |M v0| + h (|f_int(x0)| + |f_ext + M g|); when no backtracking step
+  /// reduces the residual (round-off floor), it is accepted if within
+  /// sqrt(tolerance) of the reference. On non-convergence the state is still
+  /// updated with the last iterate and the report says so.
   NewtonReport step(Model& model, State& s, double h, const NewtonOptions& options = {});
 
  private:
