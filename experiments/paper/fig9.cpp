@@ -1,0 +1,130 @@
+// fig9: the paper's Fig. 9. For each critical time, a fresh run of the scene
+// from identical initial conditions is taken to the same moment of contact
+// as table1 (`--after` frames past first contact); there we write the dense
+// meshes and the spheres used for the contact response (COLLISIONLIST leaves
+// and untested PAIRLIST pairs) as VTU files, and a manifest.csv for
+// scripts/plot_fig9.py, which renders one panel per critical time.
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "experiments/paper/contact_moment.hpp"
+#include "icd/config.hpp"
+#include "mesh/io/atomic_write.hpp"
+#include "mesh/io/error.hpp"
+#include "mesh/io/vtk_writer.hpp"
+
+namespace fs = std::filesystem;
+using namespace icd;
+using namespace icd::runner;
+
+namespace {
+
+void usage() {
+  std::printf(
+      "usage: fig9 [--out DIR] [--scene FILE] [--budgets a,b,...] [--max-frames N] [--after N]\n"
+      "  Default: experiments/scenes/bunny_dragon.json, critical times 1e-4,1e-3,1e-2,1e-1 s,\n"
+      "  3 frames after first contact. Writes DIR/budget_<t>/*.vtu and DIR/manifest.csv.\n");
+}
+
+// The spheres of one side (0: object i, 1: object j) of pair p used for the response.
+void write_contact_spheres(World& world, size_t p, int side, const fs::path& path) {
+  const auto [i, j] = world.plan().pairs[p];
+  const collision::CollisionResult& r = world.results()[p];
+  const collision::SphereTree& tree = world.objects()[side ? j : i].asset.spheres;
+  std::vector<int> ids;
+  std::vector<double> leaf;
+  for (const auto* list : {&r.colliding, &r.untested})
+    for (const collision::NodePair& np : *list) {
+      ids.push_back(side ? np.b : np.a);
+      leaf.push_back(list == &r.colliding ? 1.0 : 0.0);
+    }
+  const auto n = static_cast<Eigen::Index>(ids.size());
+  SphereSet set{MatX3d(n, 3), Eigen::VectorXd(n)};
+  PointDataArray level{"level", Eigen::MatrixXd(n, 1)};
+  PointDataArray colliding{"colliding_leaf", Eigen::MatrixXd(n, 1)};
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const collision::Sphere& sp = tree.spheres[ids[k]];
+    set.centers.row(k) << sp.x, sp.y, sp.z;
+    set.radii[k] = sp.r;
+    level.values(k, 0) = tree.level[ids[k]];
+    colliding.values(k, 0) = leaf[k];
+  }
+  const PointDataArray arrays[] = {level, colliding};
+  write_vtu_sphere_set(path, set, arrays);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fs::path out = "results/fig9";
+  fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
+  std::string budgets_text = "1e-4,1e-3,1e-2,1e-1";
+  int max_frames = 200, after = 3;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--out" && i + 1 < argc) out = argv[++i];
+    else if (a == "--scene" && i + 1 < argc) scene_path = argv[++i];
+    else if (a == "--budgets" && i + 1 < argc) budgets_text = argv[++i];
+    else if (a == "--max-frames" && i + 1 < argc) max_frames = std::stoi(argv[++i]);
+    else if (a == "--after" && i + 1 < argc) after = std::stoi(argv[++i]);
+    else {
+      usage();
+      return a == "--help" || a == "-h" ? 0 : 2;
+    }
+  }
+  const fs::path cache = fs::path(ICD_SOURCE_DIR) / "assets";
+  const fs::path tools = fs::canonical("/proc/self/exe").parent_path();
+  std::ostringstream manifest;
+  manifest << "budget,dir,scene,contact_frame,frame,pair_list,collision_list,tests,completed_level,"
+              "objects,spheres\n";
+  try {
+    const std::vector<double> budgets = experiments::parse_list(budgets_text, "--budgets");
+    Scene scene = load_scene(scene_path);
+    scene.output = OutputSpec{};
+    scene.target_fps = 0;
+    scene.collision.budget_tests = -1;
+    fs::create_directories(out);
+    for (double budget : budgets) {
+      scene.collision.budget_seconds = budget;
+      World world(scene, cache, tools);
+      if (world.plan().pairs.empty()) throw InputError(scene_path.string() + ": no collision pair");
+      const experiments::ContactMoment cm = experiments::run_to_contact(world, max_frames, after);
+      if (cm.contact_frame < 0)
+        std::fprintf(stderr, "fig9: %s at %g s: no contact within %d frames (drawing the last)\n",
+                     scene.name.c_str(), budget, max_frames);
+      char dir[64];
+      std::snprintf(dir, sizeof dir, "budget_%g", budget);
+      fs::create_directories(out / dir);
+      std::string objects, spheres;
+      for (RuntimeObject& o : world.objects()) {
+        const std::string name = o.spec.name + "_dense.vtu";
+        write_vtu_surface_mesh(out / dir / name, SurfaceMesh{experiments::dense_positions(o), o.asset.dense.F});
+        objects += (objects.empty() ? "" : ";") + name;
+      }
+      // The first pair only (the paper's scenes have one).
+      for (int side = 0; side < 2; ++side) {
+        const auto [i, j] = world.plan().pairs[0];
+        const std::string name = world.objects()[side ? j : i].spec.name + "_contact_spheres.vtu";
+        write_contact_spheres(world, 0, side, out / dir / name);
+        spheres += (spheres.empty() ? "" : ";") + name;
+      }
+      const FrameMetrics& m = cm.frames.back();
+      manifest << budget << ',' << dir << ',' << scene.name << ',' << cm.contact_frame << ','
+               << cm.last_frame << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests
+               << ',' << m.completed_level << ',' << objects << ',' << spheres << '\n';
+      std::printf("%-14s budget %-7g contact frame %3d, drawn frame %3d: PAIRLIST %lld COLLISIONLIST %lld\n",
+                  scene.name.c_str(), budget, cm.contact_frame, cm.last_frame,
+                  static_cast<long long>(m.pair_list), static_cast<long long>(m.collision_list));
+      std::fflush(stdout);
+    }
+    write_file_atomically(out / "manifest.csv", manifest.str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fig9: %s\n", e.what());
+    return 1;
+  }
+  std::printf("results: %s\n", fs::absolute(out).c_str());
+  return 0;
+}
