@@ -1,6 +1,7 @@
 #include "fem/cholmod_solver.hpp"
 
 #include <cholmod.h>
+#include <dlfcn.h>
 
 #include <string>
 
@@ -42,6 +43,11 @@ void check_status(const cholmod_common& c, const char* call) {
 }  // namespace
 
 CholmodSolver::CholmodSolver(CholmodOrdering ordering) : m_impl(new Impl) {
+  // The supernodes of these FEM systems are small: threaded BLAS only spins
+  // (measured: 3x the wall time, most of it in sched_yield, on 2 shared cores).
+  // OpenBLAS is CHOLMOD's BLAS on Debian; looked up at run time, absent elsewhere.
+  using SetThreads = void (*)(int);
+  if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) set(1);
   cholmod_start(&m_impl->common);
   if (ordering != CholmodOrdering::Default) {
     m_impl->common.nmethods = 1;

@@ -16,6 +16,7 @@ enum class CholmodOrdering {
 
 /// Sparse symmetric positive definite solver. The matrix is given with both
 /// triangles (or at least the upper one); only the upper triangle is read.
+/// Constructing one sets OpenBLAS (if that is the BLAS in use) to one thread.
 class CholmodSolver {
  public:
   explicit CholmodSolver(CholmodOrdering ordering = CholmodOrdering::Default);
