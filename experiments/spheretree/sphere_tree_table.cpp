@@ -6,6 +6,7 @@
 // and the Hubbard octree baseline (4 levels) for the bunny and the dragon,
 // prints per-level metrics (normalized units: longest bounding-box side 2000),
 // and writes each tree as .sph and one VTU sphere set per level into RESULTS_DIR.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -74,6 +75,7 @@ int main(int argc, char** argv) {
   options.depth = 3;
   options.max_spheres_per_level = {1, 8, 64, 445};
   bool with_octree = true;
+  icd::mesh::EvaluationOptions evaluation;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const char* value = argv[i + 1];
@@ -82,8 +84,12 @@ int main(int argc, char** argv) {
     else if (key == "--medial-spacing") options.medial_spacing = std::atof(value);
     else if (key == "--cover-spacing") options.cover_spacing = std::atof(value);
     else if (key == "--joint") options.joint_leaf_refinement = std::atoi(value) != 0;
-    else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
+    else if (key == "--allocation") {
+      options.allocation = std::string(value) == "worst" ? icd::mesh::ChildAllocation::reduce_worst
+                                                         : icd::mesh::ChildAllocation::reduce_sum;
+    } else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
     else if (key == "--octree") with_octree = std::atoi(value) != 0;
+    else if (key == "--coverage-spacing") evaluation.coverage_spacing = std::atof(value);
     else {
       std::cerr << "unknown option " << key << "\n";
       return 2;
@@ -122,11 +128,23 @@ int main(int argc, char** argv) {
     const icd::collision::SphereTree octree = icd::collision::build_octree_tree(mesh.V, mesh.F, octree_options);
     const double octree_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    print_table(model.name, "medial", ours.seconds, icd::mesh::evaluate_sphere_tree(mesh, ours.tree));
-    if (with_octree) print_table(model.name, "octree", octree_s, icd::mesh::evaluate_sphere_tree(mesh, octree));
+    print_table(model.name, "medial", ours.seconds, icd::mesh::evaluate_sphere_tree(mesh, ours.tree, evaluation));
+    if (with_octree) print_table(model.name, "octree", octree_s, icd::mesh::evaluate_sphere_tree(mesh, octree, evaluation));
     std::printf("# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f s%s\n",
                 model.name.c_str(), static_cast<long long>(ours.samples.points.rows()), ours.num_medial_spheres,
                 ours.num_refinement_points, ours.medial_seconds, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+    // The builder's own error bound (radius - centre depth), normalized, per level.
+    const double to_2000 = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    for (int l = 0; l < ours.tree.num_levels(); ++l) {
+      double worst = 0, sum = 0;
+      const int begin = ours.tree.level_offset[static_cast<size_t>(l)], end = ours.tree.level_offset[static_cast<size_t>(l) + 1];
+      for (int i = begin; i < end; ++i) {
+        const double bound = to_2000 * (ours.tree.spheres[static_cast<size_t>(i)].r - ours.node_depth[static_cast<size_t>(i)]);
+        worst = std::max(worst, bound), sum += bound;
+      }
+      std::printf("# %s level %d: error bound r - depth: worst %.1f mean %.2f\n", model.name.c_str(), l, worst,
+                  sum / (end - begin));
+    }
     std::fflush(stdout);
     write_tree(results, model.name + "_medial", ours.tree);
     write_tree(results, model.name + "_octree", octree);

@@ -47,8 +47,8 @@ struct ParentChoices {
 };
 
 /// How many children each parent gets under a total cap: start with one each,
-/// then repeatedly give one more to the parent whose summed child error drops most.
-std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, int cap) {
+/// then repeatedly give one more to the parent chosen by `rule`.
+std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, int cap, ChildAllocation rule) {
   std::vector<int> count(choices.size(), 1);
   long long total = static_cast<long long>(choices.size());
   using Item = std::pair<double, size_t>;
@@ -57,6 +57,11 @@ std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, in
     const int k = count[p];
     const auto& cfg = choices[p].configs;
     if (k >= static_cast<int>(cfg.size())) return -1.0;
+    if (rule == ChildAllocation::reduce_worst) {
+      double worst = 0;
+      for (const auto& sp : cfg[static_cast<size_t>(k - 1)]) worst = std::max(worst, sp.error);
+      return worst;
+    }
     return ParentChoices::total_error(cfg[static_cast<size_t>(k - 1)]) -
            ParentChoices::total_error(cfg[static_cast<size_t>(k)]);
   };
@@ -218,7 +223,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       cap = std::min<long long>(cap, options.max_spheres_per_level[static_cast<size_t>(l)]);
     }
     cap = std::max<long long>(cap, static_cast<long long>(parents.size()));
-    const std::vector<int> count = allocate_children(choices, static_cast<int>(std::min<long long>(cap, 1LL << 30)));
+    const std::vector<int> count = allocate_children(choices, static_cast<int>(std::min<long long>(cap, 1LL << 30)), options.allocation);
 
     std::vector<Node> children;
     std::vector<int> parent_index;
