@@ -44,6 +44,7 @@ void print_help(const PreprocessOptions& d) {
       "  --facet-distance F         surface approximation bound, F * cell size [%g]\n"
       "  --sliver-bound DEG         dihedral angle targeted by perturb/exude [%g]\n"
       "  --spheres KIND             sphere-tree builder: medial (adaptive medial axis), octree, none [medial]\n"
+      "  --no-spheres               same as --spheres none\n"
       "  --sphere-depth D           sphere-tree levels below the root [%d]\n"
       "  --sphere-branching B       children per sphere [%d]\n"
       "  --sphere-time-limit S      wall-clock seconds for the medial-axis optimisation [none];\n"
@@ -134,6 +135,8 @@ Cli parse(int argc, char** argv) {
       } else {
         usage_error("--spheres must be medial, octree or none, got '" + k + "'");
       }
+    } else if (a == "--no-spheres") {
+      o.sphere_builder = icd::mesh::SphereBuilder::none;
     } else if (a == "--sphere-depth") {
       o.spheres.depth = to_int(a, value());
       o.octree.levels = o.spheres.depth + 1;

@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <iterator>
+#include <map>
 #include <set>
 #include <vector>
 #include <string>
@@ -71,7 +72,9 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
                           p::cell_radius_edge_ratio = o.radius_edge_bound, p::cell_size = size);
   C3t3 c3t3;
   seed(c3t3, domain, surface, o.facet_size_factor * size);
-  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude());
+  // manifold(): the boundary of the complex must be a manifold surface (thin
+  // parts otherwise yield boundary edges shared by four faces).
+  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::manifold());
   if (optimise && o.perturb) CGAL::perturb_mesh_3(c3t3, domain, p::sliver_bound = o.sliver_bound_deg);
   if (optimise && o.exude) CGAL::exude_mesh_3(c3t3, p::sliver_bound = o.sliver_bound_deg);
 
@@ -153,6 +156,23 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
   if (best.mesh.T.rows() == 0)
     throw InputError("tetrahedralize_surface: the mesher produced no tetrahedron (cell size " +
                      std::to_string(best.cell_size) + ")");
+  // The boundary must be a closed manifold surface (the coarse surface nodes
+  // and the collision surface rely on it): each directed edge exactly once,
+  // its reverse exactly once.
+  {
+    std::map<std::pair<int, int>, int> directed;
+    const MatX3i& F = best.mesh.F;
+    for (int f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++directed[{F(f, k), F(f, (k + 1) % 3)}];
+    for (const auto& [e, n] : directed) {
+      const auto rev = directed.find({e.second, e.first});
+      if (n != 1 || rev == directed.end() || rev->second != 1)
+        throw InputError("tetrahedralize_surface: the boundary of the tet mesh is not a closed manifold "
+                         "surface at the edge between nodes " + std::to_string(e.first) + " and " +
+                         std::to_string(e.second) + " (cell size " + std::to_string(best.cell_size) +
+                         "); try a smaller cell size or more tets");
+    }
+  }
   best.quality = tet_quality(best.mesh);
   return best;
 }

@@ -38,7 +38,8 @@ struct TetrahedralizeResult {
 /// Deterministic: CGAL's default random generator is reset to random_seed
 /// before each pass and the meshing runs sequentially without time limits.
 /// Throws ParameterError on bad options, InputError when the surface is not
-/// closed or the mesher produces no tet.
+/// closed, the mesher produces no tet, or the tet boundary is not a closed
+/// manifold surface (Mesh_3 runs with its manifold option, so this is a safeguard).
 TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
                                             const TetrahedralizeOptions& options = {});
 

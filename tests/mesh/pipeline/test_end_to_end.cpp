@@ -1,0 +1,76 @@
+// End-to-end preprocessing of a real mesh (the Chinese dragon: two holes and
+// self-intersections in the raw data), with the fast octree sphere builder.
+// Skipped when the mesh has not been fetched (scripts/fetch_meshes.sh).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "collision/sphere_tree.hpp"
+#include "coupling/asset_bundle.hpp"
+#include "icd/config.hpp"
+#include "mesh/io/primitives.hpp"
+#include "mesh/io/surface_reader.hpp"
+#include "mesh/pipeline/preprocess.hpp"
+#include "mesh/pipeline/pipeline_test_utils.hpp"
+
+namespace icd::mesh {
+namespace {
+
+std::filesystem::path data_dir() {
+  const char* env = std::getenv("ICD_DATA_DIR");
+  return env ? std::filesystem::path(env) : std::filesystem::path(ICD_DATA_DIR);
+}
+
+TEST(EndToEnd, DragonDefaultsWithOctreeSpheres) {
+  const auto path = data_dir() / "ChineseDragon-10kv.off";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " missing (run scripts/fetch_meshes.sh)";
+  const SurfaceMesh raw = read_surface_mesh(path);
+  PreprocessOptions o;
+  o.sphere_builder = SphereBuilder::octree;
+  const PreprocessResult r = preprocess(raw, o, {}, path.string());
+  const coupling::AssetBundle& b = r.bundle;
+
+  // Repair: the two holes are filled, the result is closed and outward.
+  EXPECT_EQ(r.repair.holes_filled, 2);
+  EXPECT_TRUE(test::closed_and_oriented(b.dense.F));
+  EXPECT_GT(test::enclosed_volume(b.dense.V, b.dense.F), 0.0);
+
+  // Coarse mesh: count near the target, valid and sliver-free.
+  EXPECT_NEAR(b.coarse.T.rows() / 2000.0, 1.0, 0.3);
+  EXPECT_GT(signed_tet_volumes(b.coarse.V, b.coarse.T).minCoeff(), 0.0);
+  EXPECT_TRUE(test::closed_and_oriented(b.coarse.F));
+  EXPECT_GT(r.quality.min_dihedral_deg, 5.0);
+  // The coarse volume is close to the dense one (within 5%).
+  EXPECT_NEAR(r.quality.total_volume / test::enclosed_volume(b.dense.V, b.dense.F), 1.0, 0.05);
+  EXPECT_LT(r.hausdorff_dense_coarse, 0.05 * r.bbox_diagonal);
+
+  // Links reproduce the dense mesh at rest and under a rigid motion.
+  MatX3d out(b.dense.V.rows(), 3);
+  coupling::apply(b.links, b.coarse.V, out);
+  EXPECT_LT((out - b.dense.V).rowwise().norm().maxCoeff(), 1e-12 * r.bbox_diagonal);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -1, 0.5).normalized()).toRotationMatrix();
+  const Eigen::RowVector3d t(100, -50, 20);
+  const MatX3d moved = (b.coarse.V * R.transpose()).rowwise() + t;
+  coupling::apply(b.links, moved, out);
+  const MatX3d expected = (b.dense.V * R.transpose()).rowwise() + t;
+  EXPECT_LT((out - expected).rowwise().norm().maxCoeff(), 1e-12 * (r.bbox_diagonal + t.norm()));
+
+  // Sphere tree with an association for every sphere; the bundle round-trips.
+  ASSERT_GT(b.spheres.num_nodes(), 1);
+  EXPECT_NO_THROW(collision::validate(b.spheres));
+  for (int i = 0; i < b.spheres.num_nodes(); ++i)
+    EXPECT_GT(b.spheres.assoc_offset[i + 1], b.spheres.assoc_offset[i]) << "sphere " << i;
+  const auto dir = std::filesystem::path(::testing::TempDir()) / "icd_e2e_dragon";
+  std::filesystem::remove_all(dir);
+  coupling::write_asset_bundle(dir, b);
+  const coupling::AssetBundle loaded = coupling::read_asset_bundle(dir);
+  EXPECT_TRUE(loaded.links.coeffs == b.links.coeffs);
+  EXPECT_TRUE(loaded.coarse.V == b.coarse.V);
+  for (const auto& st : r.times) std::cout << "  " << st.stage << ": " << st.seconds << " s (cpu " << st.cpu_seconds << " s)\n";
+}
+
+}  // namespace
+}  // namespace icd::mesh
