@@ -31,7 +31,8 @@ def plot_contact(path, out):
     rows = read(path)
     modes = list(dict.fromkeys(r["mode"] for r in rows))
     fig, axes = plt.subplots(2, 2, figsize=(12, 8.5))
-    panels = [("force_rel_error", "relative error of the total contact force\n|F - F_full| / |F_full|", "symlog"),
+    panels = [("force_rel_error", "relative error of the total contact force\n|F - F_full| / |F_full|"
+               " (< 1e-4 drawn at 1e-4)", "log"),
               ("recall_exact", "recall of the exact contact region\n(exact triangle pairs under a reported pair)", None),
               ("false_positive", "false positives\n(reported pairs with no exact triangle pair)", None),
               ("volume_ratio", "looseness: volume of reported spheres\n/ volume for the full traversal", "log")]
@@ -44,14 +45,15 @@ def plot_contact(path, out):
                     continue
                 t = col(sel, "seconds") * 1e6
                 order = np.argsort(t)
-                ax.plot(t[order], col(sel, key)[order], marker=marker, ls=ls, color=c, ms=4,
+                y = col(sel, key)
+                if yscale == "log":
+                    y = np.maximum(y, 1e-4)
+                ax.plot(t[order], y[order], marker=marker, ls=ls, color=c, ms=4,
                         label=f"{mode} ({'time' if kind == 'seconds' else 'test'} budgets)")
         full_us = float(rows[0]["full_seconds"]) * 1e6
         ax.axvline(full_us, color="k", lw=0.8, ls="--", label="uninterrupted traversal time")
         ax.set_xscale("log")
-        if yscale == "symlog":
-            ax.set_yscale("symlog", linthresh=1e-3)
-        elif yscale == "log":
+        if yscale == "log":
             ax.set_yscale("log")
         ax.set_xlabel("time spent in the collision query (µs, median of the repetitions)")
         ax.set_ylabel(label)
@@ -69,11 +71,12 @@ def plot_deformation(links_path, res_path, out):
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
     if os.path.exists(links_path):
         rows = read(links_path)
-        for obj in dict.fromkeys(r["object"] for r in rows):
+        for k, obj in enumerate(dict.fromkeys(r["object"] for r in rows)):
             sel = [r for r in rows if r["object"] == obj]
             f = col(sel, "frame")
-            axes[0].plot(f, col(sel, "rms_error_pct_bbox"), label=f"{obj}: RMS")
-            axes[0].plot(f, col(sel, "max_error_pct_bbox"), ls="--", label=f"{obj}: max")
+            c = plt.cm.tab10(k)
+            axes[0].plot(f, col(sel, "rms_error_pct_bbox"), color=c, label=f"{obj}: RMS")
+            axes[0].plot(f, col(sel, "max_error_pct_bbox"), color=c, ls="--", label=f"{obj}: max")
             tl, tb = np.median(col(sel, "links_seconds")) * 1e3, np.median(col(sel, "barycentric_seconds")) * 1e3
             e = np.median(col(sel, "rms_error_pct_bbox"))
             axes[1].scatter([tl], [e], marker="o", label=f"{obj}: rigid links ({sel[0]['dense_vertices']} vertices)")

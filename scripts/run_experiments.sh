@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# Regenerates every table and plot of issue 8 into results/experiments/ with
+# an index.md: Table 1, Fig. 9, error against run time (contact, deformation,
+# sphere update), the stability sweep, and the FEM / collision experiments'
+# outputs when their programs exist. Builds build/release (Release, -j2).
+#
+# usage: scripts/run_experiments.sh [--quick] [--no-build]
+#   --quick     reduced sweeps (fewer budgets, frames and cases), a few minutes
+#   --no-build  use the binaries already in build/release
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+quick=0
+build_it=1
+for a in "$@"; do
+  case "$a" in
+    --quick) quick=1 ;;
+    --no-build) build_it=0 ;;
+    -h|--help) sed -n 2,10p "$0"; exit 0 ;;
+    *) echo "run_experiments.sh: unknown argument $a" >&2; exit 2 ;;
+  esac
+done
+build="$root/build/release"
+out="$root/results/experiments"
+py=/usr/bin/python3
+mkdir -p "$out"
+log="$out/run.log"
+: > "$log"
+say() { echo "== $*" | tee -a "$log"; }
+
+if [ "$build_it" = 1 ]; then
+  say "building $build"
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DICD_BUILD_TESTS=OFF -DICD_BUILD_BENCHMARKS=OFF >>"$log"
+  targets="table1 fig9 contact_error deformation_error sphere_update_error stability_sweep icd-preprocess"
+  # Other engineers' experiment programs, when they exist in this build.
+  for t in fem_error_vs_time icd_collision_accuracy sphere_tree_table; do
+    if ninja -C "$build" -t targets all 2>/dev/null | grep -q "^$t:"; then targets="$targets $t"; fi
+  done
+  cmake --build "$build" -j2 --target $targets >>"$log"
+fi
+bin="$build/bin"
+start=$(date +%s)
+status=()
+run_step() {  # name, command...: runs, records ok/failed (a failed step does not stop the others)
+  local name=$1; shift
+  say "$name: $*"
+  local t0=$(date +%s)
+  if "$@" >>"$log" 2>&1; then status+=("| $name | ok | $(( $(date +%s) - t0 )) s |")
+  else status+=("| $name | FAILED (see run.log) | $(( $(date +%s) - t0 )) s |"); fi
+}
+
+if [ "$quick" = 1 ]; then
+  run_step table1 "$bin/table1" --out "$out/table1" --budgets 1e-4,1e-2,1 --max-frames 120
+  run_step fig9 "$bin/fig9" --out "$out/fig9" --budgets 1e-4,1e-3,1e-2,1e-1 --max-frames 120
+  run_step contact_error "$bin/contact_error" --out "$out/contact_error" --budgets 1e-5,1e-4,1e-3 \
+    --test-budgets 100,1000,10000,1000000 --reps 3
+  run_step deformation_error "$bin/deformation_error" --out "$out/deformation_error" --frames 20 --cells 2,4 --fine 8
+  run_step sphere_update "$bin/sphere_update_error" --out "$out/sphere_update" --frames 30 --every 3
+  run_step stability "$bin/stability_sweep" --out "$out/stability" --quick --frames 30 --max-seconds 30
+else
+  run_step table1 "$bin/table1" --out "$out/table1"
+  run_step fig9 "$bin/fig9" --out "$out/fig9"
+  run_step contact_error "$bin/contact_error" --out "$out/contact_error"
+  run_step deformation_error "$bin/deformation_error" --out "$out/deformation_error"
+  run_step sphere_update "$bin/sphere_update_error" --out "$out/sphere_update" --frames 60 --every 2
+  run_step stability "$bin/stability_sweep" --out "$out/stability" --max-seconds 60
+fi
+run_step plot_fig9 "$py" "$root/scripts/plot_fig9.py" "$out/fig9" --out "$out/fig9/fig9.png"
+run_step plot_error_vs_time "$py" "$root/scripts/plot_error_vs_time.py" "$out"
+
+# Other engineers' experiments, reused rather than duplicated.
+fem_prog=$(find "$build/experiments/fem" -maxdepth 1 -name fem_error_vs_time -type f 2>/dev/null | head -1)
+if [ -n "$fem_prog" ]; then
+  mkdir -p "$out/fem"
+  q=(); [ "$quick" = 1 ] && q=(--quick)
+  run_step fem_error_vs_time "$fem_prog" "${q[@]}" "$out/fem/fem_error_vs_time.csv"
+  run_step plot_fem "$py" "$root/experiments/fem/plot_fem_error_vs_time.py" "$out/fem/fem_error_vs_time.csv" \
+    "$out/fem/fem_error_vs_time.png"
+fi
+col_prog=$(find "$build/experiments/collision" -maxdepth 1 -name icd_collision_accuracy -type f 2>/dev/null | head -1)
+if [ -n "$col_prog" ] && [ "$quick" = 0 ]; then
+  mkdir -p "$out/collision"
+  run_step collision_accuracy sh -c "'$col_prog' > '$out/collision/accuracy.txt'"
+fi
+
+"$py" "$root/scripts/plot_index.py" "$out" "$(( $(date +%s) - start ))" "$quick" "${status[@]}"
+say "done: $out/index.md ($(( $(date +%s) - start )) s)"
