@@ -97,7 +97,7 @@ std::vector<Case> make_cases(bool quick) {
     cases.push_back({"penalty", buf, [k](Scene& s) { s.collision.contact.stiffness = k; }, 0});
   }
   for (double v : quick ? std::vector<double>{20} : std::vector<double>{2, 5, 10, 20}) {
-    std::snprintf(buf, sizeof buf, "|v| = %g m/s each", v);
+    std::snprintf(buf, sizeof buf, "speed %g m/s each, head-on", v);
     cases.push_back({"velocity", buf, [v](Scene& s) {
                        s.objects[0].velocity = Eigen::Vector3d(v, 0, 0);
                        s.objects[1].velocity = Eigen::Vector3d(-v, 0, 0);
