@@ -110,7 +110,9 @@ def main():
         ax.set_yticks([])
         ax.set_title(f"critical time {float(row['budget']):g} s\n"
                      f"PAIRLIST {row['pair_list']}, COLLISIONLIST {row['collision_list']}\n"
-                     f"(frame {row['frame']}, completed level {row['completed_level']})", fontsize=9)
+                     f"(frame {row['frame']}, completed level {row['completed_level']})"
+                     + ("\nFEM FAILED after this frame (see manifest.csv)" if row.get("failure") else ""),
+                     fontsize=9, color="darkred" if row.get("failure") else "black")
     handles = [plt.Rectangle((0, 0), 1, 1, facecolor=(1, 0, 0, 0.75), edgecolor=(0.5, 0, 0)),
                plt.Rectangle((0, 0), 1, 1, facecolor=(1, 0, 0, 0.08), edgecolor=(0.8, 0, 0), linestyle="--")]
     fig.legend(handles, ["colliding leaf spheres (COLLISIONLIST)",

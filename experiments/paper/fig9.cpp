@@ -4,6 +4,7 @@
 // meshes and the spheres used for the contact response (COLLISIONLIST leaves
 // and untested PAIRLIST pairs) as VTU files, and a manifest.csv for
 // scripts/plot_fig9.py, which renders one panel per critical time.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -80,7 +81,7 @@ int main(int argc, char** argv) {
   const fs::path tools = fs::canonical("/proc/self/exe").parent_path();
   std::ostringstream manifest;
   manifest << "budget,dir,scene,contact_frame,frame,pair_list,collision_list,tests,completed_level,"
-              "objects,spheres\n";
+              "objects,spheres,failure\n";
   try {
     const std::vector<double> budgets = experiments::parse_list(budgets_text, "--budgets");
     Scene scene = load_scene(scene_path);
@@ -88,12 +89,12 @@ int main(int argc, char** argv) {
     scene.target_fps = 0;
     scene.collision.budget_tests = -1;
     fs::create_directories(out);
-    // The moment: `after` frames past first contact in the uninterrupted run,
-    // the same frame index for every budget (a coarse answer reports contact
-    // earlier, so per-run contact frames would differ).
+    // The moment: `after` frames past first contact in the run with the
+    // largest budget, the same frame index for every budget (a coarse answer
+    // reports contact earlier, so per-run contact frames would differ).
     int frame = -1;
     {
-      scene.collision.budget_seconds = std::numeric_limits<double>::infinity();
+      scene.collision.budget_seconds = *std::max_element(budgets.begin(), budgets.end());
       World reference(scene, cache, tools);
       if (reference.plan().pairs.empty()) throw InputError(scene_path.string() + ": no collision pair");
       const experiments::ContactMoment cm = experiments::run_to_contact(reference, max_frames, after);
@@ -105,10 +106,20 @@ int main(int argc, char** argv) {
       scene.collision.budget_seconds = budget;
       World world(scene, cache, tools);
       experiments::ContactMoment cm;
-      for (int f = 0; f <= frame; ++f) {
-        cm.frames.push_back(world.step());
-        if (cm.contact_frame < 0 && cm.frames.back().active_pairs > 0) cm.contact_frame = f;
-        cm.last_frame = f;
+      std::string failure;
+      try {
+        for (int f = 0; f <= frame; ++f) {
+          cm.frames.push_back(world.step());
+          if (cm.contact_frame < 0 && cm.frames.back().active_pairs > 0) cm.contact_frame = f;
+          cm.last_frame = f;
+        }
+      } catch (const std::exception& e) {
+        // Drawn anyway (the last completed frame), with the failure in the manifest.
+        failure = e.what();
+        std::replace(failure.begin(), failure.end(), ',', ';');
+        std::replace(failure.begin(), failure.end(), '\n', ' ');
+        std::fprintf(stderr, "fig9: budget %g s: %s\n", budget, e.what());
+        if (cm.frames.empty()) throw;
       }
       char dir[64];
       std::snprintf(dir, sizeof dir, "budget_%g", budget);
@@ -129,7 +140,7 @@ int main(int argc, char** argv) {
       const FrameMetrics& m = cm.frames.back();
       manifest << budget << ',' << dir << ',' << scene.name << ',' << cm.contact_frame << ','
                << cm.last_frame << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests
-               << ',' << m.completed_level << ',' << objects << ',' << spheres << '\n';
+               << ',' << m.completed_level << ',' << objects << ',' << spheres << ',' << failure << '\n';
       std::printf("%-14s budget %-7g contact frame %3d, drawn frame %3d: PAIRLIST %lld COLLISIONLIST %lld\n",
                   scene.name.c_str(), budget, cm.contact_frame, cm.last_frame,
                   static_cast<long long>(m.pair_list), static_cast<long long>(m.collision_list));
