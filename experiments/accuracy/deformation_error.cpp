@@ -65,7 +65,15 @@ void links_vs_barycentric(const Scene& scene, int frames, int reps, std::ostring
     diag.push_back(bbox_diagonal(o.asset.dense.V));
   }
   for (int f = 0; f < frames; ++f) {
-    const FrameMetrics m = world.step();
+    FrameMetrics m;
+    try {
+      m = world.step();
+    } catch (const std::exception& e) {
+      // Keep the frames measured so far; the failure is the simulation's, not the mapping's.
+      std::fprintf(stderr, "deformation_error: %s stopped at frame %d (links rows kept): %s\n",
+                   scene.name.c_str(), f, e.what());
+      return;
+    }
     for (size_t k = 0; k < world.objects().size(); ++k) {
       const RuntimeObject& o = world.objects()[k];
       if (!o.sim) continue;  // rigid and static objects do not deform
