@@ -77,7 +77,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("fig9_dir")
     ap.add_argument("--out", default=None, help="PNG path (default FIG9_DIR/fig9.png)")
-    ap.add_argument("--max-faces", type=int, default=30000, help="faces drawn per mesh")
+    ap.add_argument("--max-faces", type=int, default=100000, help="faces drawn per mesh (random subset above)")
     ap.add_argument("--azimuth", type=float, default=20.0, help="view azimuth about +y, degrees")
     ap.add_argument("--elevation", type=float, default=15.0, help="view elevation, degrees")
     args = ap.parse_args()
