@@ -19,8 +19,8 @@ for a in "$@"; do
     *) echo "run_experiments.sh: unknown argument $a" >&2; exit 2 ;;
   esac
 done
-build="$root/build/release"
-out="$root/results/experiments"
+build="${ICD_BUILD_DIR:-$root/build/release}"     # override: ICD_BUILD_DIR
+out="${ICD_RESULTS_DIR:-$root/results/experiments}"  # override: ICD_RESULTS_DIR
 py=/usr/bin/python3
 mkdir -p "$out"
 log="$out/run.log"

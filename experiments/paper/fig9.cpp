@@ -97,10 +97,20 @@ int main(int argc, char** argv) {
       scene.collision.budget_seconds = *std::max_element(budgets.begin(), budgets.end());
       World reference(scene, cache, tools);
       if (reference.plan().pairs.empty()) throw InputError(scene_path.string() + ": no collision pair");
-      const experiments::ContactMoment cm = experiments::run_to_contact(reference, max_frames, after);
-      if (cm.contact_frame < 0)
+      int contact = -1;
+      try {
+        for (int f = 0; f < max_frames && (contact < 0 || f <= contact + after); ++f) {
+          if (reference.step().active_pairs > 0 && contact < 0) contact = f;
+          frame = f;
+        }
+      } catch (const std::exception& e) {
+        // A simulation that fails after contact: draw its last completed frame.
+        if (contact < 0) throw;
+        std::fprintf(stderr, "fig9: reference run failed after frame %d (drawing that frame): %s\n", frame,
+                     e.what());
+      }
+      if (contact < 0)
         throw InputError(scene_path.string() + ": no contact within " + std::to_string(max_frames) + " frames");
-      frame = cm.last_frame;
     }
     for (double budget : budgets) {
       scene.collision.budget_seconds = budget;
