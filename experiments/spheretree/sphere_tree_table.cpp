@@ -1,5 +1,6 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
+//                   [--worst-share F] [--coverage-spacing UNITS]
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -8,6 +9,7 @@
 // and writes each tree as .sph and one VTU sphere set per level into RESULTS_DIR.
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -65,7 +67,8 @@ void print_table(const std::string& model, const std::string& method, double sec
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
-                 " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]\n";
+                 " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
+                 " [--worst-share F] [--coverage-spacing UNITS]\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -84,10 +87,8 @@ int main(int argc, char** argv) {
     else if (key == "--medial-spacing") options.medial_spacing = std::atof(value);
     else if (key == "--cover-spacing") options.cover_spacing = std::atof(value);
     else if (key == "--joint") options.joint_leaf_refinement = std::atoi(value) != 0;
-    else if (key == "--allocation") {
-      options.allocation = std::string(value) == "worst" ? icd::mesh::ChildAllocation::reduce_worst
-                                                         : icd::mesh::ChildAllocation::reduce_sum;
-    } else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
+    else if (key == "--worst-share") options.worst_share = std::atof(value);
+    else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
     else if (key == "--octree") with_octree = std::atoi(value) != 0;
     else if (key == "--coverage-spacing") evaluation.coverage_spacing = std::atof(value);
     else {
@@ -119,7 +120,9 @@ int main(int argc, char** argv) {
     }
     const icd::SurfaceMesh mesh = icd::read_surface_mesh(path);
 
+    const std::clock_t cpu0 = std::clock();
     const icd::mesh::SphereTreeBuild ours = icd::mesh::build_sphere_tree(mesh, options);
+    const double build_cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
     icd::collision::validate(ours.tree);
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -130,9 +133,9 @@ int main(int argc, char** argv) {
 
     print_table(model.name, "medial", ours.seconds, icd::mesh::evaluate_sphere_tree(mesh, ours.tree, evaluation));
     if (with_octree) print_table(model.name, "octree", octree_s, icd::mesh::evaluate_sphere_tree(mesh, octree, evaluation));
-    std::printf("# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f s%s\n",
+    std::printf("# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f s, build CPU time %.1f s%s\n",
                 model.name.c_str(), static_cast<long long>(ours.samples.points.rows()), ours.num_medial_spheres,
-                ours.num_refinement_points, ours.medial_seconds, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+                ours.num_refinement_points, ours.medial_seconds, build_cpu_s, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // The builder's own error bound (radius - centre depth), normalized, per level.
     const double to_2000 = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
     for (int l = 0; l < ours.tree.num_levels(); ++l) {

@@ -27,6 +27,7 @@ void check_options(const SphereTreeOptions& o) {
   if (o.refinement_iterations < 0) fail("refinement_iterations must be >= 0");
   if (!(o.refinement_tolerance > 0)) fail("refinement_tolerance must be > 0");
   if (o.lloyd_iterations < 0) fail("lloyd_iterations must be >= 0");
+  if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
 }
 
@@ -46,35 +47,40 @@ struct ParentChoices {
   }
 };
 
-/// How many children each parent gets under a total cap: start with one each,
-/// then repeatedly give one more to the parent chosen by `rule`.
-std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, int cap, ChildAllocation rule) {
+/// How many children each parent gets under a total cap: start with one
+/// each; give the first (1 - worst_share) of the extra spheres, one at a time,
+/// to the parent whose summed child error drops most, then the rest to the
+/// parent whose worst child error is largest.
+std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, int cap, double worst_share) {
   std::vector<int> count(choices.size(), 1);
-  long long total = static_cast<long long>(choices.size());
-  using Item = std::pair<double, size_t>;
-  std::priority_queue<Item> heap;
-  auto gain = [&](size_t p) {
-    const int k = count[p];
-    const auto& cfg = choices[p].configs;
-    if (k >= static_cast<int>(cfg.size())) return -1.0;
-    if (rule == ChildAllocation::reduce_worst) {
-      double worst = 0;
-      for (const auto& sp : cfg[static_cast<size_t>(k - 1)]) worst = std::max(worst, sp.error);
-      return worst;
+  const long long extra = std::max<long long>(0, cap - static_cast<long long>(choices.size()));
+  const auto by_worst = static_cast<long long>(std::llround(worst_share * static_cast<double>(extra)));
+  auto run = [&](long long n, bool worst_rule) {
+    auto gain = [&](size_t p) {
+      const int k = count[p];
+      const auto& cfg = choices[p].configs;
+      if (k >= static_cast<int>(cfg.size())) return -1.0;
+      if (worst_rule) {
+        double worst = 0;
+        for (const auto& sp : cfg[static_cast<size_t>(k - 1)]) worst = std::max(worst, sp.error);
+        return worst;
+      }
+      return ParentChoices::total_error(cfg[static_cast<size_t>(k - 1)]) -
+             ParentChoices::total_error(cfg[static_cast<size_t>(k)]);
+    };
+    std::priority_queue<std::pair<double, size_t>> heap;
+    for (size_t p = 0; p < choices.size(); ++p) heap.emplace(gain(p), p);
+    while (n > 0 && !heap.empty()) {
+      const size_t p = heap.top().second;
+      heap.pop();
+      if (count[p] >= static_cast<int>(choices[p].configs.size())) continue;
+      count[p] += 1;
+      --n;
+      heap.emplace(gain(p), p);
     }
-    return ParentChoices::total_error(cfg[static_cast<size_t>(k - 1)]) -
-           ParentChoices::total_error(cfg[static_cast<size_t>(k)]);
   };
-  for (size_t p = 0; p < choices.size(); ++p) heap.emplace(gain(p), p);
-  while (total < cap && !heap.empty()) {
-    const auto [g, p] = heap.top();
-    heap.pop();
-    if (count[p] >= static_cast<int>(choices[p].configs.size())) continue;
-    (void)g;
-    count[p] += 1;
-    ++total;
-    heap.emplace(gain(p), p);
-  }
+  run(extra - by_worst, false);
+  run(by_worst, true);
   return count;
 }
 
@@ -223,7 +229,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       cap = std::min<long long>(cap, options.max_spheres_per_level[static_cast<size_t>(l)]);
     }
     cap = std::max<long long>(cap, static_cast<long long>(parents.size()));
-    const std::vector<int> count = allocate_children(choices, static_cast<int>(std::min<long long>(cap, 1LL << 30)), options.allocation);
+    const std::vector<int> count = allocate_children(choices, static_cast<int>(std::min<long long>(cap, 1LL << 30)), options.worst_share);
 
     std::vector<Node> children;
     std::vector<int> parent_index;

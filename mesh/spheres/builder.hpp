@@ -10,12 +10,6 @@
 
 namespace icd::mesh {
 
-/// How a per-level sphere cap is shared among the parents of that level.
-enum class ChildAllocation {
-  reduce_sum,    ///< next child to the parent whose summed child error drops most (favours the mean)
-  reduce_worst,  ///< next child to the parent with the worst child error (favours the worst)
-};
-
 /// Options of build_sphere_tree(). Lengths are fractions of the longest side
 /// of the model's axis-aligned bounding box (so 0.001 is 2 units when that
 /// side is 2000), which makes the defaults independent of the model's scale.
@@ -30,7 +24,11 @@ struct SphereTreeOptions {
   /// missing or non-positive entry means branching^level). Extra spheres go
   /// where they lower the error most.
   std::vector<int> max_spheres_per_level;
-  ChildAllocation allocation = ChildAllocation::reduce_sum;  ///< how a cap is shared
+  /// How a cap is shared: the first (1 - worst_share) of the spheres beyond
+  /// one per parent go where the summed child error drops most (favours the
+  /// mean error), the rest to the parents with the worst child (favours the
+  /// worst error). In [0, 1].
+  double worst_share = 0.1;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;
