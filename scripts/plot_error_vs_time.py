@@ -3,7 +3,7 @@
 bin/contact_error, bin/deformation_error and bin/sphere_update_error.
 
 usage: /usr/bin/python3 scripts/plot_error_vs_time.py RESULTS_DIR
-  RESULTS_DIR/contact_error/contact_error.csv  -> contact_error.png
+  RESULTS_DIR/contact_error{,_spheres}/contact_error.csv  -> contact_error.png
   RESULTS_DIR/deformation_error/{links,resolution}.csv -> deformation_error.png
   RESULTS_DIR/sphere_update/sphere_update.csv -> sphere_update.png
 Missing inputs are reported and skipped. Offscreen (Agg).
@@ -147,12 +147,13 @@ def main():
         sys.exit(__doc__)
     d = sys.argv[1]
     done = 0
-    p = os.path.join(d, "contact_error", "contact_error.csv")
-    if os.path.exists(p):
-        plot_contact(p, os.path.join(d, "contact_error", "contact_error.png"))
-        done += 1
-    else:
-        print(f"plot_error_vs_time: {p} missing, skipped")
+    for sub in ("contact_error", "contact_error_spheres"):
+        p = os.path.join(d, sub, "contact_error.csv")
+        if os.path.exists(p):
+            plot_contact(p, os.path.join(d, sub, "contact_error.png"))
+            done += 1
+        else:
+            print(f"plot_error_vs_time: {p} missing, skipped")
     links = os.path.join(d, "deformation_error", "links.csv")
     res = os.path.join(d, "deformation_error", "resolution.csv")
     if os.path.exists(links) or os.path.exists(res):

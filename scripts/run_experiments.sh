@@ -61,6 +61,8 @@ if [ "$quick" = 1 ]; then
   run_step fig9 "$bin/fig9" --out "$out/fig9" --scene "$scenes/bunny_dragon.json" --max-frames 120
   run_step contact_error "$bin/contact_error" --out "$out/contact_error" --scene "$scenes/bunny_dragon.json" --budgets 1e-5,1e-4,1e-3 \
     --test-budgets 100,1000,10000,1000000 --reps 3
+  run_step contact_error_spheres "$bin/contact_error" --out "$out/contact_error_spheres" \
+    --scene "$scenes/two_spheres_soft.json" --after 5 --budgets 1e-6,1e-5,1e-4 --test-budgets 100,1000,10000,1000000 --reps 3
   run_step deformation_error "$bin/deformation_error" --out "$out/deformation_error" --scene "$scenes/bunny_dragon.json" \
     --frames 20 --cells 2,4 --fine 8
   run_step sphere_update "$bin/sphere_update_error" --out "$out/sphere_update" --frames 30 --every 3
@@ -70,6 +72,10 @@ else
     --scene "$scenes/bunny_bunny.json" --scene "$scenes/bunny_dragon.json"
   run_step fig9 "$bin/fig9" --out "$out/fig9" --scene "$scenes/bunny_dragon.json"
   run_step contact_error "$bin/contact_error" --out "$out/contact_error" --scene "$scenes/bunny_dragon.json" --reps 3
+  # A deeper contact (soft penalty, the dense surfaces interpenetrate): the exact
+  # triangle reference is not empty there, unlike at the bunny-dragon moment.
+  run_step contact_error_spheres "$bin/contact_error" --out "$out/contact_error_spheres" \
+    --scene "$scenes/two_spheres_soft.json" --after 5 --reps 3
   run_step deformation_error "$bin/deformation_error" --out "$out/deformation_error" --scene "$scenes/bunny_dragon.json" \
     --frames 30 --cells 2,3,4,6 --fine 8
   run_step sphere_update "$bin/sphere_update_error" --out "$out/sphere_update" --frames 60 --every 2
