@@ -30,8 +30,17 @@ constexpr std::size_t kHeaderBytes = 32, kSectionHeaderBytes = 32;
 
 // Layout of the "meta" section.
 enum Meta : int {
-  kDenseV, kDenseF, kCoarseV, kCoarseT, kSurfaceNodes, kLinks, kLinkCoarseNodes,
-  kSphereNodes, kLevelOffsets, kAssoc, kMetaSize
+  kDenseV,
+  kDenseF,
+  kCoarseV,
+  kCoarseT,
+  kSurfaceNodes,
+  kLinks,
+  kLinkCoarseNodes,
+  kSphereNodes,
+  kLevelOffsets,
+  kAssoc,
+  kMetaSize
 };
 
 template <class T>
@@ -95,16 +104,19 @@ class Reader {
       fail("not an icd asset bundle (bad magic)");
     }
     const char* h = m_bytes.data();
-    if (get<uint64_t>(h + 24) != fnv1a64(h, 24)) fail("header checksum mismatch: the file is corrupted");
+    if (get<uint64_t>(h + 24) != fnv1a64(h, 24))
+      fail("header checksum mismatch: the file is corrupted");
     const auto version = get<uint32_t>(h + 8);
     if (version != kBundleFormatVersion)
-      fail("format version " + std::to_string(version) + " is not supported (this build reads version " +
-           std::to_string(kBundleFormatVersion) + "); re-run icd-preprocess");
+      fail("format version " + std::to_string(version) +
+           " is not supported (this build reads version " + std::to_string(kBundleFormatVersion) +
+           "); re-run icd-preprocess");
     const auto sections = get<uint32_t>(h + 12);
     const auto total = get<uint64_t>(h + 16);
     if (total != m_bytes.size())
-      fail(std::string(total > m_bytes.size() ? "truncated" : "trailing data") + ": the header announces " +
-           std::to_string(total) + " bytes, the file has " + std::to_string(m_bytes.size()));
+      fail(std::string(total > m_bytes.size() ? "truncated" : "trailing data") +
+           ": the header announces " + std::to_string(total) + " bytes, the file has " +
+           std::to_string(m_bytes.size()));
     std::size_t pos = kHeaderBytes;
     for (uint32_t s = 0; s < sections; ++s) {
       if (m_bytes.size() - pos < kSectionHeaderBytes)
@@ -116,16 +128,18 @@ class Reader {
       sec.count = get<uint64_t>(p + 16);
       const auto checksum = get<uint64_t>(p + 24);
       for (std::size_t c = name.size(); c < 8; ++c)
-        if (p[c] != 0) fail("section " + std::to_string(s) + " has a malformed name: the file is corrupted");
-      if (get<uint32_t>(p + 12) != 0) fail("section '" + name + "' has a non-zero reserved field: the file is corrupted");
+        if (p[c] != 0)
+          fail("section " + std::to_string(s) + " has a malformed name: the file is corrupted");
+      if (get<uint32_t>(p + 12) != 0)
+        fail("section '" + name + "' has a non-zero reserved field: the file is corrupted");
       if (sec.type != kInt32 && sec.type != kFloat64)
         fail("section '" + name + "' has unknown element type " + std::to_string(sec.type));
       const uint64_t elem = sec.type == kInt32 ? 4 : 8;
       pos += kSectionHeaderBytes;
       if (sec.count > (m_bytes.size() - pos) / elem)
         fail("truncated: section '" + name + "' announces " + std::to_string(sec.count * elem) +
-             " bytes at offset " + std::to_string(pos) + ", only " + std::to_string(m_bytes.size() - pos) +
-             " remain");
+             " bytes at offset " + std::to_string(pos) + ", only " +
+             std::to_string(m_bytes.size() - pos) + " remain");
       sec.data = m_bytes.data() + pos;
       if (fnv1a64(sec.data, sec.count * elem) != checksum)
         fail("section '" + name + "' checksum mismatch: the file is corrupted");
@@ -138,21 +152,28 @@ class Reader {
   /// Copies section `name` (of type T and exactly `count` elements) into out.
   template <class T>
   void read(const char* name, uint64_t count, T* out) const {
+    const Section& s = check<T>(name, count);
+    if (count) std::memcpy(out, s.data, count * sizeof(T));
+  }
+  template <class T>
+  std::vector<T> read(const char* name, uint64_t count) const {
+    check<T>(name, count);  // before allocating: counts come from the file
+    std::vector<T> v(count);
+    read(name, count, v.data());
+    return v;
+  }
+  /// The section `name`, after checking that it has type T and `count` elements.
+  template <class T>
+  const Section& check(const char* name, uint64_t count) const {
     const auto it = m_sections.find(name);
     if (it == m_sections.end()) fail(std::string("section '") + name + "' is missing");
     const Section& s = it->second;
     if (s.type != (std::is_same_v<T, int32_t> ? kInt32 : kFloat64))
       fail(std::string("section '") + name + "' has the wrong element type");
     if (s.count != count)
-      fail(std::string("section '") + name + "' has " + std::to_string(s.count) + " elements, expected " +
-           std::to_string(count));
-    if (count) std::memcpy(out, s.data, count * sizeof(T));
-  }
-  template <class T>
-  std::vector<T> read(const char* name, uint64_t count) const {
-    std::vector<T> v(count);
-    read(name, count, v.data());
-    return v;
+      fail(std::string("section '") + name + "' has " + std::to_string(s.count) +
+           " elements, expected " + std::to_string(count));
+    return s;
   }
   uint64_t count(const char* name) const {
     const auto it = m_sections.find(name);
@@ -190,7 +211,8 @@ std::vector<double> flatten(const std::vector<collision::Sphere>& s) {
 
 std::vector<collision::Sphere> unflatten(const std::vector<double>& v) {
   std::vector<collision::Sphere> out(v.size() / 4);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]};
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = {v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]};
   return out;
 }
 
@@ -256,7 +278,8 @@ void write_asset_bundle(const std::filesystem::path& folder, const AssetBundle& 
   meta[kLevelOffsets] = static_cast<int32_t>(t.level_offset.size());
   meta[kAssoc] = static_cast<int32_t>(t.assoc_nodes.size());
   const auto fp = fingerprints(b.dense, b.coarse);
-  const std::vector<int32_t> surf(b.surface_nodes.data(), b.surface_nodes.data() + b.surface_nodes.size());
+  const std::vector<int32_t> surf(b.surface_nodes.data(),
+                                  b.surface_nodes.data() + b.surface_nodes.size());
 
   Writer w;
   w.section("meta", meta.data(), meta.size());
@@ -295,21 +318,26 @@ AssetBundle read_asset_bundle(const std::filesystem::path& folder) {
       fingerprints(b.dense, b.coarse) != fp) {
     std::ostringstream s;
     s << "the meshes in " << folder.string() << " do not match " << kBundleDataFile << " (recorded "
-      << meta[kDenseV] << "/" << meta[kDenseF] << " dense vertices/faces and " << meta[kCoarseV] << "/"
-      << meta[kCoarseT] << " coarse vertices/tets, found " << b.dense.V.rows() << "/" << b.dense.F.rows()
-      << " and " << b.coarse.V.rows() << "/" << b.coarse.T.rows()
+      << meta[kDenseV] << "/" << meta[kDenseF] << " dense vertices/faces and " << meta[kCoarseV]
+      << "/" << meta[kCoarseT] << " coarse vertices/tets, found " << b.dense.V.rows() << "/"
+      << b.dense.F.rows() << " and " << b.coarse.V.rows() << "/" << b.coarse.T.rows()
       << ", or different coordinates): files from different preprocessing runs?";
     r.fail(s.str());
   }
   const auto surf = r.read<int32_t>("surfnode", static_cast<uint64_t>(meta[kSurfaceNodes]));
   b.surface_nodes.resize(static_cast<Eigen::Index>(surf.size()));
   for (std::size_t i = 0; i < surf.size(); ++i) {
-    if (surf[i] < 0 || surf[i] >= meta[kCoarseV]) r.fail("surface node " + std::to_string(i) + " out of range");
+    if (surf[i] < 0 || surf[i] >= meta[kCoarseV])
+      r.fail("surface node " + std::to_string(i) + " out of range");
     b.surface_nodes[static_cast<Eigen::Index>(i)] = surf[i];
   }
   const int N = meta[kLinks];
-  if (N != meta[kDenseV]) r.fail("has " + std::to_string(N) + " links for " + std::to_string(meta[kDenseV]) + " dense vertices");
-  if (meta[kLinkCoarseNodes] != meta[kCoarseV]) r.fail("links refer to a coarse mesh of another size");
+  if (N != meta[kDenseV])
+    r.fail("has " + std::to_string(N) + " links for " + std::to_string(meta[kDenseV]) +
+           " dense vertices");
+  if (meta[kLinkCoarseNodes] != meta[kCoarseV])
+    r.fail("links refer to a coarse mesh of another size");
+  r.check<int32_t>("lnk_node", 3ull * N);  // before allocating
   b.links.nodes.resize(N, 3);
   b.links.alpha.resize(N, 3);
   b.links.coeffs.resize(N, 3);
@@ -337,7 +365,8 @@ AssetBundle read_asset_bundle(const std::filesystem::path& folder) {
       r.fail(std::string("invalid sphere tree: ") + e.what());
     }
     for (int32_t v : t.assoc_nodes)
-      if (v < 0 || v >= meta[kCoarseV]) r.fail("sphere association refers to coarse node " + std::to_string(v));
+      if (v < 0 || v >= meta[kCoarseV])
+        r.fail("sphere association refers to coarse node " + std::to_string(v));
   }
   return b;
 }

@@ -110,8 +110,8 @@ Eigen::Matrix3d frame(const Vec3& q0, const Vec3& q1, const Vec3& q2) {
 }
 
 bool collinear(const Vec3& q0, const Vec3& q1, const Vec3& q2, double tol) {
-  const double l2 = std::max({(q1 - q0).squaredNorm(), (q2 - q0).squaredNorm(),
-                              (q2 - q1).squaredNorm()});
+  const double l2 =
+      std::max({(q1 - q0).squaredNorm(), (q2 - q0).squaredNorm(), (q2 - q1).squaredNorm()});
   return !(l2 > 0.0) || (q1 - q0).cross(q2 - q0).norm() < tol * l2;
 }
 
@@ -138,8 +138,9 @@ RigidLinks build_rigid_links(const Eigen::Ref<const MatX3d>& P,
     if (v < 0 || v >= M)
       throw ParameterError("build_rigid_links: surface_nodes[" + std::to_string(s) + "] = " +
                            std::to_string(v) + " is outside [0, " + std::to_string(M) + ")");
-    if (seen[v]) throw ParameterError("build_rigid_links: surface node " + std::to_string(v) +
-                                      " is listed twice");
+    if (seen[v])
+      throw ParameterError("build_rigid_links: surface node " + std::to_string(v) +
+                           " is listed twice");
     seen[v] = 1;
     pts[s] = coarse_rest_positions.row(v).transpose();
   }
@@ -184,15 +185,15 @@ RigidLinks build_rigid_links(const Eigen::Ref<const MatX3d>& P,
       if (K == S)
         throw InputError("build_rigid_links: the " + std::to_string(S) +
                          " coarse surface nodes are all collinear or coincident; no link frame "
-                         "exists for dense vertex " + std::to_string(k));
+                         "exists for dense vertex " +
+                         std::to_string(k));
     }
     const Vec3 q[3] = {pts[chosen[0]], pts[chosen[1]], pts[chosen[2]]};
     double d[3];  // Eq. 2
     for (int i = 0; i < 3; ++i) d[i] = (q[i] - p).norm();
     const double denom = 2.0 * (d[0] + d[1] + d[2]);  // Eq. 3, normalised
     assert(denom > 0.0);
-    const double alpha[3] = {(d[1] + d[2]) / denom, (d[0] + d[2]) / denom,
-                             (d[0] + d[1]) / denom};
+    const double alpha[3] = {(d[1] + d[2]) / denom, (d[0] + d[2]) / denom, (d[0] + d[1]) / denom};
     const Vec3 O = alpha[0] * q[0] + alpha[1] * q[1] + alpha[2] * q[2];  // Eq. 1
     const Vec3 c = frame(q[0], q[1], q[2]).transpose() * (p - O);        // Eqs. 7-8
     for (int i = 0; i < 3; ++i) {

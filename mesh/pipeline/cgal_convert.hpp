@@ -24,10 +24,12 @@ inline bool to_cgal(const SurfaceMesh& in, CgalMesh& out) {
   out.reserve(static_cast<CgalMesh::size_type>(in.V.rows()),
               static_cast<CgalMesh::size_type>(3 * in.F.rows() / 2 + 3),
               static_cast<CgalMesh::size_type>(in.F.rows()));
-  for (Eigen::Index i = 0; i < in.V.rows(); ++i) out.add_vertex(Point(in.V(i, 0), in.V(i, 1), in.V(i, 2)));
+  for (Eigen::Index i = 0; i < in.V.rows(); ++i)
+    out.add_vertex(Point(in.V(i, 0), in.V(i, 1), in.V(i, 2)));
   for (Eigen::Index f = 0; f < in.F.rows(); ++f) {
-    const auto fd = out.add_face(CgalMesh::Vertex_index(in.F(f, 0)), CgalMesh::Vertex_index(in.F(f, 1)),
-                                 CgalMesh::Vertex_index(in.F(f, 2)));
+    const auto fd =
+        out.add_face(CgalMesh::Vertex_index(in.F(f, 0)), CgalMesh::Vertex_index(in.F(f, 1)),
+                     CgalMesh::Vertex_index(in.F(f, 2)));
     if (fd == CgalMesh::null_face()) return false;
   }
   return true;

@@ -35,7 +35,8 @@ double one_sided(const SurfaceMesh& from, const SurfaceMesh& to) {
   const auto probe = [&](const Point& p) { d2 = std::max(d2, tree.squared_distance(p)); };
   // Only vertices used by faces are samples (a tet mesh's interior nodes are not).
   for (int f = 0; f < from.F.rows(); ++f) {
-    const Point a = point(from, from.F(f, 0)), b = point(from, from.F(f, 1)), c = point(from, from.F(f, 2));
+    const Point a = point(from, from.F(f, 0)), b = point(from, from.F(f, 1)),
+                c = point(from, from.F(f, 2));
     probe(a);
     probe(b);
     probe(c);

@@ -17,7 +17,10 @@ using Clock = std::chrono::steady_clock;
 class StageTimer {
  public:
   StageTimer(PreprocessResult& r, const ProgressFn& progress, std::string stage)
-      : m_result(r), m_progress(progress), m_stage(std::move(stage)), m_start(Clock::now()),
+      : m_result(r),
+        m_progress(progress),
+        m_stage(std::move(stage)),
+        m_start(Clock::now()),
         m_cpu_start(std::clock()) {
     if (m_progress) m_progress(m_stage, "start");
   }
@@ -62,7 +65,8 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     SimplifyResult s = simplify_surface(b.dense, o.simplify);
     simplified = std::move(s.mesh);
     r.simplify = s.report;
-    t.done(std::to_string(r.simplify.input_faces) + " -> " + std::to_string(r.simplify.output_faces) + " faces");
+    t.done(std::to_string(r.simplify.input_faces) + " -> " +
+           std::to_string(r.simplify.output_faces) + " faces");
   }
   {
     StageTimer t(r, progress, "tetrahedralize");
@@ -75,8 +79,8 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     b.surface_nodes.resize(static_cast<Eigen::Index>(surf.size()));
     int i = 0;
     for (int v : surf) b.surface_nodes[i++] = v;
-    t.done(std::to_string(b.coarse.T.rows()) + " tets, " + std::to_string(surf.size()) + " surface nodes, " +
-           std::to_string(tet.passes) + " pass(es)");
+    t.done(std::to_string(b.coarse.T.rows()) + " tets, " + std::to_string(surf.size()) +
+           " surface nodes, " + std::to_string(tet.passes) + " pass(es)");
   }
   {
     StageTimer t(r, progress, "rigid links");
@@ -93,10 +97,12 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       b.spheres = collision::build_octree_tree(b.dense.V, b.dense.F, o.octree);
     }
     r.sphere_levels = b.spheres.num_levels();
-    const std::vector<int> cand(b.surface_nodes.data(), b.surface_nodes.data() + b.surface_nodes.size());
+    const std::vector<int> cand(b.surface_nodes.data(),
+                                b.surface_nodes.data() + b.surface_nodes.size());
     collision::associate_nearest_nodes(b.spheres, b.coarse.V, o.association, cand);
-    t.done(std::to_string(b.spheres.num_nodes()) + " spheres on " + std::to_string(r.sphere_levels) +
-           " levels" + (r.sphere_time_limit_hit ? " (time limit hit)" : ""));
+    t.done(std::to_string(b.spheres.num_nodes()) + " spheres on " +
+           std::to_string(r.sphere_levels) + " levels" +
+           (r.sphere_time_limit_hit ? " (time limit hit)" : ""));
   }
   if (o.compute_hausdorff) {
     StageTimer t(r, progress, "hausdorff");

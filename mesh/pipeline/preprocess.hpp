@@ -64,8 +64,8 @@ struct PreprocessResult {
   coupling::AssetBundle bundle;  ///< dense = repaired input surface
   RepairReport repair;
   SimplifyReport simplify;
-  TetQuality quality;            ///< of bundle.coarse
-  double cell_size = 0.0;        ///< Mesh_3 cell size that was kept
+  TetQuality quality;      ///< of bundle.coarse
+  double cell_size = 0.0;  ///< Mesh_3 cell size that was kept
   int mesher_passes = 0;
   int sphere_levels = 0;
   bool sphere_time_limit_hit = false;  ///< the builder stopped early: output may vary between runs

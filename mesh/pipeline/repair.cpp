@@ -52,8 +52,9 @@ double signed_volume(const CgalMesh& m) {
     auto h = m.halfedge(f);
     const Point &a = m.point(m.source(h)), &b = m.point(m.target(h)),
                 &c = m.point(m.target(m.next(h)));
-    vol += CGAL::scalar_product(a - CGAL::ORIGIN, CGAL::cross_product(b - CGAL::ORIGIN,
-                                                                       c - CGAL::ORIGIN)) / 6.0;
+    vol += CGAL::scalar_product(a - CGAL::ORIGIN,
+                                CGAL::cross_product(b - CGAL::ORIGIN, c - CGAL::ORIGIN)) /
+           6.0;
   }
   return vol;
 }
@@ -88,14 +89,17 @@ std::vector<Loop> boundary_loops(CgalMesh& m) {
 std::string RepairReport::to_string() const {
   std::ostringstream s;
   s << "input " << input_vertices << " vertices, " << input_faces << " faces\n";
-  if (merged_duplicate_vertices) s << "merged duplicate vertices: " << merged_duplicate_vertices << "\n";
-  if (removed_degenerate_faces) s << "removed degenerate faces: " << removed_degenerate_faces << "\n";
+  if (merged_duplicate_vertices)
+    s << "merged duplicate vertices: " << merged_duplicate_vertices << "\n";
+  if (removed_degenerate_faces)
+    s << "removed degenerate faces: " << removed_degenerate_faces << "\n";
   if (removed_duplicate_faces) s << "removed duplicate faces: " << removed_duplicate_faces << "\n";
   if (removed_unreferenced_vertices)
     s << "removed unreferenced vertices: " << removed_unreferenced_vertices << "\n";
   if (reoriented_faces) s << "re-oriented faces: " << reoriented_faces << "\n";
   if (reversed_to_outward) s << "reversed to face outward\n";
-  if (holes_filled) s << "filled holes: " << holes_filled << " (" << hole_faces_added << " faces)\n";
+  if (holes_filled)
+    s << "filled holes: " << holes_filled << " (" << hole_faces_added << " faces)\n";
   if (self_intersections_repaired)
     s << "repaired self-intersections: " << self_intersections_repaired << " face pair(s)\n";
   s << "output " << output_vertices << " vertices, " << output_faces << " faces, " << components
@@ -107,8 +111,9 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
                             const std::string& name) {
   if (options.max_hole_edges < 0 || !(options.max_hole_diameter >= 0.0) ||
       !(options.min_volume_fraction >= 0.0))
-    throw ParameterError("repair_surface: max_hole_edges, max_hole_diameter and "
-                         "min_volume_fraction must be >= 0");
+    throw ParameterError(
+        "repair_surface: max_hole_edges, max_hole_diameter and "
+        "min_volume_fraction must be >= 0");
   RepairResult result;
   RepairReport& rep = result.report;
   const int nv = static_cast<int>(input.V.rows());
@@ -125,15 +130,16 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
     for (int k = 0; k < 3; ++k)
       if (input.F(f, k) < 0 || input.F(f, k) >= nv)
         throw InputError(name + ": face " + std::to_string(f) + " refers to vertex " +
-                         std::to_string(input.F(f, k)) + ", outside [0, " + std::to_string(nv) + ")");
+                         std::to_string(input.F(f, k)) + ", outside [0, " + std::to_string(nv) +
+                         ")");
 
   // 1. Merge exactly duplicated vertices (first occurrence wins).
   std::map<std::array<double, 3>, int> unique;
   std::vector<int> remap(nv);
   std::vector<int> first_of;  // new index -> an original index
   for (int i = 0; i < nv; ++i) {
-    const auto [it, inserted] =
-        unique.try_emplace({input.V(i, 0), input.V(i, 1), input.V(i, 2)}, static_cast<int>(first_of.size()));
+    const auto [it, inserted] = unique.try_emplace({input.V(i, 0), input.V(i, 1), input.V(i, 2)},
+                                                   static_cast<int>(first_of.size()));
     if (inserted) first_of.push_back(i);
     remap[i] = it->second;
   }
@@ -196,7 +202,8 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
     cov += x * x.transpose();
   }
   cov /= static_cast<double>(points.size());
-  const double thickness = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues()[0]));
+  const double thickness = std::sqrt(
+      std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues()[0]));
   if (!(thickness > 1e-9 * diag))
     throw InputError(name + ": zero volume: all " + std::to_string(points.size()) +
                      " vertices lie in one plane (thickness " + std::to_string(thickness) +
@@ -215,15 +222,18 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
         if (bad++ == 0) {
           std::ostringstream s;
           s << "non-manifold edge between input vertices " << original_vertex[e.first] << " "
-            << fmt_point(Eigen::RowVector3d(points[e.first].x(), points[e.first].y(), points[e.first].z()))
-            << " and " << original_vertex[e.second] << " shared by " << fs.size() << " faces (input faces";
+            << fmt_point(Eigen::RowVector3d(points[e.first].x(), points[e.first].y(),
+                                            points[e.first].z()))
+            << " and " << original_vertex[e.second] << " shared by " << fs.size()
+            << " faces (input faces";
           for (int f : fs) s << " " << face_origin[f];
           s << ")";
           first = s.str();
         }
       }
     if (bad > 0)
-      throw InputError(name + ": " + first + (bad > 1 ? "; " + std::to_string(bad - 1) + " more" : ""));
+      throw InputError(name + ": " + first +
+                       (bad > 1 ? "; " + std::to_string(bad - 1) + " more" : ""));
   }
 
   // 6. Consistent orientation of the soup; it splits non-manifold vertices.
@@ -239,10 +249,10 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
     int orig = -1;
     for (size_t v = 0; v < n_points; ++v)
       if (points[v] == p) orig = original_vertex[v];
-    throw InputError(name + ": non-manifold vertex " + std::to_string(orig) + " at " + fmt_point(p) +
-                     " (its faces form " + std::to_string(points.size() - n_points + 1) +
-                     " separate fans); " + std::to_string(points.size() - n_points) +
-                     " vertex split(s) needed in total");
+    throw InputError(name + ": non-manifold vertex " + std::to_string(orig) + " at " +
+                     fmt_point(p) + " (its faces form " +
+                     std::to_string(points.size() - n_points + 1) + " separate fans); " +
+                     std::to_string(points.size() - n_points) + " vertex split(s) needed in total");
   }
   for (size_t f = 0; f < polygons.size(); ++f) {
     const auto& a = before[f];
@@ -283,13 +293,14 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
   {
     const std::vector<Loop> left = boundary_loops(mesh);
     if (!left.empty()) {
-      const auto big = std::max_element(left.begin(), left.end(),
-                                        [](const Loop& a, const Loop& b) { return a.edges < b.edges; });
+      const auto big = std::max_element(
+          left.begin(), left.end(), [](const Loop& a, const Loop& b) { return a.edges < b.edges; });
       std::ostringstream s;
       s << name << ": open surface: " << left.size() << " boundary loop(s) remain after filling "
-        << rep.holes_filled << " small hole(s); the largest has " << big->edges << " edges and diameter "
-        << big->diameter << " (limits: " << options.max_hole_edges << " edges, "
-        << options.max_hole_diameter * diag << ") and passes through " << fmt_point(mesh.point(mesh.source(big->h)));
+        << rep.holes_filled << " small hole(s); the largest has " << big->edges
+        << " edges and diameter " << big->diameter << " (limits: " << options.max_hole_edges
+        << " edges, " << options.max_hole_diameter * diag << ") and passes through "
+        << fmt_point(mesh.point(mesh.source(big->h)));
       throw InputError(s.str());
     }
   }
@@ -305,7 +316,8 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
     if (options.remove_self_intersections) {
       PMP::experimental::remove_self_intersections(mesh);
       mesh.collect_garbage();
-      repaired = CGAL::is_closed(mesh) && CGAL::is_valid_polygon_mesh(mesh) && !PMP::does_self_intersect(mesh);
+      repaired = CGAL::is_closed(mesh) && CGAL::is_valid_polygon_mesh(mesh) &&
+                 !PMP::does_self_intersect(mesh);
     }
     if (repaired) {
       rep.self_intersections_repaired = static_cast<int>(found);
@@ -315,15 +327,17 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
       std::ostringstream s;
       s << name << ": the surface intersects itself: " << found << " intersecting face pair(s)";
       if (options.remove_self_intersections)
-        s << "; local repair left " << pairs.size() << (CGAL::is_closed(mesh) ? "" : " and opened the surface");
+        s << "; local repair left " << pairs.size()
+          << (CGAL::is_closed(mesh) ? "" : " and opened the surface");
       if (!pairs.empty()) {
         const auto centroid = [&](CgalMesh::Face_index f) {
           auto h = mesh.halfedge(f);
           return CGAL::centroid(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)),
                                 mesh.point(mesh.target(mesh.next(h))));
         };
-        s << ", e.g. faces " << pairs[0].first.idx() << " near " << fmt_point(centroid(pairs[0].first))
-          << " and " << pairs[0].second.idx() << " near " << fmt_point(centroid(pairs[0].second));
+        s << ", e.g. faces " << pairs[0].first.idx() << " near "
+          << fmt_point(centroid(pairs[0].first)) << " and " << pairs[0].second.idx() << " near "
+          << fmt_point(centroid(pairs[0].second));
       }
       throw InputError(s.str());
     }

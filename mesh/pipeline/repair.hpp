@@ -31,18 +31,18 @@ struct RepairOptions {
 /// What repair_surface() did, in counts.
 struct RepairReport {
   int input_vertices = 0, input_faces = 0;
-  int merged_duplicate_vertices = 0;   ///< vertices with exactly equal coordinates merged
-  int removed_degenerate_faces = 0;    ///< repeated vertex or zero area
-  int removed_duplicate_faces = 0;     ///< same vertex set as an earlier face
+  int merged_duplicate_vertices = 0;  ///< vertices with exactly equal coordinates merged
+  int removed_degenerate_faces = 0;   ///< repeated vertex or zero area
+  int removed_duplicate_faces = 0;    ///< same vertex set as an earlier face
   int removed_unreferenced_vertices = 0;
-  int reoriented_faces = 0;            ///< faces flipped to make orientation consistent
-  bool reversed_to_outward = false;    ///< whole surface (or components) flipped outward
+  int reoriented_faces = 0;          ///< faces flipped to make orientation consistent
+  bool reversed_to_outward = false;  ///< whole surface (or components) flipped outward
   int holes_filled = 0;
   int hole_faces_added = 0;
   int self_intersections_repaired = 0;  ///< intersecting face pairs removed by local repair
-  int components = 0;                  ///< connected components of the output
+  int components = 0;                   ///< connected components of the output
   int output_vertices = 0, output_faces = 0;
-  double volume = 0.0;                 ///< enclosed volume of the output (model units^3)
+  double volume = 0.0;  ///< enclosed volume of the output (model units^3)
 
   /// One line per non-zero count, for the tool's summary.
   std::string to_string() const;

@@ -28,15 +28,18 @@ SimplifyResult simplify_surface(const SurfaceMesh& input, const SimplifyOptions&
   const int nf = static_cast<int>(input.F.rows());
   int target = options.target_faces;
   if (target < 0 || (target == 0 && !(options.target_ratio > 0.0 && options.target_ratio <= 1.0)))
-    throw ParameterError("simplify_surface: target_faces must be > 0, or 0 with target_ratio in (0, 1]");
+    throw ParameterError(
+        "simplify_surface: target_faces must be > 0, or 0 with target_ratio in (0, 1]");
   if (target == 0) target = static_cast<int>(std::lround(options.target_ratio * nf));
-  if (target < 4) throw ParameterError("simplify_surface: target of " + std::to_string(target) +
-                                       " faces is below the 4 faces of a closed surface");
+  if (target < 4)
+    throw ParameterError("simplify_surface: target of " + std::to_string(target) +
+                         " faces is below the 4 faces of a closed surface");
   SimplifyResult result;
   result.report.input_faces = nf;
   CgalMesh m;
   if (!detail::to_cgal(input, m))
-    throw InputError("simplify_surface: input is not a manifold, consistently oriented triangle mesh");
+    throw InputError(
+        "simplify_surface: input is not a manifold, consistently oriented triangle mesh");
   if (nf > target) {
     using Policies = SMS::GarlandHeckbert_plane_policies<CgalMesh, detail::Kernel>;
     Policies gh(m);

@@ -59,8 +59,9 @@ TetQuality tet_quality(const TetMesh& mesh) {
   q.min_dihedral_deg = 180.0;
   q.min_volume = std::numeric_limits<double>::infinity();
   for (int t = 0; t < q.num_tets; ++t) {
-    const TetShape s = tet_shape(mesh.V.row(mesh.T(t, 0)).transpose(), mesh.V.row(mesh.T(t, 1)).transpose(),
-                                 mesh.V.row(mesh.T(t, 2)).transpose(), mesh.V.row(mesh.T(t, 3)).transpose());
+    const TetShape s =
+        tet_shape(mesh.V.row(mesh.T(t, 0)).transpose(), mesh.V.row(mesh.T(t, 1)).transpose(),
+                  mesh.V.row(mesh.T(t, 2)).transpose(), mesh.V.row(mesh.T(t, 3)).transpose());
     for (double ang : s.dihedral_deg) {
       q.min_dihedral_deg = std::min(q.min_dihedral_deg, ang);
       q.max_dihedral_deg = std::max(q.max_dihedral_deg, ang);

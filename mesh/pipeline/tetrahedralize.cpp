@@ -3,8 +3,8 @@
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
-#include <CGAL/Polyhedral_mesh_domain_3.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polyhedral_mesh_domain_3.h>
 #include <CGAL/Random.h>
 #include <CGAL/make_mesh_3.h>
 #include <CGAL/refine_mesh_3.h>
@@ -14,10 +14,10 @@
 #include <iterator>
 #include <map>
 #include <set>
-#include <vector>
 #include <string>
 #include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
@@ -46,8 +46,10 @@ void seed(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, double s
   std::set<std::array<long long, 3>> taken;
   for (Eigen::Index i = 0; i < surface.V.rows(); ++i) {
     const Eigen::RowVector3d c = ((surface.V.row(i) - lo) / spacing).array().floor();
-    if (taken.insert({static_cast<long long>(c[0]), static_cast<long long>(c[1]),
-                      static_cast<long long>(c[2])}).second)
+    if (taken
+            .insert({static_cast<long long>(c[0]), static_cast<long long>(c[1]),
+                     static_cast<long long>(c[2])})
+            .second)
       pts.emplace_back(Domain::Point_3(surface.V(i, 0), surface.V(i, 1), surface.V(i, 2)),
                        surface_index);
   }
@@ -67,7 +69,8 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
                   double size, bool optimise) {
   namespace p = CGAL::parameters;
   CGAL::get_default_random() = CGAL::Random(o.random_seed);
-  const Criteria criteria(p::facet_angle = o.facet_angle_deg, p::facet_size = o.facet_size_factor * size,
+  const Criteria criteria(p::facet_angle = o.facet_angle_deg,
+                          p::facet_size = o.facet_size_factor * size,
                           p::facet_distance = o.facet_distance_factor * size,
                           p::cell_radius_edge_ratio = o.radius_edge_bound, p::cell_size = size);
   C3t3 c3t3;
@@ -75,7 +78,8 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
   // manifold(): the boundary of the complex must be a manifold surface (thin
   // parts otherwise yield boundary edges shared by four faces).
   CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::manifold());
-  if (optimise && o.perturb) CGAL::perturb_mesh_3(c3t3, domain, p::sliver_bound = o.sliver_bound_deg);
+  if (optimise && o.perturb)
+    CGAL::perturb_mesh_3(c3t3, domain, p::sliver_bound = o.sliver_bound_deg);
   if (optimise && o.exude) CGAL::exude_mesh_3(c3t3, p::sliver_bound = o.sliver_bound_deg);
 
   TetMesh out;
@@ -112,8 +116,10 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       !(o.sliver_bound_deg >= 0.0 && o.sliver_bound_deg < 70.0) || o.max_size_iterations < 1 ||
       !(o.count_tolerance > 0.0))
     throw ParameterError(
-        "tetrahedralize_surface: need target_tets >= 1 or cell_size > 0, facet_angle_deg in (0, 30], "
-        "radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, max_size_iterations >= 1");
+        "tetrahedralize_surface: need target_tets >= 1 or cell_size > 0, facet_angle_deg in (0, "
+        "30], "
+        "radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, "
+        "max_size_iterations >= 1");
   CgalMesh sm;
   if (!detail::to_cgal(surface, sm) || !CGAL::is_closed(sm))
     throw InputError("tetrahedralize_surface: the surface is not a closed manifold triangle mesh");
@@ -167,10 +173,11 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     for (const auto& [e, n] : directed) {
       const auto rev = directed.find({e.second, e.first});
       if (n != 1 || rev == directed.end() || rev->second != 1)
-        throw InputError("tetrahedralize_surface: the boundary of the tet mesh is not a closed manifold "
-                         "surface at the edge between nodes " + std::to_string(e.first) + " and " +
-                         std::to_string(e.second) + " (cell size " + std::to_string(best.cell_size) +
-                         "); try a smaller cell size or more tets");
+        throw InputError(
+            "tetrahedralize_surface: the boundary of the tet mesh is not a closed manifold "
+            "surface at the edge between nodes " +
+            std::to_string(e.first) + " and " + std::to_string(e.second) + " (cell size " +
+            std::to_string(best.cell_size) + "); try a smaller cell size or more tets");
     }
   }
   best.quality = tet_quality(best.mesh);

@@ -49,8 +49,11 @@ AssetBundle make_bundle(double radius = 0.5) {
   for (int v : s) b.surface_nodes[i++] = v;
   b.links = build_rigid_links(b.dense.V, b.coarse.V, b.surface_nodes);
   collision::SphereTree& t = b.spheres;
-  t.spheres = {{0.5, 0.5, 0.5, 0.9}, {0.25, 0.5, 0.5, 0.5}, {0.75, 0.5, 0.5, 0.5},
-               {0.5, 0.25, 0.5, 0.5}, {0.5, 0.75, 0.5, 0.5}};
+  t.spheres = {{0.5, 0.5, 0.5, 0.9},
+               {0.25, 0.5, 0.5, 0.5},
+               {0.75, 0.5, 0.5, 0.5},
+               {0.5, 0.25, 0.5, 0.5},
+               {0.5, 0.75, 0.5, 0.5}};
   collision::build_topology(t, {-1, 0, 0, 0, 0});
   std::vector<int> cand(b.surface_nodes.data(), b.surface_nodes.data() + b.surface_nodes.size());
   collision::associate_nearest_nodes(t, b.coarse.V, {}, cand);
@@ -177,7 +180,8 @@ TEST(AssetBundle, RefusesMismatchedMeshesAndMissingFiles) {
   const fs::path d = fresh_dir("mismatch"), other = fresh_dir("other");
   write_asset_bundle(d, make_bundle(0.5));
   write_asset_bundle(other, make_bundle(0.45));  // same sizes, other coordinates
-  fs::copy_file(other / kDenseSurfaceFile, d / kDenseSurfaceFile, fs::copy_options::overwrite_existing);
+  fs::copy_file(other / kDenseSurfaceFile, d / kDenseSurfaceFile,
+                fs::copy_options::overwrite_existing);
   expect_refused(d, "do not match");
   fs::remove(d / kDenseSurfaceFile);
   EXPECT_THROW(read_asset_bundle(d), InputError);

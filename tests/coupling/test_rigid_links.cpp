@@ -136,8 +136,8 @@ TEST(RigidLinks, TranslationDetectsUnnormalisedWeights) {
     // coefficients are frame coordinates of p - O', i.e. c' = c + E^T (O - O').
     Eigen::Vector3d q[3];
     for (int i = 0; i < 3; ++i) q[i] = coarse.V.row(links.nodes(k, i)).transpose();
-    const Eigen::Vector3d O = links.alpha(k, 0) * q[0] + links.alpha(k, 1) * q[1] +
-                              links.alpha(k, 2) * q[2];
+    const Eigen::Vector3d O =
+        links.alpha(k, 0) * q[0] + links.alpha(k, 1) * q[1] + links.alpha(k, 2) * q[2];
     const Eigen::Vector3d O2 = 2.0 * O;
     const Eigen::Vector3d n = (q[1] - q[0]).cross(q[2] - q[0]);
     Eigen::Matrix3d E;
@@ -192,12 +192,12 @@ TEST(RigidLinks, KdTreeChoiceMatchesBruteForce) {
 // fall back to the next candidate, and still be exact under rigid motions.
 TEST(RigidLinks, FallsBackWhenNearestAreCollinearOrCoincident) {
   MatX3d X(6, 3);
-  X << 0, 0, 0,      // 0
-      1, 0, 0,       // 1
-      2, 0, 0,       // 2
-      1, 0, 0,       // 3: coincident with 1
-      0.5, 3, 0,     // 4: first off the line
-      0.5, 0, 4;     // 5
+  X << 0, 0, 0,   // 0
+      1, 0, 0,    // 1
+      2, 0, 0,    // 2
+      1, 0, 0,    // 3: coincident with 1
+      0.5, 3, 0,  // 4: first off the line
+      0.5, 0, 4;  // 5
   Eigen::VectorXi surf(6);
   surf << 0, 1, 2, 3, 4, 5;
   MatX3d P(2, 3);

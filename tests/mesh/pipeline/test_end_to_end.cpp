@@ -13,8 +13,8 @@
 #include "icd/config.hpp"
 #include "mesh/io/primitives.hpp"
 #include "mesh/io/surface_reader.hpp"
-#include "mesh/pipeline/preprocess.hpp"
 #include "mesh/pipeline/pipeline_test_utils.hpp"
+#include "mesh/pipeline/preprocess.hpp"
 
 namespace icd::mesh {
 namespace {
@@ -26,7 +26,8 @@ std::filesystem::path data_dir() {
 
 TEST(EndToEnd, DragonDefaultsWithOctreeSpheres) {
   const auto path = data_dir() / "ChineseDragon-10kv.off";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " missing (run scripts/fetch_meshes.sh)";
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " missing (run scripts/fetch_meshes.sh)";
   const SurfaceMesh raw = read_surface_mesh(path);
   PreprocessOptions o;
   o.sphere_builder = SphereBuilder::octree;
@@ -51,7 +52,8 @@ TEST(EndToEnd, DragonDefaultsWithOctreeSpheres) {
   MatX3d out(b.dense.V.rows(), 3);
   coupling::apply(b.links, b.coarse.V, out);
   EXPECT_LT((out - b.dense.V).rowwise().norm().maxCoeff(), 1e-12 * r.bbox_diagonal);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -1, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -1, 0.5).normalized()).toRotationMatrix();
   const Eigen::RowVector3d t(100, -50, 20);
   const MatX3d moved = (b.coarse.V * R.transpose()).rowwise() + t;
   coupling::apply(b.links, moved, out);
@@ -69,7 +71,8 @@ TEST(EndToEnd, DragonDefaultsWithOctreeSpheres) {
   const coupling::AssetBundle loaded = coupling::read_asset_bundle(dir);
   EXPECT_TRUE(loaded.links.coeffs == b.links.coeffs);
   EXPECT_TRUE(loaded.coarse.V == b.coarse.V);
-  for (const auto& st : r.times) std::cout << "  " << st.stage << ": " << st.seconds << " s (cpu " << st.cpu_seconds << " s)\n";
+  for (const auto& st : r.times)
+    std::cout << "  " << st.stage << ": " << st.seconds << " s (cpu " << st.cpu_seconds << " s)\n";
 }
 
 }  // namespace

@@ -7,8 +7,8 @@
 
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
-#include "mesh/pipeline/repair.hpp"
 #include "mesh/pipeline/pipeline_test_utils.hpp"
+#include "mesh/pipeline/repair.hpp"
 
 namespace icd::mesh {
 namespace {
@@ -26,7 +26,8 @@ void expect_refused(const SurfaceMesh& m, std::initializer_list<const char*> fra
   } catch (const InputError& e) {
     const std::string msg = e.what();
     EXPECT_EQ(msg.rfind("in.off: ", 0), 0u) << msg;
-    for (const char* f : fragments) EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
+    for (const char* f : fragments)
+      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
     std::cout << "  message: " << msg << "\n";
   }
 }
@@ -37,7 +38,8 @@ TEST(Repair, CleanSphereIsUnchanged) {
   EXPECT_EQ(r.mesh.V.rows(), s.V.rows());
   EXPECT_EQ(r.mesh.F.rows(), s.F.rows());
   EXPECT_EQ(r.report.merged_duplicate_vertices + r.report.removed_degenerate_faces +
-                r.report.removed_duplicate_faces + r.report.reoriented_faces + r.report.holes_filled,
+                r.report.removed_duplicate_faces + r.report.reoriented_faces +
+                r.report.holes_filled,
             0);
   EXPECT_FALSE(r.report.reversed_to_outward);
   EXPECT_EQ(r.report.components, 1);
@@ -93,7 +95,7 @@ TEST(Repair, MergesDuplicateVerticesAndDropsBadFaces) {
       soup.V.row(3 * f + c) = s.V.row(s.F(f, c));
       soup.F(f, c) = 3 * f + c;
     }
-  soup.F.row(nf) << 3, 4, 5;  // duplicate of face 1
+  soup.F.row(nf) << 3, 4, 5;      // duplicate of face 1
   soup.F.row(nf + 1) << 0, 0, 1;  // repeated vertex: degenerate
   const RepairResult r = repair_surface(soup);
   EXPECT_EQ(r.report.merged_duplicate_vertices, 3 * nf - s.V.rows());

@@ -5,9 +5,9 @@
 
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
+#include "mesh/pipeline/pipeline_test_utils.hpp"
 #include "mesh/pipeline/simplify.hpp"
 #include "mesh/pipeline/tetrahedralize.hpp"
-#include "mesh/pipeline/pipeline_test_utils.hpp"
 
 namespace icd::mesh {
 namespace {
@@ -24,7 +24,8 @@ TEST(Simplify, SphereToTargetStaysOnSphere) {
   EXPECT_GE(r.mesh.F.rows(), 450);
   EXPECT_EQ(r.report.output_faces, r.mesh.F.rows());
   EXPECT_TRUE(closed_and_oriented(r.mesh.F));
-  EXPECT_TRUE(test::all_vertices_used(static_cast<int>(r.mesh.V.rows()), r.mesh.F.data(), r.mesh.F.size()));
+  EXPECT_TRUE(
+      test::all_vertices_used(static_cast<int>(r.mesh.V.rows()), r.mesh.F.data(), r.mesh.F.size()));
   // Analytic oracle: vertices stay near the unit sphere, the volume near 4/3 pi.
   const double max_dev = (r.mesh.V.rowwise().norm().array() - 1.0).abs().maxCoeff();
   EXPECT_LT(max_dev, 0.02);
@@ -68,7 +69,8 @@ TEST(Tetrahedralize, SphereQualityAndCount) {
   o.target_tets = 600;
   const TetrahedralizeResult r = tetrahedralize_surface(s, o);
   check_tet_mesh(r, 4.0 / 3.0 * std::numbers::pi, 0.08);
-  std::cout << "  " << r.quality.to_string() << "  passes " << r.passes << " cell size " << r.cell_size << "\n";
+  std::cout << "  " << r.quality.to_string() << "  passes " << r.passes << " cell size "
+            << r.cell_size << "\n";
   EXPECT_LE(std::abs(r.quality.num_tets / 600.0 - 1.0), o.count_tolerance + 0.25);
   // Sliver removal: no dihedral angle below 5 deg, none above 170 deg.
   EXPECT_GT(r.quality.min_dihedral_deg, 5.0);

@@ -25,7 +25,8 @@ TEST(TetQuality, CornerTetAnalytic) {
   const TetShape s = tet_shape(t.V.row(0), t.V.row(1), t.V.row(2), t.V.row(3));
   // Edges at the right-angle corner (01, 02, 03): 90 deg; the others acos(1/sqrt 3).
   for (int e = 0; e < 3; ++e) EXPECT_NEAR(s.dihedral_deg[e], 90.0, 1e-10);
-  for (int e = 3; e < 6; ++e) EXPECT_NEAR(s.dihedral_deg[e], std::acos(1 / std::sqrt(3.0)) * kDeg, 1e-10);
+  for (int e = 3; e < 6; ++e)
+    EXPECT_NEAR(s.dihedral_deg[e], std::acos(1 / std::sqrt(3.0)) * kDeg, 1e-10);
   EXPECT_NEAR(s.radius_edge, std::sqrt(3.0) / 2.0, 1e-12);  // R = sqrt(3)/2, shortest edge 1
   EXPECT_NEAR(s.volume, 1.0 / 6.0, 1e-15);
   const TetQuality q = tet_quality(t);
