@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <unordered_map>
 
 #include <Eigen/Geometry>
-#include <unordered_map>
 
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"

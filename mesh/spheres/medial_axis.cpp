@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
-#include <vector>
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include "mesh/io/error.hpp"
@@ -19,8 +20,17 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
+/// Per-cell cache of the inside test, so that a refinement round only tests
+/// the cells its insertions created (CGAL keeps the info of untouched cells).
+struct CellInfo {
+  signed char state = 0;  // 0: not tested yet, 1: outside or flat, 2: inside
+  double center[3] = {0, 0, 0};
+  double circumradius = 0;
+  double inscribed = 0;
+};
 using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
-using Tds = CGAL::Triangulation_data_structure_3<Vb>;
+using Cb = CGAL::Triangulation_cell_base_with_info_3<CellInfo, Kernel, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
 
 Eigen::Vector3d to_eigen(const Point& p) { return {p.x(), p.y(), p.z()}; }
@@ -52,17 +62,27 @@ struct InnerVertex {
   int corner[4];
 };
 
-std::vector<InnerVertex> inner_vertices(const Delaunay& dt, const MeshOracle& oracle) {
+std::vector<InnerVertex> inner_vertices(Delaunay& dt, const MeshOracle& oracle) {
   std::vector<InnerVertex> out;
   for (auto cell = dt.finite_cells_begin(); cell != dt.finite_cells_end(); ++cell) {
-    Eigen::Vector3d corners[4];
-    for (int k = 0; k < 4; ++k) corners[k] = to_eigen(cell->vertex(k)->point());
-    Eigen::Vector3d center;
-    if (!circumcenter(corners, center) || !oracle.inside(center)) continue;
+    CellInfo& info = cell->info();
+    if (info.state == 0) {
+      Eigen::Vector3d corners[4];
+      for (int k = 0; k < 4; ++k) corners[k] = to_eigen(cell->vertex(k)->point());
+      Eigen::Vector3d center;
+      info.state = 1;
+      if (circumcenter(corners, center) && oracle.inside(center)) {
+        info.state = 2;
+        for (int k = 0; k < 3; ++k) info.center[k] = center[k];
+        info.circumradius = (center - corners[0]).norm();
+        info.inscribed = oracle.distance(center);
+      }
+    }
+    if (info.state != 2) continue;
     InnerVertex v;
-    v.center = center;
-    v.circumradius = (center - corners[0]).norm();
-    v.inscribed = oracle.distance(center);
+    v.center = Eigen::Vector3d(info.center[0], info.center[1], info.center[2]);
+    v.circumradius = info.circumradius;
+    v.inscribed = info.inscribed;
     for (int k = 0; k < 4; ++k) v.corner[k] = cell->vertex(k)->info();
     out.push_back(v);
   }

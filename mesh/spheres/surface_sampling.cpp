@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
-#include <vector>
 
 #include "mesh/io/error.hpp"
 
