@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -33,6 +34,14 @@ bool next_content_line(std::istream& in, std::string& line, long long& line_no) 
     return true;
   }
   return false;
+}
+
+// Parses a whole token as a double. strtod, unlike operator>>, accepts "nan"
+// and "inf", so such values reach the finiteness check and are named there.
+bool parse_double(const std::string& token, double& value) {
+  char* end = nullptr;
+  value = std::strtod(token.c_str(), &end);
+  return !token.empty() && end == token.c_str() + token.size();
 }
 
 }  // namespace
@@ -70,7 +79,10 @@ SphereTree read_sph(std::istream& in, const std::string& name, const SphReadOpti
       fail(line_no, "more node lines than the " + std::to_string(expected) + " declared by the header");
     std::istringstream ls(line);
     double x, y, z, r, occ;
-    if (!(ls >> x >> y >> z >> r)) fail(line_no, "expected `x y z r occupancy`");
+    std::string tx, ty, tz, tr;
+    if (!(ls >> tx >> ty >> tz >> tr) || !parse_double(tx, x) || !parse_double(ty, y) ||
+        !parse_double(tz, z) || !parse_double(tr, r))
+      fail(line_no, "expected `x y z r occupancy`");
     if (!(ls >> occ)) occ = 0.0;
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) || !std::isfinite(r))
       fail(line_no, "node " + std::to_string(count) + " has a non-finite value");

@@ -1,0 +1,146 @@
+// faults: the fault cases of issue 9, each run through the runner's World on
+// two small deformable balls (budget in sphere tests, so runs are
+// reproducible). Each case must either be handled -- every frame runs, all
+// positions and energies stay finite -- or stop with a clear diagnostic
+// (icd::InputError / ParameterError / NumericalError naming the problem).
+// A silent NaN or any other exception is a failure (exit 1).
+// usage: faults [--frames N=120]
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <typeinfo>
+#include <vector>
+
+#include "experiments/runner/json.hpp"
+#include "experiments/runner/world.hpp"
+#include "icd/config.hpp"
+#include "mesh/io/error.hpp"
+
+namespace {
+
+using namespace icd;
+
+struct Case {
+  std::string name;
+  std::string what;     // the documented expectation
+  double left_x = -0.13, right_x = 0.13, speed = 0.6;
+  std::string collision = R"("budget_tests": 2000)";
+  bool fix_all_left = false;
+  double force_at_half = 0;  // N per node on the left ball from the middle frame on
+};
+
+runner::Scene make_scene(const Case& c) {
+  std::ostringstream s;
+  s.precision(17);
+  auto ball = [&](const char* name, double x, double v) {
+    s << R"({"name": ")" << name
+      << R"(", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 4},)"
+      << R"( "position": [)" << x << R"(, 0, 0], "velocity": [)" << v
+      << R"(, 0, 0], "material": {"model": "stvk", "young": 5e5, "poisson": 0.3,)"
+      << R"( "density": 1000}, "integrator": "rk4", "preprocess": {"tree_depth": 3}})";
+  };
+  s << R"({"name": ")" << c.name << R"(", "frames": 1, "objects": [)";
+  ball("left", c.left_x, c.speed);
+  s << ",";
+  ball("right", c.right_x, -c.speed);
+  s << R"(], "collision": {)" << c.collision << R"(, "stiffness": 2000, "layered": true}})";
+  return runner::parse_scene(runner::parse_json(s.str(), c.name), c.name, ".");
+}
+
+struct Outcome {
+  std::string status;  // handled / diagnostic / FAILED
+  int frames = 0;
+  double max_energy = 0;
+  int contact_frames = 0;
+  std::string message;
+};
+
+Outcome run_case(const Case& c, int frames) {
+  Outcome out;
+  try {
+    runner::Scene scene = make_scene(c);
+    if (c.fix_all_left) {
+      // Learn the coarse node count, then fix every node of the left ball.
+      runner::World probe(scene, ICD_SOURCE_DIR "/assets", ICD_TOOL_DIR);
+      const int n = static_cast<int>(probe.objects()[0].positions.rows());
+      for (int i = 0; i < n; ++i) scene.objects[0].fixed_nodes.push_back(i);
+    }
+    runner::World world(scene, ICD_SOURCE_DIR "/assets", ICD_TOOL_DIR);
+    for (int f = 0; f < frames; ++f) {
+      if (c.force_at_half != 0 && f == frames / 2) {
+        runner::RuntimeObject& o = world.objects()[0];
+        MatX3d force = MatX3d::Zero(o.positions.rows(), 3);
+        force.col(0).setConstant(c.force_at_half);
+        o.sim->set_external_forces(force);
+      }
+      const runner::FrameMetrics m = world.step();
+      bool finite = std::isfinite(m.energy) && std::isfinite(m.max_penetration);
+      for (runner::RuntimeObject& o : world.objects()) finite = finite && o.positions.allFinite();
+      if (!finite) {
+        out.status = "FAILED";
+        out.message = "silent non-finite state at frame " + std::to_string(f);
+        return out;
+      }
+      out.frames = f + 1;
+      out.max_energy = std::max(out.max_energy, m.energy);
+      out.contact_frames += m.active_pairs > 0;
+    }
+    out.status = "handled";
+  } catch (const InputError& e) {
+    out.status = "diagnostic";
+    out.message = std::string("InputError: ") + e.what();
+  } catch (const ParameterError& e) {
+    out.status = "diagnostic";
+    out.message = std::string("ParameterError: ") + e.what();
+  } catch (const NumericalError& e) {
+    out.status = "diagnostic";
+    out.message = std::string("NumericalError: ") + e.what();
+  } catch (const std::exception& e) {
+    out.status = "FAILED";
+    out.message = std::string("undocumented ") + typeid(e).name() + ": " + e.what();
+  }
+  if (out.status == "diagnostic" && out.message.find(": ") + 2 >= out.message.size())
+    out.status = "FAILED";  // an empty message is no diagnostic
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int frames = 120;
+  if (argc == 3 && std::string(argv[1]) == "--frames") frames = std::atoi(argv[2]);
+  std::vector<Case> cases;
+  cases.push_back({"zero_budget", "no sphere test: no contact found, objects pass through"});
+  cases.back().collision = R"("budget_tests": 0)";
+  cases.push_back({"huge_budget", "budget far above need: every query completes"});
+  cases.back().collision = R"("budget_tests": 1000000000000)";
+  cases.push_back({"unlimited_time_budget", "no budget at all (\"unlimited\": true)"});
+  cases.back().collision = R"("unlimited": true)";
+  cases.push_back({"all_nodes_fixed", "left ball fully fixed: acts as a wall"});
+  cases.back().fix_all_left = true;
+  cases.push_back({"coincident_centres", "both balls at the same place"});
+  cases.back().left_x = cases.back().right_x = 0;
+  cases.push_back({"start_interpenetrated", "balls overlap by half a radius at t = 0"});
+  cases.back().left_x = -0.075;
+  cases.back().right_x = 0.075;
+  cases.back().speed = 0;
+  cases.push_back({"sudden_huge_force", "1e6 N per node on the left ball from mid-run"});
+  cases.back().force_at_half = 1e6;
+
+  bool ok = true;
+  std::printf("%-22s %-10s %6s %12s %8s  %s\n", "case", "outcome", "frames", "max energy",
+              "contact", "expectation / diagnostic");
+  for (const Case& c : cases) {
+    const Outcome o = run_case(c, frames);
+    std::printf("%-22s %-10s %6d %12.4g %8d  %s\n", c.name.c_str(), o.status.c_str(), o.frames,
+                o.max_energy, o.contact_frames, o.message.empty() ? c.what.c_str() : o.message.c_str());
+    ok = ok && o.status != "FAILED";
+  }
+  return ok ? 0 : 1;
+}
