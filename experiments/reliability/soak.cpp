@@ -8,7 +8,7 @@
 // position or energy, an energy above --energy-factor times the initial one,
 // or resident memory that grows by more than --max-growth-mb after the
 // first window.
-// usage: soak [--frames N=100000] [--every K=1000] [--budget-tests B=200]
+// usage: soak [--frames N=100000] [--every K=1000] [--budget-tests B=2000]
 //             [--scene FILE] [--speed V=1] [--energy-factor F=1.5]
 //             [--max-growth-mb M=16] [--csv FILE]
 #include <unistd.h>
@@ -39,7 +39,7 @@ double resident_mb() {
 struct Args {
   int frames = 100000;
   int every = 1000;
-  long long budget_tests = 200;
+  long long budget_tests = 2000;
   bool budget_given = false;
   std::string scene;
   double speed = 1.0;
