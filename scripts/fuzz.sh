@@ -6,9 +6,11 @@
 # once fixed). Prints executions and coverage (libFuzzer cov/ft) per target.
 #
 # Usage: scripts/fuzz.sh [--seconds N] [--targets "off obj ..."] [--no-build]
-#                        [--parallel K]
+#                        [--parallel K] [--keep-going]
 #   --seconds N    run time per target (default 60)
 #   --parallel K   run K targets at the same time (default 1)
+#   --keep-going   libFuzzer fork mode: record a finding and go on fuzzing
+#                  (default: a target stops at its first finding)
 # Exit status: 0 when no target found anything, 1 otherwise.
 set -euo pipefail
 
@@ -18,13 +20,15 @@ seconds=60
 targets="off obj ply stl vtu sph bundle scene"
 do_build=1
 parallel=1
+mode=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --targets) targets="$2"; shift 2 ;;
     --no-build) do_build=0; shift ;;
     --parallel) parallel="$2"; shift 2 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    --keep-going) mode=(-fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1); shift ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "fuzz.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -51,8 +55,7 @@ run_one() {
     ICD_FUZZ_SEED_OUT="$root/tests/fuzz/corpus/bundle" "$build/tests/fuzz/fuzz_bundle" -runs=0 \
       >/dev/null 2>&1 || true
   fi
-  # -fork keeps fuzzing after a finding (each crash saved, no early stop).
-  "$build/tests/fuzz/fuzz_$t" "$corpus" "$root/tests/fuzz/corpus/$t" \
+  "$build/tests/fuzz/fuzz_$t" "${mode[@]}" "$corpus" "$root/tests/fuzz/corpus/$t" \
     -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
     -max_len=65536 -print_final_stats=1 -artifact_prefix="$crashes/" \
     >"$log" 2>&1 || true
@@ -72,6 +75,7 @@ for t in $targets; do
   log="$out/$t.log"
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
   last=$(grep -E '^#[0-9]+' "$log" | tail -1)
+  [[ -z "$execs" ]] && execs=$(grep -oE '^#[0-9]+' <<<"$last" | tr -d '#')
   cov=$(grep -o 'cov: [0-9]*' <<<"$last" | grep -o '[0-9]*' || true)
   ft=$(grep -o 'ft: [0-9]*' <<<"$last" | grep -o '[0-9]*' || true)
   files=$(find "$out/corpus/$t" -type f | wc -l)
