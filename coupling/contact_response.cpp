@@ -1,6 +1,7 @@
 #include "coupling/contact_response.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -34,8 +35,13 @@ struct Accumulator {
   MatX3d received;             // PaperAverage: sum of received forces
   Eigen::VectorXd stiffness;   // added stiffness per node
 
-  Accumulator(Eigen::Ref<MatX3d> o, const SphereTree& t, ContactDistribution m)
-      : out(o), tree(t), mode(m), stiffness(Eigen::VectorXd::Zero(o.rows())) {
+  const Eigen::VectorXd* mass;  // node masses, or null
+  Eigen::VectorXd rate;         // per node: sum of k * share / m_n (1/s^2)
+
+  Accumulator(Eigen::Ref<MatX3d> o, const SphereTree& t, ContactDistribution m,
+              const Eigen::VectorXd* node_mass)
+      : out(o), tree(t), mode(m), stiffness(Eigen::VectorXd::Zero(o.rows())), mass(node_mass),
+        rate(Eigen::VectorXd::Zero(node_mass ? o.rows() : 0)) {
     if (mode == ContactDistribution::PaperAverage) {
       count.assign(static_cast<size_t>(o.rows()), 0);
       received = MatX3d::Zero(o.rows(), 3);
@@ -44,10 +50,15 @@ struct Accumulator {
 
   void add(int sphere, const Eigen::Vector3d& f, double k) {
     const int32_t begin = tree.assoc_offset[sphere], end = tree.assoc_offset[sphere + 1];
-    const double share = 1.0 / std::max(1, end - begin);
+    double share = 1.0 / std::max(1, end - begin);
+    double total_mass = 0;
+    if (mode == ContactDistribution::MassWeighted)
+      for (int32_t j = begin; j < end; ++j) total_mass += (*mass)[tree.assoc_nodes[j]];
     for (int32_t j = begin; j < end; ++j) {
       const int32_t node = tree.assoc_nodes[j];
-      if (mode == ContactDistribution::PartitionOfUnity) {
+      if (mode == ContactDistribution::MassWeighted) share = (*mass)[node] / total_mass;
+      if (mass) rate[node] += k * (mode == ContactDistribution::PaperAverage ? 1.0 : share) / (*mass)[node];
+      if (mode != ContactDistribution::PaperAverage) {
         out.row(node) += share * f.transpose();
         stiffness[node] += share * k;
       } else {
@@ -67,6 +78,7 @@ struct Accumulator {
           out.row(n) += avg;
           total += avg.transpose();
           stiffness[n] /= count[n];
+          if (mass) rate[n] /= count[n];
         }
     }
     return total;
@@ -98,11 +110,23 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
                          std::to_string(options.stiffness) + ")");
   check_association(a, forces_a.rows(), "a");
   check_association(b, forces_b.rows(), "b");
+  auto check_mass = [](const Eigen::VectorXd* m, Eigen::Index rows, const char* which) {
+    if (!m) return;
+    if (m->size() != rows || !(m->minCoeff() > 0.0) || !m->allFinite())
+      throw ParameterError(std::string("contact response: mass_") + which + " must hold " +
+                           std::to_string(rows) + " positive finite node masses");
+  };
+  check_mass(options.mass_a, forces_a.rows(), "a");
+  check_mass(options.mass_b, forces_b.rows(), "b");
+  if (options.distribution == ContactDistribution::MassWeighted &&
+      (!options.mass_a || !options.mass_b))
+    throw ParameterError("contact response: the mass-weighted distribution needs mass_a and mass_b");
   Eigen::Vector3d fallback = options.coincident_direction;
   fallback = fallback.allFinite() && fallback.norm() > 0 ? fallback.normalized()
                                                          : Eigen::Vector3d::UnitZ();
 
-  Accumulator acc_a(forces_a, a, options.distribution), acc_b(forces_b, b, options.distribution);
+  Accumulator acc_a(forces_a, a, options.distribution, options.mass_a),
+      acc_b(forces_b, b, options.distribution, options.mass_b);
   ContactStats stats;
   const double k = options.stiffness;
   auto respond = [&](const NodePair& p) {
@@ -116,7 +140,7 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     const Eigen::Vector3d f = k * delta * n;  // on b; -f on a (Eq. 11)
     acc_a.add(p.a, -f, k);
     acc_b.add(p.b, f, k);
-    if (options.distribution == ContactDistribution::PartitionOfUnity) {
+    if (options.distribution != ContactDistribution::PaperAverage) {
       stats.total_force_a -= f;
       stats.total_force_b += f;
     }
@@ -130,6 +154,8 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     stats.total_force_a = acc_a.finish();
     stats.total_force_b = acc_b.finish();
   }
+  if (options.mass_a && options.mass_b && stats.active_pairs > 0)
+    stats.max_rate = acc_a.rate.maxCoeff() + acc_b.rate.maxCoeff();
   stats.max_node_stiffness =
       std::max(acc_a.stiffness.size() ? acc_a.stiffness.maxCoeff() : 0.0,
                acc_b.stiffness.size() ? acc_b.stiffness.maxCoeff() : 0.0);

@@ -22,6 +22,11 @@ enum class ContactDistribution {
   /// Each of the |V_i| nodes gets F / |V_i|; a node adds what it receives.
   /// Conserves momentum exactly (default).
   PartitionOfUnity,
+  /// Node n of V_i gets F m_n / sum_{V_i} m (ContactOptions::mass_a/mass_b
+  /// required): every node of the sphere accelerates alike, so the contact
+  /// stiffness acts on the sphere's whole mass, not on its lightest node
+  /// (far milder stability limit). Conserves momentum exactly.
+  MassWeighted,
   /// The paper's wording: each node of V_i receives F and "averages the
   /// received forces" (sum / count). Does not conserve momentum when nodes
   /// receive different numbers of forces; kept for comparison.
@@ -39,6 +44,10 @@ struct ContactOptions {
   /// normally the direction from object a's centroid to object b's. Normalised
   /// internally; a zero vector falls back to +z.
   Eigen::Vector3d coincident_direction{0.0, 0.0, 1.0};
+  /// Lumped node masses of objects a and b (kg), for MassWeighted; also used
+  /// to report ContactStats::max_rate. Not owned; may be null otherwise.
+  const Eigen::VectorXd* mass_a = nullptr;
+  const Eigen::VectorXd* mass_b = nullptr;
 };
 
 /// What the response did.
@@ -50,6 +59,12 @@ struct ContactStats {
   /// Largest added stiffness on one coarse node (k times the node's share of
   /// every active pair), for the FEM stable-step estimate (N/m).
   double max_node_stiffness = 0;
+  /// Squared frequency of the penalty springs (1/s^2): per node n the sum
+  /// over its active pairs of k * share_n / m_n (for MassWeighted k / M_i,
+  /// M_i the mass of sphere i's nodes), maximised over each object's nodes
+  /// and added for the two objects. A staggered response stays stable while
+  /// sqrt(max_rate) h < 2. 0 unless both mass arrays were given.
+  double max_rate = 0;
 };
 
 /// The sphere -> coarse node map of one object as a sparse matrix
@@ -61,7 +76,8 @@ Eigen::SparseMatrix<double> sphere_to_node_matrix(const collision::SphereTree& t
 /// Computes penalty forces for the pairs of `result` between trees a and b
 /// (current spheres) and adds them to forces_a (#coarse nodes of a x 3) and
 /// forces_b. Throws ParameterError for a non-positive stiffness, missing
-/// sphere associations or out-of-range node indices.
+/// sphere associations, out-of-range node indices, or MassWeighted without
+/// masses (or with a non-positive mass).
 ContactStats apply_contact_forces(const collision::SphereTree& a, const collision::SphereTree& b,
                                   const collision::CollisionResult& result,
                                   const ContactOptions& options, Eigen::Ref<MatX3d> forces_a,

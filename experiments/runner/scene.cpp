@@ -229,10 +229,12 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
                                  : collision::SphereUpdateMode::DisplacementBound;
   c.update.margin = f.number("sphere_margin", 0, 0, 1e3);
   c.contact.stiffness = f.number("stiffness", 1e3, 0, 1e12, true);
-  const std::string dist =
-      f.string("distribution", "partition_of_unity", {"partition_of_unity", "paper_average"});
+  const std::string dist = f.string("distribution", "partition_of_unity",
+                                    {"mass_weighted", "partition_of_unity", "paper_average"});
   c.contact.distribution = dist == "paper_average" ? coupling::ContactDistribution::PaperAverage
-                                                   : coupling::ContactDistribution::PartitionOfUnity;
+                           : dist == "partition_of_unity"
+                               ? coupling::ContactDistribution::PartitionOfUnity
+                               : coupling::ContactDistribution::MassWeighted;
   c.contact.use_untested = f.boolean("use_untested", true);
   f.finish();
   return c;

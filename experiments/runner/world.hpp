@@ -52,6 +52,7 @@ struct RuntimeObject {
   MatX3d rest;            ///< rest coarse positions, placed in the scene
   MatX3d contact_forces;  ///< forces from the last collision response (#V x 3)
   MatX3d dense;           ///< current dense positions (when the plan updates them)
+  Eigen::VectorXd node_mass;  ///< lumped coarse node masses (kg); huge for objects without FEM
 };
 
 /// A scene being simulated.
@@ -79,6 +80,8 @@ class World {
   int contact_cycles(double dt) const;
 
   static constexpr int kMaxContactCycles = 64;
+  /// Node mass standing for "does not move under contact" (static, rigid objects).
+  static constexpr double kImmovableMass = 1e30;
   /// Largest omega h of the staggered penalty (explicit limit 2; smaller
   /// values inject less energy per contact).
   static constexpr double kContactOmegaStep = 0.25;
@@ -88,8 +91,8 @@ class World {
   std::vector<RuntimeObject> m_objects;
   std::vector<collision::CollisionResult> m_results;
   std::vector<std::vector<collision::NodePair>> m_fronts;
-  double m_min_node_mass = 1;    ///< smallest lumped node mass of the deformable objects, kg
-  double m_node_stiffness = 0;   ///< largest per-node penalty stiffness of the last response, N/m
+  double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
+  double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
   int m_frame = 0;
   double m_time = 0;
 };

@@ -145,3 +145,38 @@ TEST(ContactResponse, BadParametersThrow) {
 
 }  // namespace
 }  // namespace icd::coupling
+
+namespace icd::coupling {
+namespace {
+
+// Mass-weighted distribution: node n of V_i gets F m_n / sum m, so all nodes
+// of a sphere accelerate alike; momentum still balances; the reported rate
+// is k (1/M_a + 1/M_b) with M the sphere's node-mass sum.
+TEST(ContactResponse, MassWeightedGivesEqualAccelerations) {
+  const SphereTree a = make_tree({{0, 0, 0, 1}}, {{0, 1, 2}, {0, 1, 2}});
+  const SphereTree b = make_tree({{1.5, 0, 0, 1}}, {{0, 1}, {0, 1}});
+  const Eigen::VectorXd ma = (Eigen::VectorXd(3) << 1.0, 2.0, 5.0).finished();
+  const Eigen::VectorXd mb = (Eigen::VectorXd(2) << 0.5, 1.5).finished();
+  CollisionResult r;
+  r.colliding = {{1, 1}};
+  MatX3d fa = MatX3d::Zero(3, 3), fb = MatX3d::Zero(2, 3);
+  ContactOptions o;
+  o.distribution = ContactDistribution::MassWeighted;
+  o.stiffness = 100;
+  o.mass_a = &ma;
+  o.mass_b = &mb;
+  const ContactStats s = apply_contact_forces(a, b, r, o, fa, fb);
+  // Total |F| = k delta = 100 * 0.5 = 50 N along x.
+  for (int n = 0; n < 3; ++n) EXPECT_NEAR(fa(n, 0) / ma[n], -50.0 / 8.0, 1e-12);
+  for (int n = 0; n < 2; ++n) EXPECT_NEAR(fb(n, 0) / mb[n], 50.0 / 2.0, 1e-12);
+  EXPECT_NEAR(fa.col(0).sum() + fb.col(0).sum(), 0.0, 1e-12);
+  EXPECT_NEAR(s.max_rate, 100 * (1.0 / 8.0 + 1.0 / 2.0), 1e-12);
+  o.mass_b = nullptr;
+  EXPECT_THROW(apply_contact_forces(a, b, r, o, fa, fb), ParameterError);
+  const Eigen::VectorXd bad = (Eigen::VectorXd(2) << 0.5, 0.0).finished();
+  o.mass_b = &bad;
+  EXPECT_THROW(apply_contact_forces(a, b, r, o, fa, fb), ParameterError);
+}
+
+}  // namespace
+}  // namespace icd::coupling
