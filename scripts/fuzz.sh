@@ -73,9 +73,10 @@ status=0
 printf '%-8s %12s %8s %8s %8s %s\n' target execs cov ft corpus findings
 for t in $targets; do
   log="$out/$t.log"
-  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
-  last=$(grep -E '^#[0-9]+' "$log" | tail -1)
-  [[ -z "$execs" ]] && execs=$(grep -oE '^#[0-9]+' <<<"$last" | tr -d '#')
+  # (no stat lines in fork mode or after a crash: never let a missing match stop the summary)
+  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || true)
+  last=$(grep -E '^#[0-9]+' "$log" | tail -1 || true)
+  [[ -z "$execs" ]] && execs=$(grep -oE '^#[0-9]+' <<<"$last" | tr -d '#' || true)
   cov=$(grep -o 'cov: [0-9]*' <<<"$last" | grep -o '[0-9]*' || true)
   ft=$(grep -o 'ft: [0-9]*' <<<"$last" | grep -o '[0-9]*' || true)
   files=$(find "$out/corpus/$t" -type f | wc -l)
