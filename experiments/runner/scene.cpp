@@ -223,7 +223,7 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.max_list_size = static_cast<std::size_t>(f.integer("max_list_size", 1 << 14, 8, 1 << 28));
   c.depth_cap = f.integer("depth_cap", -1, -1, 64);
   c.temporal_coherence = f.boolean("temporal_coherence", false);
-  c.layered = f.boolean("layered", false);
+  c.layered = f.boolean("layered", true);
   const std::string upd = f.string("sphere_update", "paper", {"paper", "conservative"});
   c.update.mode = upd == "paper" ? collision::SphereUpdateMode::PaperRatio
                                  : collision::SphereUpdateMode::DisplacementBound;

@@ -43,6 +43,8 @@ World::World(const Scene& scene, const std::filesystem::path& cache_dir,
     o.plan = m_plan.objects[i];
     o.asset = load_object_asset(o.spec, cache_dir, tool_dir);
     place_object(o.asset, o.spec);
+    // Static objects are never updated: make their trees layered once here.
+    if (scene.collision.layered) enclose_children(o.asset.spheres);
     o.rest = o.asset.coarse.V;
     o.positions = o.rest;
     o.contact_forces = MatX3d::Zero(o.rest.rows(), 3);
