@@ -38,16 +38,6 @@ TetMesh compact(const MatX3d& V, const std::vector<Eigen::Vector4i>& tets) {
   return m;
 }
 
-Eigen::VectorXi surface_nodes_of(const TetMesh& m) {
-  std::vector<char> on(m.V.rows(), 0);
-  for (int f = 0; f < m.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) on[m.F(f, k)] = 1;
-  std::vector<int> ids;
-  for (int i = 0; i < m.V.rows(); ++i)
-    if (on[i]) ids.push_back(i);
-  return Eigen::Map<Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size()));
-}
-
 // Octree sphere tree (CGAL-free) tied to the nearest coarse surface nodes.
 void build_octree_spheres(ObjectAsset& a, int depth) {
   collision::OctreeTreeOptions to;
@@ -59,7 +49,7 @@ void build_octree_spheres(ObjectAsset& a, int depth) {
 }
 
 void finish_asset(ObjectAsset& a, int depth) {
-  a.surface_nodes = surface_nodes_of(a.coarse);
+  a.surface_nodes = boundary_nodes(a.coarse.F);
   a.links = coupling::build_rigid_links(a.dense.V, a.coarse.V, a.surface_nodes);
   build_octree_spheres(a, depth);
 }

@@ -106,6 +106,13 @@ MatX3i boundary_faces(const Eigen::Ref<const MatX4i>& T) {
   return F;
 }
 
+Eigen::VectorXi boundary_nodes(const Eigen::Ref<const MatX3i>& F) {
+  std::vector<int> ids(F.data(), F.data() + F.size());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return Eigen::Map<const Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size()));
+}
+
 Eigen::VectorXd signed_tet_volumes(const Eigen::Ref<const MatX3d>& V,
                                    const Eigen::Ref<const MatX4i>& T) {
   Eigen::VectorXd vol(T.rows());

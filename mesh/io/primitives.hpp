@@ -35,6 +35,10 @@ SurfaceMesh make_torus(double R, double r, int nu, int nv);
 /// faces that belong to exactly one tet, ordered by (tet, local face).
 MatX3i boundary_faces(const Eigen::Ref<const MatX4i>& T);
 
+/// Sorted, distinct vertex indices used by the triangles F (#F x 3): for the
+/// boundary F of a tet mesh, its surface nodes (the paper's reduced coordinates Q).
+Eigen::VectorXi boundary_nodes(const Eigen::Ref<const MatX3i>& F);
+
 /// Signed volume of every tet: det[v1-v0, v2-v0, v3-v0] / 6 (#T).
 Eigen::VectorXd signed_tet_volumes(const Eigen::Ref<const MatX3d>& V,
                                    const Eigen::Ref<const MatX4i>& T);

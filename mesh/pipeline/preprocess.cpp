@@ -2,10 +2,10 @@
 
 #include <chrono>
 #include <ctime>
-#include <set>
 #include <sstream>
 #include <utility>
 
+#include "mesh/io/primitives.hpp"
 #include "mesh/pipeline/hausdorff.hpp"
 
 namespace icd::mesh {
@@ -75,11 +75,8 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     r.quality = tet.quality;
     r.cell_size = tet.cell_size;
     r.mesher_passes = tet.passes;
-    const std::set<int> surf(b.coarse.F.data(), b.coarse.F.data() + b.coarse.F.size());
-    b.surface_nodes.resize(static_cast<Eigen::Index>(surf.size()));
-    int i = 0;
-    for (int v : surf) b.surface_nodes[i++] = v;
-    t.done(std::to_string(b.coarse.T.rows()) + " tets, " + std::to_string(surf.size()) +
+    b.surface_nodes = boundary_nodes(b.coarse.F);
+    t.done(std::to_string(b.coarse.T.rows()) + " tets, " + std::to_string(b.surface_nodes.size()) +
            " surface nodes, " + std::to_string(tet.passes) + " pass(es)");
   }
   {

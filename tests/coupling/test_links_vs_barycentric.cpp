@@ -25,15 +25,6 @@ MatX3d dense_points_around(const TetMesh& box, double offset) {
   return P;
 }
 
-Eigen::VectorXi surface_nodes(const TetMesh& m) {
-  std::vector<int> on(m.V.rows(), 0), ids;
-  for (int f = 0; f < m.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) on[m.F(f, k)] = 1;
-  for (int i = 0; i < m.V.rows(); ++i)
-    if (on[i]) ids.push_back(i);
-  return Eigen::Map<Eigen::VectorXi>(ids.data(), static_cast<Eigen::Index>(ids.size()));
-}
-
 // At rest and under rigid motions the two mappings agree exactly (both are
 // exact there). Under a smooth bending of curvature kappa the barycentric
 // embedding is a linear interpolation: error O(kappa h^2), 4x smaller when
@@ -53,7 +44,7 @@ TEST(LinksVsBarycentric, ExactWhenRigidAndConvergentUnderBending) {
     const TetMesh box = make_box_tet_mesh(o);
     const double h = 1.0 / o.nx;
     const MatX3d P = dense_points_around(box, 0.2 * h);
-    const RigidLinks links = build_rigid_links(P, box.V, surface_nodes(box));
+    const RigidLinks links = build_rigid_links(P, box.V, boundary_nodes(box.F));
     const BarycentricEmbedding emb = build_barycentric_embedding(P, box.V, box.T);
     MatX3d by_links(P.rows(), 3), by_bary(P.rows(), 3);
 

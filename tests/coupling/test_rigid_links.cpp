@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <random>
-#include <set>
 #include <utility>
 #include <vector>
 
@@ -14,15 +13,6 @@
 
 namespace icd::coupling {
 namespace {
-
-// Boundary node indices of a tet mesh (the reduced coordinates Q), sorted.
-Eigen::VectorXi surface_nodes_of(const TetMesh& m) {
-  std::set<int> s(m.F.data(), m.F.data() + m.F.size());
-  Eigen::VectorXi out(static_cast<Eigen::Index>(s.size()));
-  int i = 0;
-  for (int v : s) out[i++] = v;
-  return out;
-}
 
 // Dense points near the surface of the box [0,1] x [0,0.5] x [0,0.3]: jittered
 // boundary points (inside and outside), the typical dense-vs-coarse situation.
@@ -91,7 +81,7 @@ TEST(RigidLinks, ReproducesDenseMeshAtRest) {
   std::mt19937 rng(0);
   const TetMesh coarse = coarse_box();
   const MatX3d P = dense_points_near_box(2000, rng);
-  const RigidLinks links = build_rigid_links(P, coarse.V, surface_nodes_of(coarse));
+  const RigidLinks links = build_rigid_links(P, coarse.V, boundary_nodes(coarse.F));
   ASSERT_EQ(links.num_links(), 2000);
   for (int k = 0; k < links.num_links(); ++k)
     EXPECT_NEAR(links.alpha.row(k).sum(), 1.0, 1e-14) << "link " << k;
@@ -104,7 +94,7 @@ TEST(RigidLinks, ReproducesDenseMeshUnderRigidMotions) {
   std::mt19937 rng(1);
   const TetMesh coarse = coarse_box();
   const MatX3d P = dense_points_near_box(1000, rng);
-  const RigidLinks links = build_rigid_links(P, coarse.V, surface_nodes_of(coarse));
+  const RigidLinks links = build_rigid_links(P, coarse.V, boundary_nodes(coarse.F));
   std::normal_distribution<double> g(0.0, 1.0);
   MatX3d out(P.rows(), 3);
   for (int trial = 0; trial < 20; ++trial) {
@@ -126,7 +116,7 @@ TEST(RigidLinks, TranslationDetectsUnnormalisedWeights) {
   std::mt19937 rng(2);
   const TetMesh coarse = coarse_box();
   const MatX3d P = dense_points_near_box(300, rng);
-  const RigidLinks links = build_rigid_links(P, coarse.V, surface_nodes_of(coarse));
+  const RigidLinks links = build_rigid_links(P, coarse.V, boundary_nodes(coarse.F));
 
   RigidLinks printed = links;
   printed.alpha *= 2.0;
@@ -167,7 +157,7 @@ TEST(RigidLinks, KdTreeChoiceMatchesBruteForce) {
   o.ny = 5;
   o.nz = 7;
   const TetMesh coarse = make_box_tet_mesh(o);
-  const Eigen::VectorXi surf = surface_nodes_of(coarse);
+  const Eigen::VectorXi surf = boundary_nodes(coarse.F);
   std::uniform_real_distribution<double> u(-1.0, 3.0);
   MatX3d P(500, 3);
   for (int k = 0; k < P.rows(); ++k) P.row(k) << u(rng), u(rng), u(rng);
@@ -246,7 +236,7 @@ TEST(RigidLinks, ValidateNamesTheBadLink) {
   std::mt19937 rng(4);
   const TetMesh coarse = coarse_box();
   const MatX3d P = dense_points_near_box(50, rng);
-  RigidLinks links = build_rigid_links(P, coarse.V, surface_nodes_of(coarse));
+  RigidLinks links = build_rigid_links(P, coarse.V, boundary_nodes(coarse.F));
   EXPECT_NO_THROW(validate(links, "test"));
   RigidLinks bad = links;
   bad.alpha(17, 1) += 0.01;

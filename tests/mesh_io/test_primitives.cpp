@@ -121,3 +121,26 @@ TEST(Primitives, BadParametersThrow) {
 
 }  // namespace
 }  // namespace icd
+
+namespace icd {
+namespace {
+
+// boundary_nodes: the distinct vertices of F, sorted, checked against a
+// brute-force membership scan on the box boundary (every vertex of a 2x2x2
+// grid but the centre).
+TEST(Primitives, BoundaryNodesAreTheDistinctSortedFaceVertices) {
+  BoxMeshOptions o;
+  o.size = {1, 1, 1};
+  o.nx = o.ny = o.nz = 2;
+  const TetMesh m = make_box_tet_mesh(o);
+  const Eigen::VectorXi b = boundary_nodes(m.F);
+  std::vector<int> expected;
+  for (int v = 0; v < m.V.rows(); ++v)
+    if ((m.F.array() == v).any()) expected.push_back(v);
+  ASSERT_EQ(b.size(), static_cast<Eigen::Index>(expected.size()));
+  EXPECT_EQ(b.size(), 26);
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(b[i], expected[i]);
+}
+
+}  // namespace
+}  // namespace icd
