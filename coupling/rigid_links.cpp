@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "coupling/link_evaluator.hpp"
 #include "mesh/io/error.hpp"
 
 namespace icd::coupling {
@@ -207,13 +208,29 @@ RigidLinks build_rigid_links(const Eigen::Ref<const MatX3d>& P,
 
 void apply(const RigidLinks& links, const Eigen::Ref<const MatX3d>& coarse_positions,
            Eigen::Ref<MatX3d> dense_out) {
+  LinkEvaluator(links).apply(coarse_positions, dense_out);
+}
+
+Eigen::SparseMatrix<double, Eigen::RowMajor> origin_matrix(const RigidLinks& links) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(3 * static_cast<size_t>(links.num_links()));
+  for (int k = 0; k < links.num_links(); ++k)
+    for (int i = 0; i < 3; ++i) entries.emplace_back(k, links.nodes(k, i), links.alpha(k, i));
+  Eigen::SparseMatrix<double, Eigen::RowMajor> A(links.num_links(), links.num_coarse_nodes);
+  A.setFromTriplets(entries.begin(), entries.end());  // repeated nodes are summed
+  return A;
+}
+
+void apply_reference(const RigidLinks& links, const Eigen::Ref<const MatX3d>& coarse_positions,
+                     Eigen::Ref<MatX3d> dense_out) {
   if (coarse_positions.rows() != links.num_coarse_nodes)
-    throw ParameterError("rigid links apply: coarse_positions has " +
+    throw ParameterError("rigid links apply_reference: coarse_positions has " +
                          std::to_string(coarse_positions.rows()) + " rows, the links expect " +
                          std::to_string(links.num_coarse_nodes));
   if (dense_out.rows() != links.nodes.rows())
-    throw ParameterError("rigid links apply: dense_out has " + std::to_string(dense_out.rows()) +
-                         " rows, expected " + std::to_string(links.nodes.rows()));
+    throw ParameterError("rigid links apply_reference: dense_out has " +
+                         std::to_string(dense_out.rows()) + " rows, expected " +
+                         std::to_string(links.nodes.rows()));
   const int N = links.num_links();
   for (int k = 0; k < N; ++k) {
     const Vec3 q0 = coarse_positions.row(links.nodes(k, 0)).transpose();

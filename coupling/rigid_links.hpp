@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include "mesh/io/types.hpp"
 
@@ -69,12 +70,30 @@ RigidLinks build_rigid_links(const Eigen::Ref<const MatX3d>& P,
 
 /// Evaluates the links (Eqs. 1, 9, 10): dense_out.row(k) = O_k + sum_i c_ki e_i
 /// with the frame of the current coarse positions (#M x 3, M ==
-/// links.num_coarse_nodes). dense_out must already have links.num_links() rows;
-/// no memory is allocated. Throws ParameterError on a size mismatch. A link
-/// whose three nodes have become collinear yields non-finite output; the caller
-/// (FEM health check) detects that.
+/// links.num_coarse_nodes). dense_out must already have links.num_links() rows.
+/// Convenience wrapper: builds a LinkEvaluator on the fly (sorts the links by
+/// node triple and allocates ~60 bytes per link, several times the cost of one
+/// evaluation), so code that evaluates the same links every frame should keep a
+/// LinkEvaluator (coupling/link_evaluator.hpp) instead. Degenerate frames use
+/// the evaluator's fallback frame (no previous frame: see link_evaluator.hpp).
+/// Throws ParameterError on a size mismatch, InputError on inconsistent links,
+/// NumericalError when a linked coarse node is not finite.
 void apply(const RigidLinks& links, const Eigen::Ref<const MatX3d>& coarse_positions,
            Eigen::Ref<MatX3d> dense_out);
+
+/// The original one-link-at-a-time evaluation (Eigen 3-vectors, the frame
+/// recomputed for every link), kept as the reference that LinkEvaluator is
+/// tested and benchmarked against. Same contract as apply() except for
+/// degenerate frames: an axis whose defining vector is exactly zero stays zero
+/// (Eigen's normalized()), so exactly collinear nodes drop the e0 and e2 terms
+/// and coincident q0 == q1 collapse the vertex onto O; non-finite coarse
+/// positions give non-finite output without an exception. No allocation.
+void apply_reference(const RigidLinks& links, const Eigen::Ref<const MatX3d>& coarse_positions,
+                     Eigen::Ref<MatX3d> dense_out);
+
+/// The origin map of Eq. 1 as a sparse matrix A (#N x #M, row-major, three
+/// entries alpha_ki per row at columns nodes(k, i)): O = A * coarse_positions.
+Eigen::SparseMatrix<double, Eigen::RowMajor> origin_matrix(const RigidLinks& links);
 
 /// Checks the internal consistency of `links` (sizes, index ranges, finite
 /// values, weights summing to 1); throws InputError naming `what` and the first

@@ -1,0 +1,113 @@
+#pragma once
+/// Fast evaluation of the rigid links (paper section 3.2, Eqs. 1, 9, 10).
+///
+/// Many dense vertices share the same ordered coarse node triple (q0, q1, q2).
+/// LinkEvaluator groups the links by triple once; each apply() then computes
+/// the deformed frame (e0, e1, e2) of Eqs. 4-6 once per unique triple and
+/// evaluates every link of the triple as a 3 x 6 matrix times its six stored
+/// numbers,
+///   p = [q0 q1 q2 | e0 e1 e2] (alpha_0, alpha_1, alpha_2, c_0, c_1, c_2)^T,
+/// in structure-of-arrays loops that the compiler vectorises. The arithmetic is
+/// the same, in the same order, as apply_reference(), so results agree with it
+/// to rounding (bit for bit when the compiler contracts no multiply-adds).
+///
+/// Degenerate frames. When the deformed triangle (q0, q1, q2) is degenerate
+/// (|n| <= degenerate_tolerance * |q1 - q0| * |q2 - q0|: collinear or
+/// coincident nodes) the frame of Eqs. 4-6 is undefined. The evaluator then
+/// uses a fallback frame that is orthonormal and right-handed like Eqs. 4-6
+/// (e2 = e0 x e1), so every link keeps its length |c| (no NaN, no collapse):
+///   - if q0 != q1: e1 = (q0 - q1) / |q0 - q1| as usual; e0 is the previous
+///     frame's e0 (or, if that is nearly parallel to e1, its e2) made
+///     orthogonal to e1 and normalised; e2 = e0 x e1. The "previous frame" is
+///     the frame this triple had at the last apply() (the state kept by the
+///     evaluator), or, before any, the frame of the first non-degenerate
+///     apply; a triple never seen non-degenerate uses the coordinate axis
+///     least aligned with e1.
+///   - if q0 == q1: the previous frame is kept unchanged (the identity frame
+///     if there is none).
+/// The number of degenerate triples and of links they carry is returned, so a
+/// caller's health check can react.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "coupling/rigid_links.hpp"
+#include "mesh/io/types.hpp"
+
+namespace icd::coupling {
+
+/// Options of LinkEvaluator.
+struct LinkEvaluatorOptions {
+  /// A deformed frame is degenerate when |n| <= degenerate_tolerance *
+  /// |q1 - q0| * |q2 - q0|, i.e. when the sine of the triangle's angle at q0 is
+  /// at most this (dimensionless, in [0, 1)); also when an edge is zero. Near
+  /// that limit the frame of Eqs. 4-6 loses orthogonality like 1e-16 / sine
+  /// (1e-10 at the default), so smaller values follow apply_reference() into
+  /// noisier frames. Links are built with sines >= ~1e-3 (RigidLinkOptions).
+  double degenerate_tolerance = 1e-6;
+};
+
+/// What LinkEvaluator::apply() met.
+struct LinkApplyResult {
+  int degenerate_triples = 0;  ///< triples that used the fallback frame this call
+  int degenerate_links = 0;    ///< dense vertices carried by those triples
+};
+
+/// The rigid links of one object, grouped by coarse node triple for fast
+/// per-frame evaluation. Build once per RigidLinks (cost O(N log N), memory
+/// about 60 bytes per link plus 220 per unique triple), then call apply()
+/// every frame. apply() allocates nothing. Not thread-safe: apply() updates
+/// the per-triple frame state used by the degenerate-frame fallback.
+class LinkEvaluator {
+ public:
+  LinkEvaluator() = default;
+
+  /// Groups `links` (checked with validate()) by node triple. Throws InputError
+  /// when the links are inconsistent, ParameterError on a bad option.
+  explicit LinkEvaluator(const RigidLinks& links, const LinkEvaluatorOptions& options = {});
+
+  /// Evaluates every link (Eqs. 1, 9, 10) for the current coarse positions
+  /// (#M x 3, M == num_coarse_nodes()) into dense_out (#N x 3, N ==
+  /// num_links(), resized by nobody: must already have N rows). Equal to
+  /// apply_reference() to rounding wherever no frame is degenerate; see the file
+  /// comment for degenerate frames. Throws ParameterError on a size mismatch,
+  /// NumericalError naming the node when a linked coarse node is not finite
+  /// (dense_out is then left unspecified).
+  LinkApplyResult apply(const Eigen::Ref<const MatX3d>& coarse_positions,
+                        Eigen::Ref<MatX3d> dense_out);
+
+  /// Forgets the frame state: the next apply() behaves as on a new evaluator.
+  void reset_frames();
+
+  int num_links() const { return static_cast<int>(m_order.size()); }
+  int num_coarse_nodes() const { return m_num_coarse_nodes; }
+  /// Number of distinct ordered node triples (q0, q1, q2) among the links.
+  int num_triples() const { return static_cast<int>(m_group_offset.size()) - 1; }
+
+ private:
+  /// Number of per-triple scalars: q0, q1, q2, e0, e1, e2 (3 each).
+  static constexpr int kTripleScalars = 18;
+
+  void gather_nodes(const Eigen::Ref<const MatX3d>& coarse_positions);
+  int compute_frames();
+  void fallback_frame(int t);
+  void evaluate_links();
+
+  LinkEvaluatorOptions m_options;
+  int32_t m_num_coarse_nodes = 0;
+  std::vector<int32_t> m_triple_nodes;  ///< #T x 3, row-major: q0, q1, q2 node indices
+  std::vector<int32_t> m_group_offset;  ///< #T + 1: links of triple t are [offset[t], offset[t+1])
+  std::vector<int32_t> m_order;         ///< #N: link (dense vertex) at grouped position j
+  /// 6 x #N, structure of arrays in grouped order: alpha_0..2, then c_0..2.
+  std::vector<double> m_weights;
+  /// kTripleScalars x #T, structure of arrays: q0x q0y q0z q1x ... e2z.
+  std::vector<double> m_triple;
+  std::vector<char> m_degenerate;  ///< #T: flag of the last apply()
+  std::vector<char> m_has_frame;   ///< #T: a previous frame is stored in m_triple
+  /// 3 x #N: evaluated positions in grouped order (x, y, z arrays), scattered
+  /// into the caller's rows at the end.
+  std::vector<double> m_out;
+};
+
+}  // namespace icd::coupling
