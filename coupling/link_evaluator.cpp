@@ -13,10 +13,6 @@
 namespace icd::coupling {
 namespace {
 
-// Slots of the per-triple scalars (each an array of #T doubles): the nodes
-// q0, q1, q2, then the frame e0, e1, e2, each x, y, z.
-constexpr int kQ0 = 0, kQ1 = 3, kQ2 = 6, kE0 = 9, kE1 = 12, kE2 = 15;
-
 struct Vec {
   double x, y, z;
 };
@@ -43,35 +39,39 @@ LinkEvaluator::LinkEvaluator(const RigidLinks& links, const LinkEvaluatorOptions
                          std::to_string(options.degenerate_tolerance));
   validate(links, "LinkEvaluator");
   const int N = links.num_links();
-  m_order.resize(N);
-  std::iota(m_order.begin(), m_order.end(), 0);
+  // Distinct ordered triples, numbered in order of first use (so that the
+  // link loop walks the triple table mostly forwards).
+  std::vector<int32_t> order(N);
+  std::iota(order.begin(), order.end(), 0);
   const auto key = [&](int32_t k) {
     return std::array<int32_t, 4>{links.nodes(k, 0), links.nodes(k, 1), links.nodes(k, 2), k};
   };
-  std::sort(m_order.begin(), m_order.end(), [&](int32_t a, int32_t b) { return key(a) < key(b); });
-
-  m_group_offset.push_back(0);
-  for (int j = 0; j < N; ++j) {
-    const int32_t k = m_order[j];
-    if (j > 0 && links.nodes.row(k) != links.nodes.row(m_order[j - 1])) m_group_offset.push_back(j);
-    if (m_group_offset.size() > m_triple_nodes.size() / 3)
-      for (int i = 0; i < 3; ++i) m_triple_nodes.push_back(links.nodes(k, i));
+  std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return key(a) < key(b); });
+  m_link_triple.assign(N, -1);
+  for (int j = 0; j < N;) {  // one run of equal triples: all get the id of its first link
+    int end = j + 1;
+    while (end < N && links.nodes.row(order[end]) == links.nodes.row(order[j])) ++end;
+    for (int i = j; i < end; ++i) m_link_triple[order[i]] = order[j];
+    j = end;
   }
-  m_group_offset.push_back(N);
-  if (N == 0) m_group_offset.assign(1, 0);
-  const int T = num_triples();
-  assert(static_cast<int>(m_triple_nodes.size()) == 3 * T);
-
-  m_weights.resize(6 * static_cast<size_t>(N));
-  for (int j = 0; j < N; ++j)
-    for (int i = 0; i < 3; ++i) {
-      m_weights[i * static_cast<size_t>(N) + j] = links.alpha(m_order[j], i);
-      m_weights[(3 + i) * static_cast<size_t>(N) + j] = links.coeffs(m_order[j], i);
+  std::vector<int32_t> id(N, -1);  // first link -> triple number
+  for (int k = 0; k < N; ++k) {
+    int32_t& t = id[m_link_triple[k]];
+    if (t < 0) {
+      t = static_cast<int32_t>(m_links_per_triple.size());
+      m_links_per_triple.push_back(0);
+      for (int i = 0; i < 3; ++i) m_triple_nodes.push_back(links.nodes(k, i));
     }
-  m_triple.assign(kTripleScalars * static_cast<size_t>(T), 0.0);
+    m_link_triple[k] = t;
+    ++m_links_per_triple[t];
+  }
+  m_weights.resize(6, N);
+  m_weights.topRows(3) = links.alpha.transpose();
+  m_weights.bottomRows(3) = links.coeffs.transpose();
+  const int T = num_triples();
   m_degenerate.assign(T, 0);
+  m_table.setZero(24, T);
   m_has_frame.assign(T, 0);
-  m_out.resize(3 * static_cast<size_t>(N));
 }
 
 void LinkEvaluator::reset_frames() { std::fill(m_has_frame.begin(), m_has_frame.end(), 0); }
@@ -85,95 +85,89 @@ LinkApplyResult LinkEvaluator::apply(const Eigen::Ref<const MatX3d>& coarse_posi
   if (dense_out.rows() != num_links())
     throw ParameterError("LinkEvaluator::apply: dense_out has " + std::to_string(dense_out.rows()) +
                          " rows, expected " + std::to_string(num_links()));
-  gather_nodes(coarse_positions);
   LinkApplyResult result;
-  result.degenerate_triples = compute_frames();
-  if (result.degenerate_triples > 0) {
+  result.degenerate_triples = update_triples(coarse_positions);
+  if (result.degenerate_triples > 0)
     for (int t = 0; t < num_triples(); ++t)
       if (m_degenerate[t]) {
         fallback_frame(t);
-        result.degenerate_links += m_group_offset[t + 1] - m_group_offset[t];
+        result.degenerate_links += m_links_per_triple[t];
       }
-  }
-  evaluate_links();
-
-  const int N = num_links();
-  const double* __restrict x = m_out.data();
-  const double* __restrict y = x + N;
-  const double* __restrict z = y + N;
-  const int32_t* __restrict order = m_order.data();
-  double* out = dense_out.data();
-  const Eigen::Index stride = dense_out.outerStride();
-  for (int j = 0; j < N; ++j) {
-    double* row = out + order[j] * stride;
-    row[0] = x[j];
-    row[1] = y[j];
-    row[2] = z[j];
-  }
+  evaluate_links(dense_out);
   return result;
 }
 
-void LinkEvaluator::gather_nodes(const Eigen::Ref<const MatX3d>& coarse_positions) {
-  const int T = num_triples();
-  double* q = m_triple.data();
-  bool finite = true;
-  for (int t = 0; t < T; ++t)
-    for (int i = 0; i < 3; ++i) {
-      const int32_t v = m_triple_nodes[3 * t + i];
-      for (int d = 0; d < 3; ++d) {
-        const double c = coarse_positions(v, d);
-        finite = finite && std::isfinite(c);
-        q[(3 * i + d) * static_cast<size_t>(T) + t] = c;
-      }
-    }
-  if (finite) return;
-  for (int t = 0; t < T; ++t)
-    for (int i = 0; i < 3; ++i) {
-      const int32_t v = m_triple_nodes[3 * t + i];
-      if (!coarse_positions.row(v).allFinite())
-        throw NumericalError("LinkEvaluator::apply: coarse node " + std::to_string(v) +
-                             " has a non-finite position");
-    }
+void LinkEvaluator::check_finite(const Eigen::Ref<const MatX3d>& coarse_positions) const {
+  for (size_t i = 0; i < m_triple_nodes.size(); ++i) {
+    const int32_t v = m_triple_nodes[i];
+    if (!coarse_positions.row(v).allFinite())
+      throw NumericalError("LinkEvaluator::apply: coarse node " + std::to_string(v) +
+                           " has a non-finite position");
+  }
 }
 
-int LinkEvaluator::compute_frames() {
+// Eqs. 4-6 for kLanes triples at a time: the triples' nodes are gathered into
+// fixed-size lane arrays (the last chunk repeats its last triple), on which
+// Eigen's packet arithmetic (sqrt included) runs; then nodes and frames are
+// stored into the per-triple table, except the frames of degenerate triples.
+// Returns the number of degenerate triples; throws when a node is not finite.
+int LinkEvaluator::update_triples(const Eigen::Ref<const MatX3d>& coarse_positions) {
+  constexpr int kLanes = 8;
+  using Lane = Eigen::Array<double, kLanes, 1>;
   const int T = num_triples();
-  const double tol = m_options.degenerate_tolerance;
-  double* s = m_triple.data();
-  const auto at = [&](int slot, int t) -> double& { return s[slot * static_cast<size_t>(T) + t]; };
+  const double* X = coarse_positions.data();
+  const Eigen::Index stride = coarse_positions.outerStride();
+  const double tol2 = m_options.degenerate_tolerance * m_options.degenerate_tolerance;
   int degenerate = 0;
-  for (int t = 0; t < T; ++t) {
-    const Vec q0{at(kQ0, t), at(kQ0 + 1, t), at(kQ0 + 2, t)};
-    const Vec q1{at(kQ1, t), at(kQ1 + 1, t), at(kQ1 + 2, t)};
-    const Vec q2{at(kQ2, t), at(kQ2 + 1, t), at(kQ2 + 2, t)};
-    const Vec u = sub(q1, q0), v = sub(q2, q0);
-    const Vec n = cross(u, v);  // Eq. 4
-    const double nn = dot(n, n);
-    const bool bad = !(std::sqrt(nn) > tol * std::sqrt(dot(u, u)) * std::sqrt(dot(v, v)) &&
-                       nn < std::numeric_limits<double>::infinity());
-    m_degenerate[t] = bad;
-    if (bad) {
-      ++degenerate;
-      continue;  // keep the previous frame for fallback_frame()
+  bool finite = true;
+  for (int t0 = 0; t0 < T; t0 += kLanes) {
+    Lane q[9];  // q0x q0y q0z q1x ... q2z
+    for (int l = 0; l < kLanes; ++l) {
+      const int t = std::min(t0 + l, T - 1);
+      for (int i = 0; i < 3; ++i) {
+        const double* row = X + m_triple_nodes[3 * t + i] * stride;
+        for (int d = 0; d < 3; ++d) q[3 * i + d][l] = row[d];
+      }
     }
-    const Vec a = cross(u, n);                                                 // Eq. 5
-    const Vec e[3] = {normalized(n), normalized(sub(q0, q1)), normalized(a)};  // Eq. 6
-    for (int i = 0; i < 3; ++i) {
-      at(kE0 + 3 * i, t) = e[i].x;
-      at(kE0 + 3 * i + 1, t) = e[i].y;
-      at(kE0 + 3 * i + 2, t) = e[i].z;
+    const Lane ux = q[3] - q[0], uy = q[4] - q[1], uz = q[5] - q[2];
+    const Lane vx = q[6] - q[0], vy = q[7] - q[1], vz = q[8] - q[2];
+    const Lane nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;  // Eq. 4
+    const Lane ax = uy * nz - uz * ny, ay = uz * nx - ux * nz, az = ux * ny - uy * nx;  // Eq. 5
+    const Lane nn = nx.square() + ny.square() + nz.square();
+    const Lane uu = ux.square() + uy.square() + uz.square();
+    const Lane vv = vx.square() + vy.square() + vz.square();
+    // Eq. 6: e0 = n / |n|, e1 = (q0 - q1) / |q0 - q1| = -u / |u|, e2 = a / |a|
+    // with |a| = |u| |n| (u is orthogonal to n).
+    const Lane inv_n = nn.sqrt().inverse();
+    const Lane minus_inv_u = -uu.sqrt().inverse();
+    const Lane inv_a = -inv_n * minus_inv_u;
+    const Lane* e[9] = {&nx, &ny, &nz, &ux, &uy, &uz, &ax, &ay, &az};
+    const Lane* scale[3] = {&inv_n, &minus_inv_u, &inv_a};
+    const int lanes = std::min(kLanes, T - t0);
+    for (int l = 0; l < lanes; ++l) {
+      const int t = t0 + l;
+      double* col = m_table.col(t).data();
+      for (int i = 0; i < 9; ++i) col[4 * (i / 3) + i % 3] = q[i][l];
+      finite = finite && std::isfinite(nn[l] + uu[l] + vv[l]);
+      const bool ok = nn[l] > 0.0 && nn[l] > tol2 * uu[l] * vv[l] &&
+                      nn[l] < std::numeric_limits<double>::infinity();
+      m_degenerate[t] = !ok;
+      if (!ok) {
+        ++degenerate;
+        continue;
+      }
+      for (int i = 0; i < 9; ++i) col[12 + 4 * (i / 3) + i % 3] = (*e[i])[l] * (*scale[i / 3])[l];
+      m_has_frame[t] = 1;
     }
-    m_has_frame[t] = 1;
   }
+  if (!finite) check_finite(coarse_positions);
   return degenerate;
 }
 
 void LinkEvaluator::fallback_frame(int t) {
-  const int T = num_triples();
-  double* s = m_triple.data();
-  const auto at = [&](int slot) -> double& { return s[slot * static_cast<size_t>(T) + t]; };
-  const auto load = [&](int slot) { return Vec{at(slot), at(slot + 1), at(slot + 2)}; };
-  const Vec q0 = load(kQ0), q1 = load(kQ1);
+  double* col = m_table.col(t).data();
+  const auto load = [&](int offset) { return Vec{col[offset], col[offset + 1], col[offset + 2]}; };
+  const Vec q0 = load(0), q1 = load(4);
   Vec e0, e1, e2;
   const Vec d = sub(q0, q1);
   const double dd = dot(d, d);
@@ -182,9 +176,9 @@ void LinkEvaluator::fallback_frame(int t) {
     e1 = {d.x / len, d.y / len, d.z / len};
     Vec cand;
     if (m_has_frame[t]) {
-      cand = load(kE0);
+      cand = load(12);
       const double c = dot(cand, e1);
-      if (1.0 - c * c < 0.25) cand = load(kE2);  // e1 turned towards the old e0
+      if (1.0 - c * c < 0.25) cand = load(20);  // e1 turned towards the old e0
     } else {
       // The coordinate axis least aligned with e1.
       const double ax = std::abs(e1.x), ay = std::abs(e1.y), az = std::abs(e1.z);
@@ -194,9 +188,9 @@ void LinkEvaluator::fallback_frame(int t) {
     e0 = normalized(Vec{cand.x - c * e1.x, cand.y - c * e1.y, cand.z - c * e1.z});
     e2 = cross(e0, e1);
   } else if (m_has_frame[t]) {
-    e0 = load(kE0);
-    e1 = load(kE1);
-    e2 = load(kE2);
+    e0 = load(12);
+    e1 = load(16);
+    e2 = load(20);
   } else {
     e0 = {1, 0, 0};
     e1 = {0, 1, 0};
@@ -204,41 +198,32 @@ void LinkEvaluator::fallback_frame(int t) {
   }
   const Vec e[3] = {e0, e1, e2};
   for (int i = 0; i < 3; ++i) {
-    at(kE0 + 3 * i) = e[i].x;
-    at(kE0 + 3 * i + 1) = e[i].y;
-    at(kE0 + 3 * i + 2) = e[i].z;
+    col[12 + 4 * i] = e[i].x;
+    col[12 + 4 * i + 1] = e[i].y;
+    col[12 + 4 * i + 2] = e[i].z;
   }
   m_has_frame[t] = 1;
 }
 
-void LinkEvaluator::evaluate_links() {
-  const int T = num_triples();
-  const size_t N = m_order.size();
-  const double* __restrict w = m_weights.data();
-  const double* __restrict a0 = w;
-  const double* __restrict a1 = w + N;
-  const double* __restrict a2 = w + 2 * N;
-  const double* __restrict c0 = w + 3 * N;
-  const double* __restrict c1 = w + 4 * N;
-  const double* __restrict c2 = w + 5 * N;
-  double* __restrict px = m_out.data();
-  double* __restrict py = px + N;
-  double* __restrict pz = py + N;
-  const double* s = m_triple.data();
-  double m[kTripleScalars];
-  for (int t = 0; t < T; ++t) {
-    for (int k = 0; k < kTripleScalars; ++k) m[k] = s[k * static_cast<size_t>(T) + t];
-    const int32_t end = m_group_offset[t + 1];
-    // p = ((a0 q0 + a1 q1) + a2 q2) + c0 e0 + c1 e1 + c2 e2, left to right
-    // as in apply_reference() (Eqs. 1, 9, 10).
-    for (int32_t j = m_group_offset[t]; j < end; ++j) {
-      px[j] = a0[j] * m[kQ0] + a1[j] * m[kQ1] + a2[j] * m[kQ2] + c0[j] * m[kE0] + c1[j] * m[kE1] +
-              c2[j] * m[kE2];
-      py[j] = a0[j] * m[kQ0 + 1] + a1[j] * m[kQ1 + 1] + a2[j] * m[kQ2 + 1] + c0[j] * m[kE0 + 1] +
-              c1[j] * m[kE1 + 1] + c2[j] * m[kE2 + 1];
-      pz[j] = a0[j] * m[kQ0 + 2] + a1[j] * m[kQ1 + 2] + a2[j] * m[kQ2 + 2] + c0[j] * m[kE0 + 2] +
-              c1[j] * m[kE1 + 2] + c2[j] * m[kE2 + 2];
-    }
+// p = ((a0 q0 + a1 q1) + a2 q2) + c0 e0 + c1 e1 + c2 e2, summed left to right as
+// in apply_reference() (Eqs. 1, 9, 10), on (x, y, z, pad) packets.
+void LinkEvaluator::evaluate_links(Eigen::Ref<MatX3d> dense_out) const {
+  using Packet = Eigen::Map<const Eigen::Vector4d, Eigen::Aligned16>;
+  const int N = num_links();
+  const int32_t* triple = m_link_triple.data();
+  const double* table = m_table.data();
+  const double* weights = m_weights.data();
+  double* out = dense_out.data();
+  const Eigen::Index stride = dense_out.outerStride();
+  for (int k = 0; k < N; ++k) {
+    const double* m = table + 24 * static_cast<Eigen::Index>(triple[k]);
+    const double* w = weights + 6 * static_cast<Eigen::Index>(k);
+    const Eigen::Vector4d p = w[0] * Packet(m) + w[1] * Packet(m + 4) + w[2] * Packet(m + 8) +
+                              w[3] * Packet(m + 12) + w[4] * Packet(m + 16) + w[5] * Packet(m + 20);
+    double* row = out + k * stride;
+    row[0] = p[0];
+    row[1] = p[1];
+    row[2] = p[2];
   }
 }
 

@@ -80,34 +80,31 @@ class LinkEvaluator {
   /// Forgets the frame state: the next apply() behaves as on a new evaluator.
   void reset_frames();
 
-  int num_links() const { return static_cast<int>(m_order.size()); }
+  int num_links() const { return static_cast<int>(m_link_triple.size()); }
   int num_coarse_nodes() const { return m_num_coarse_nodes; }
   /// Number of distinct ordered node triples (q0, q1, q2) among the links.
-  int num_triples() const { return static_cast<int>(m_group_offset.size()) - 1; }
+  int num_triples() const { return static_cast<int>(m_links_per_triple.size()); }
 
  private:
-  /// Number of per-triple scalars: q0, q1, q2, e0, e1, e2 (3 each).
-  static constexpr int kTripleScalars = 18;
-
-  void gather_nodes(const Eigen::Ref<const MatX3d>& coarse_positions);
-  int compute_frames();
+  void check_finite(const Eigen::Ref<const MatX3d>& coarse_positions) const;
+  int update_triples(const Eigen::Ref<const MatX3d>& coarse_positions);
   void fallback_frame(int t);
-  void evaluate_links();
+  void evaluate_links(Eigen::Ref<MatX3d> dense_out) const;
 
   LinkEvaluatorOptions m_options;
   int32_t m_num_coarse_nodes = 0;
-  std::vector<int32_t> m_triple_nodes;  ///< #T x 3, row-major: q0, q1, q2 node indices
-  std::vector<int32_t> m_group_offset;  ///< #T + 1: links of triple t are [offset[t], offset[t+1])
-  std::vector<int32_t> m_order;         ///< #N: link (dense vertex) at grouped position j
-  /// 6 x #N, structure of arrays in grouped order: alpha_0..2, then c_0..2.
-  std::vector<double> m_weights;
-  /// kTripleScalars x #T, structure of arrays: q0x q0y q0z q1x ... e2z.
-  std::vector<double> m_triple;
-  std::vector<char> m_degenerate;  ///< #T: flag of the last apply()
-  std::vector<char> m_has_frame;   ///< #T: a previous frame is stored in m_triple
-  /// 3 x #N: evaluated positions in grouped order (x, y, z arrays), scattered
-  /// into the caller's rows at the end.
-  std::vector<double> m_out;
+  /// #T x 3, row-major: node indices q0, q1, q2 of each distinct triple, in
+  /// order of first use by the links.
+  std::vector<int32_t> m_triple_nodes;
+  std::vector<int32_t> m_links_per_triple;  ///< #T
+  std::vector<int32_t> m_link_triple;       ///< #N: triple of each link
+  /// 6 x #N (column k: alpha_k0..2, c_k0..2 of link k).
+  Eigen::Matrix<double, 6, Eigen::Dynamic> m_weights;
+  /// 24 x #T, column t: q0, q1, q2, e0, e1, e2 of triple t, each padded to 4
+  /// doubles (aligned packets). The frame part is the state kept between calls.
+  Eigen::Matrix<double, 24, Eigen::Dynamic> m_table;
+  std::vector<char> m_has_frame;   ///< #T: m_table holds a frame of this triple
+  std::vector<char> m_degenerate;  ///< #T: degenerate at the last apply()
 };
 
 }  // namespace icd::coupling
