@@ -86,14 +86,14 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
   csv.precision(9);
   csv << "frame,time,wall,fem,links,sphere_update,collision,response,budget,pair_list,"
          "collision_list,tests,interrupted,completed_level,active_pairs,max_penetration,"
-         "contact_force,cycles,substeps,min_step,energy,exact_contacts\n";
+         "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused\n";
   for (const FrameMetrics& m : frames)
     csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
         << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
         << ',' << m.budget << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests
         << ',' << m.interrupted << ',' << m.completed_level << ',' << m.active_pairs << ','
         << m.max_penetration << ',' << m.contact_force << ',' << m.cycles << ',' << m.substeps << ',' << m.min_step
-        << ',' << m.energy << ',' << m.exact_contacts << '\n';
+        << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback << ',' << m.reused << '\n';
   return csv.str();
 }
 
@@ -140,14 +140,16 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
 
   if (opt.log) {
     std::fprintf(opt.log,
-                 "%-13s %7s %8s %8s %8s %8s %8s %9s %9s %6s\n", "frames", "fps", "fem%", "links%",
-                 "update%", "collide%", "respond%", "PAIRLIST", "COLLLIST", "intr.");
+                 "%-13s %7s %8s %8s %8s %8s %8s %9s %9s %6s %6s %7s\n", "frames", "fps", "fem%",
+                 "links%", "update%", "collide%", "respond%", "PAIRLIST", "COLLLIST", "intr.",
+                 "reused", "cycles");
     const int ranges = std::max(1, std::min(opt.summary_ranges, scene.frames));
     for (int r = 0; r < ranges; ++r) {
       const int a = r * scene.frames / ranges, b = (r + 1) * scene.frames / ranges;
       StageTimes sum;
       double wall = 0, pl = 0, cl = 0;
-      int intr = 0;
+      int intr = 0, reused = 0;
+      double cycles = 0;
       for (int f = a; f < b; ++f) {
         const FrameMetrics& m = frames[f];
         wall += m.wall;
@@ -159,14 +161,16 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
         pl += m.pair_list;
         cl += m.collision_list;
         intr += m.interrupted;
+        reused += m.reused;
+        cycles += m.cycles;
       }
       const double n = b - a;
       char label[32];
       std::snprintf(label, sizeof label, "%d-%d", a, b - 1);
-      std::fprintf(opt.log, "%-13s %7.1f %8.1f %8.1f %8.1f %8.1f %8.1f %9.1f %9.1f %6d\n", label,
-                   n / wall, 100 * sum.fem / wall, 100 * sum.links / wall,
+      std::fprintf(opt.log, "%-13s %7.1f %8.1f %8.1f %8.1f %8.1f %8.1f %9.1f %9.1f %6d %6d %7.1f\n",
+                   label, n / wall, 100 * sum.fem / wall, 100 * sum.links / wall,
                    100 * sum.sphere_update / wall, 100 * sum.collision / wall,
-                   100 * sum.response / wall, pl / n, cl / n, intr);
+                   100 * sum.response / wall, pl / n, cl / n, intr, reused, cycles / n);
     }
   }
 

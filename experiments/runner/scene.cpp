@@ -224,6 +224,7 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.depth_cap = f.integer("depth_cap", -1, -1, 64);
   c.temporal_coherence = f.boolean("temporal_coherence", false);
   c.layered = f.boolean("layered", true);
+  c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", true);
   const std::string upd = f.string("sphere_update", "paper", {"paper", "conservative"});
   c.update.mode = upd == "paper" ? collision::SphereUpdateMode::PaperRatio
                                  : collision::SphereUpdateMode::DisplacementBound;
@@ -236,6 +237,9 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
                                ? coupling::ContactDistribution::PartitionOfUnity
                                : coupling::ContactDistribution::MassWeighted;
   c.contact.use_untested = f.boolean("use_untested", true);
+  c.on_interrupt = f.string("on_interrupt", "previous", {"untested", "previous"}) == "untested"
+                       ? InterruptedResponse::Untested
+                       : InterruptedResponse::Previous;
   f.finish();
   return c;
 }

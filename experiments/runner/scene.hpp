@@ -63,6 +63,19 @@ struct ObjectSpec {
   std::vector<int> fixed_nodes;  ///< coarse node indices held fixed
 };
 
+/// What the response uses when a query is interrupted by its budget.
+enum class InterruptedResponse {
+  /// The paper (4.2): the untested pairs (PAIRLIST) count as colliding, with
+  /// their own, coarser spheres. An interruption at a coarse level (e.g. the
+  /// process lost the processor for longer than the budget) then pushes with
+  /// the penetration of large inner spheres: an energy kick.
+  Untested,
+  /// The last complete answer of the pair, if it is at most one frame old,
+  /// re-evaluated at the current sphere positions; otherwise as Untested.
+  /// The query's own lists (PAIRLIST, COLLISIONLIST) are still reported.
+  Previous,
+};
+
 /// Collision detection and response settings.
 struct CollisionSpec {
   double budget_seconds = 1e-3;  ///< critical time per pair query (s); inf = none
@@ -79,8 +92,13 @@ struct CollisionSpec {
   /// already deeply overlapping once its parents start to overlap (an energy
   /// kick: a ball bouncing between static walls gained ~30x its energy).
   bool layered = true;
+  /// A frame that starts with every pair apart runs as one detection/response
+  /// cycle, rolled back and re-run in full cycles if its closing query finds
+  /// a contact (see World::step). false: every frame runs all its cycles.
+  bool single_cycle_when_apart = true;
   collision::SphereUpdateOptions update;
   coupling::ContactOptions contact;
+  InterruptedResponse on_interrupt = InterruptedResponse::Previous;
 };
 
 /// What the run writes.

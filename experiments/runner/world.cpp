@@ -83,6 +83,8 @@ World::World(const Scene& scene, const std::filesystem::path& cache_dir,
     if (o.sim) m_min_node_mass = std::min(m_min_node_mass, o.node_mass.minCoeff());
   m_results.resize(m_plan.pairs.size());
   m_fronts.resize(m_plan.pairs.size());
+  m_complete.resize(m_plan.pairs.size());
+  m_complete_time.assign(m_plan.pairs.size(), -std::numeric_limits<double>::infinity());
 }
 
 int World::contact_cycles(double dt) const {
@@ -101,7 +103,7 @@ void World::update_dense(RuntimeObject& o) {
   coupling::apply(o.asset.links, o.positions, o.dense);
 }
 
-void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
+void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics& m) {
   Clock::time_point t0 = Clock::now();
   // 1. Deformation: FEM for deformable objects (with last frame's contact
   //    forces), rigid motion for kinematic ones.
@@ -170,6 +172,11 @@ void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
     }
     collision::collide(m_objects[i].asset.spheres, m_objects[j].asset.spheres, req, r);
     if (cs.temporal_coherence) m_fronts[p] = r.front;
+    if (!r.interrupted && cs.on_interrupt == InterruptedResponse::Previous) {
+      m_complete[p].colliding = r.colliding;  // copies into reused storage
+      m_complete[p].untested = r.untested;
+      m_complete_time[p] = t_end;
+    }
     if (last) {
       m.pair_list += static_cast<int64_t>(r.untested.size());
       m.collision_list += static_cast<int64_t>(r.colliding.size());
@@ -196,8 +203,16 @@ void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
       co.coincident_direction = cb - ca;
       co.mass_a = &a.node_mass;
       co.mass_b = &b.node_mass;
+      // An interrupted query answers with coarse spheres; with on_interrupt =
+      // "previous" the last complete answer (at most a frame old) stands in,
+      // evaluated at the current sphere positions.
+      const bool reuse = m_results[p].interrupted &&
+                         cs.on_interrupt == InterruptedResponse::Previous &&
+                         t_end - m_complete_time[p] <= 1.0 / m_scene.frame_rate + 1e-12;
+      if (reuse) ++m.reused;
       const coupling::ContactStats st = coupling::apply_contact_forces(
-          a.asset.spheres, b.asset.spheres, m_results[p], co, a.contact_forces, b.contact_forces);
+          a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : m_results[p], co,
+          a.contact_forces, b.contact_forces);
       m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
       m.max_penetration = std::max(m.max_penetration, st.max_penetration);
       if (last) {
@@ -210,12 +225,57 @@ void World::cycle(double h, double budget, bool last, FrameMetrics& m) {
 
 }
 
+bool World::contact_free() const {
+  for (const collision::CollisionResult& r : m_results)
+    if (!r.colliding.empty() || !r.untested.empty()) return false;
+  return true;
+}
+
+void World::save(Snapshot& s) const {
+  s.positions.resize(m_objects.size());
+  s.velocities.resize(m_objects.size());
+  for (size_t i = 0; i < m_objects.size(); ++i) {
+    const RuntimeObject& o = m_objects[i];
+    s.positions[i] = o.positions;
+    if (o.sim) s.velocities[i] = o.sim->velocities();
+  }
+  s.fronts = m_fronts;
+  s.complete = m_complete;
+  s.complete_time = m_complete_time;
+  s.node_stiffness = m_node_stiffness;
+}
+
+void World::restore(const Snapshot& s) {
+  for (size_t i = 0; i < m_objects.size(); ++i) {
+    RuntimeObject& o = m_objects[i];
+    o.positions = s.positions[i];
+    o.contact_forces.setZero();  // the trial started contact-free: no forces
+    if (o.sim) {
+      o.sim->set_positions(s.positions[i]);
+      o.sim->set_velocities(s.velocities[i]);
+    }
+  }
+  m_fronts = s.fronts;
+  m_complete = s.complete;
+  m_complete_time = s.complete_time;
+  m_node_stiffness = s.node_stiffness;
+}
+
 FrameMetrics World::step(double budget) {
   const Clock::time_point frame_start = Clock::now();
   const double dt = 1.0 / m_scene.frame_rate;
   FrameMetrics m;
   m.frame = m_frame;
   m.min_step = std::numeric_limits<double>::infinity();
+  m.budget = budget >= 0 ? budget : m_scene.collision.budget_seconds;
+
+  // Real-time mode: collision detection gets what is left of the frame (of
+  // the first `fraction` of it), shared between the pairs.
+  const auto budget_at = [&](double fraction) {
+    if (budget >= 0 || m_scene.target_fps <= 0 || m_plan.pairs.empty()) return m.budget;
+    const double left = fraction / m_scene.target_fps - seconds_since(frame_start);
+    return std::max(kMinRealTimeBudget, left / static_cast<double>(m_plan.pairs.size()));
+  };
 
   // The contact response is explicit and staggered: forces computed from one
   // query act until the next. Its stiffness k on a node of mass m oscillates
@@ -224,18 +284,39 @@ FrameMetrics World::step(double budget) {
   // many detection/response cycles as that needs; FEM sub-steps inside each.
   const int cycles = contact_cycles(dt);
   m.cycles = cycles;
-  const double h = dt / cycles;
-  m.budget = budget >= 0 ? budget : m_scene.collision.budget_seconds;
-  for (int c = 0; c < cycles; ++c) {
-    const bool last = c + 1 == cycles;
-    if (budget < 0 && m_scene.target_fps > 0 && !m_plan.pairs.empty()) {
-      // Real-time mode: collision detection gets what is left of the frame.
-      const double left = (c + 1) * (1.0 / m_scene.target_fps) / cycles - seconds_since(frame_start);
-      m.budget = std::max(1e-6, left / static_cast<double>(m_plan.pairs.size()));
+
+  // While the objects are apart, no force acts and one cycle per frame gives
+  // the same motion. So a frame that starts contact-free is first tried as a
+  // single cycle; if its closing query finds a contact, the frame is rolled
+  // back and re-run in `cycles` cycles, so contact forces start from the
+  // cycle in which the contact begins, as if every frame had been cycled.
+  // (A contact that begins and ends inside one trial frame is missed: it
+  // would need the objects to cross a whole contact within 1 / frame_rate.)
+  if (cycles > 1 && m_scene.collision.single_cycle_when_apart && contact_free()) {
+    save(m_snapshot);
+    FrameMetrics trial = m;
+    trial.cycles = 1;
+    trial.budget = budget_at(1.0);
+    cycle(dt, m_time + dt, trial.budget, true, trial);
+    if (contact_free()) {
+      m = trial;
+      return finish_frame(m, frame_start);
     }
-    cycle(h, m.budget, last, m);
+    restore(m_snapshot);
+    m.rollback = 1;
+    m.times = trial.times;  // the rolled-back work is part of the frame's cost
   }
 
+  const double h = dt / cycles;
+  for (int c = 0; c < cycles; ++c) {
+    const bool last = c + 1 == cycles;
+    m.budget = budget_at((c + 1) / static_cast<double>(cycles));
+    cycle(h, m_time + (c + 1) * h, m.budget, last, m);
+  }
+  return finish_frame(m, frame_start);
+}
+
+FrameMetrics World::finish_frame(FrameMetrics& m, Clock::time_point frame_start) {
   // Exact reference: intersecting dense triangles (for accuracy studies).
   if (m_plan.exact_reference) {
     m.exact_contacts = 0;
@@ -253,7 +334,7 @@ FrameMetrics World::step(double budget) {
 
   if (!std::isfinite(m.min_step)) m.min_step = 0;
   ++m_frame;
-  m_time += dt;
+  m_time += 1.0 / m_scene.frame_rate;
   m.time = m_time;
   m.wall = seconds_since(frame_start);
   return m;

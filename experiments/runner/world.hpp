@@ -2,6 +2,7 @@
 /// The simulation loop of a scene (paper sections 3.2, 4 and 5): FEM on the
 /// coarse meshes, sphere-tree update, interruptible collision detection,
 /// penalty response, rigid links, each stage only where the plan needs it.
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -36,6 +37,12 @@ struct FrameMetrics {
   double max_penetration = 0;  ///< deepest sphere penetration, m
   double contact_force = 0;    ///< |total contact force| on the first object of each pair, N (sum)
   int cycles = 1;              ///< detection/response cycles in the frame (stable penalty)
+  /// 1 when the frame was first tried as one contact-free cycle, found a
+  /// contact at its end, and was rolled back and re-run in `cycles` cycles.
+  int rollback = 0;
+  /// Interrupted queries whose response used the pair's previous complete
+  /// answer (collision.on_interrupt = "previous").
+  int reused = 0;
   int substeps = 0;            ///< FEM sub-steps summed over objects
   double min_step = 0;         ///< smallest FEM step used, s
   double energy = 0;           ///< total mechanical energy of the deformable objects, J
@@ -73,13 +80,33 @@ class World {
   FrameMetrics step(double budget = -1);
 
  private:
+  using Clock = std::chrono::steady_clock;
   void update_dense(RuntimeObject& o);
-  /// One detection/response cycle of length h (s) inside a frame.
-  void cycle(double h, double budget, bool last, FrameMetrics& m);
+  /// Exact reference, frame counter and wall time at the end of step().
+  FrameMetrics finish_frame(FrameMetrics& m, Clock::time_point frame_start);
+  /// One detection/response cycle of length h (s) inside a frame, ending at
+  /// simulated time t_end.
+  void cycle(double h, double t_end, double budget, bool last, FrameMetrics& m);
   /// Detection/response cycles a frame of dt needs for a stable penalty.
   int contact_cycles(double dt) const;
+  /// True when the last queries reported no pair at all (every pair pruned:
+  /// the covered surfaces are apart).
+  bool contact_free() const;
+  /// State a rolled-back frame returns to.
+  struct Snapshot {
+    std::vector<MatX3d> positions, velocities;
+    std::vector<std::vector<collision::NodePair>> fronts;
+    std::vector<collision::CollisionResult> complete;
+    std::vector<double> complete_time;
+    double node_stiffness = 0;
+  };
+  void save(Snapshot& s) const;
+  void restore(const Snapshot& s);
 
   static constexpr int kMaxContactCycles = 64;
+  /// Smallest per-query budget in real-time mode when the frame is already
+  /// over (the query then answers with the root pair), s.
+  static constexpr double kMinRealTimeBudget = 1e-6;
   /// Node mass standing for "does not move under contact" (static, rigid objects).
   static constexpr double kImmovableMass = 1e30;
   /// Largest omega h of the staggered penalty (explicit limit 2; smaller
@@ -91,8 +118,12 @@ class World {
   std::vector<RuntimeObject> m_objects;
   std::vector<collision::CollisionResult> m_results;
   std::vector<std::vector<collision::NodePair>> m_fronts;
+  /// Last complete (not interrupted) answer of each pair and its simulated time.
+  std::vector<collision::CollisionResult> m_complete;
+  std::vector<double> m_complete_time;
   double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
   double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
+  Snapshot m_snapshot;          ///< reused storage for the single-cycle trial
   int m_frame = 0;
   double m_time = 0;
 };
