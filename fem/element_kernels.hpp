@@ -137,15 +137,83 @@ ICD_FEM_INLINE void polar_rotation(const double* F, Eigen::Quaterniond& q, int m
   q = Eigen::Quaterniond(qw, qx, qy, qz);
 }
 
-/// Corotational: R from the warm-started polar iteration (q in/out).
+/// Corotational: R from the warm-started polar iteration (q in/out); R_out
+/// (row-major, optional) receives the rotation used.
 ICD_FEM_INLINE void corotational_stress(const double* F, double mu, double lambda, Eigen::Quaterniond& q,
-                                        int max_iterations, double tolerance, double* P) {
-  double R[9];
+                                        int max_iterations, double tolerance, double* P, double* R_out = nullptr) {
+  double Rl[9];
+  double* R = R_out ? R_out : Rl;
   polar_rotation(F, q, max_iterations, tolerance, R);
   double tr = 0;
   for (int k = 0; k < 9; ++k) tr += R[k] * F[k];
   const double t = lambda * (tr - 3.0);
   for (int k = 0; k < 9; ++k) P[k] = 2.0 * mu * (F[k] - R[k]) + t * R[k];
+}
+
+/// Bilinear cofactor form: cof(F) = cofactor_bilinear(F, F), and
+/// d cof(F)[dF] = cofactor_bilinear(dF, F) + cofactor_bilinear(F, dF) (row-major).
+ICD_FEM_INLINE void cofactor_bilinear(const double* A, const double* B, double* C) {
+  C[0] = A[4] * B[8] - A[7] * B[5];
+  C[1] = A[5] * B[6] - A[8] * B[3];
+  C[2] = A[3] * B[7] - A[6] * B[4];
+  C[3] = A[7] * B[2] - A[1] * B[8];
+  C[4] = A[8] * B[0] - A[2] * B[6];
+  C[5] = A[6] * B[1] - A[0] * B[7];
+  C[6] = A[1] * B[5] - A[4] * B[2];
+  C[7] = A[2] * B[3] - A[5] * B[0];
+  C[8] = A[0] * B[4] - A[3] * B[1];
+}
+
+/// dP = dP/dF [dF] of linear elasticity: mu (dF + dF^T) + lambda tr(dF) I.
+ICD_FEM_INLINE void linear_stress_differential(const double* dF, double mu, double lambda, double* dP) {
+  const double t = lambda * (dF[0] + dF[4] + dF[8]);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) dP[3 * r + c] = mu * (dF[3 * r + c] + dF[3 * c + r]);
+  dP[0] += t;
+  dP[4] += t;
+  dP[8] += t;
+}
+
+/// dP of StVK: dF S + F dS, dS = 2 mu dE + lambda tr(dE) I, dE = sym(F^T dF).
+ICD_FEM_INLINE void stvk_stress_differential(const double* F, const double* dF, double mu, double lambda,
+                                             double* dP) {
+  double G[9], dG[9];  // F^T F and F^T dF + dF^T F = 2 dE
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      G[3 * r + c] = F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c];
+      dG[3 * r + c] = F[r] * dF[c] + F[3 + r] * dF[3 + c] + F[6 + r] * dF[6 + c] + dF[r] * F[c] +
+                      dF[3 + r] * F[3 + c] + dF[6 + r] * F[6 + c];
+    }
+  const double trE = 0.5 * (G[0] + G[4] + G[8]) - 1.5;
+  const double trdE = 0.5 * (dG[0] + dG[4] + dG[8]);
+  double S[9], dS[9];
+  for (int k = 0; k < 9; ++k) {
+    S[k] = mu * G[k];
+    dS[k] = mu * dG[k];
+  }
+  for (int k = 0; k < 9; k += 4) {
+    S[k] += lambda * trE - mu;
+    dS[k] += lambda * trdE;
+  }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      dP[3 * r + c] = dF[3 * r] * S[c] + dF[3 * r + 1] * S[3 + c] + dF[3 * r + 2] * S[6 + c] +
+                      F[3 * r] * dS[c] + F[3 * r + 1] * dS[3 + c] + F[3 * r + 2] * dS[6 + c];
+}
+
+/// dP of stable Neo-Hookean: mu dF + lambda' (cof F : dF) cof F + (lambda' (J - 1) - mu) d cof F [dF].
+ICD_FEM_INLINE void stable_neo_hookean_stress_differential(const double* F, const double* dF, double mu,
+                                                           double lambda, double* dP) {
+  const double lp = lambda + mu;
+  double C[9], dC[9], dC2[9];
+  cofactor_bilinear(F, F, C);
+  cofactor_bilinear(dF, F, dC);
+  cofactor_bilinear(F, dF, dC2);
+  const double J = F[0] * C[0] + F[3] * C[3] + F[6] * C[6];
+  double cdf = 0;
+  for (int k = 0; k < 9; ++k) cdf += C[k] * dF[k];
+  const double s = lp * (J - 1.0) - mu;
+  for (int k = 0; k < 9; ++k) dP[k] = mu * dF[k] + lp * cdf * C[k] + s * (dC[k] + dC2[k]);
 }
 
 ICD_FEM_INLINE double determinant(const double* F) {
@@ -172,6 +240,22 @@ ICD_FEM_INLINE double stvk_energy(const double* F, double mu, double lambda) {
       sq += e * e;
       if (r == c) tr += e;
     }
+  return mu * sq + 0.5 * lambda * tr * tr;
+}
+
+/// Corotational energy density with the rotation R (row-major) of F = R S:
+/// mu |S - I|^2 + lambda/2 tr(S - I)^2, S = sym(R^T F).
+ICD_FEM_INLINE double corotational_energy(const double* F, const double* R, double mu, double lambda) {
+  double A[9];  // R^T F
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) A[3 * r + c] = R[r] * F[c] + R[3 + r] * F[3 + c] + R[6 + r] * F[6 + c];
+  double sq = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      const double e = 0.5 * (A[3 * r + c] + A[3 * c + r]) - (r == c ? 1.0 : 0.0);
+      sq += e * e;
+    }
+  const double tr = A[0] + A[4] + A[8] - 3.0;
   return mu * sq + 0.5 * lambda * tr * tr;
 }
 

@@ -1,6 +1,7 @@
 #include "fem/forces.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -105,6 +106,7 @@ ElasticForces::ElasticForces(TetMeshData mesh, const Material& material, const F
   for (int e = 0; e < m_mesh.num_tets(); ++e)  // ascending e: the sequential scatter order
     for (int a = 0; a < 4; ++a) m_node_slot[fill[m_mesh.tets(e, a)]++] = 12 * e + 3 * a;
   m_chunk_sum.resize((m_mesh.num_tets() + kChunk - 1) / kChunk);
+  m_chunk_health.resize(m_chunk_sum.size());
   static_assert(kChunk % lanes::kLanes == 0, "chunks hold whole lane blocks");
   static_assert(sizeof(lanes::Block) == sizeof(double) * 10 * lanes::kLanes, "Block is plain doubles");
   const int nblocks = (m_mesh.num_tets() + lanes::kLanes - 1) / lanes::kLanes;
@@ -246,7 +248,26 @@ void ElasticForces::compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d
     compute_impl<false>(x, f);
     return;
   }
-  // The hot path: scalar kernels (element_kernels.hpp), one instantiation per model.
+  compute_fast<false>(x, f, nullptr);
+}
+
+ElementHealth ElasticForces::compute_with_health(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
+  check_shape(x, "positions");
+  check_shape(f, "forces");
+  if (x.outerStride() != 3 || f.outerStride() != 3) {
+    compute_impl<false>(x, f);
+    return health(x);
+  }
+  ElementHealth h;
+  compute_fast<true>(x, f, &h);
+  return h;
+}
+
+
+template <bool kHealth>
+void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health) {
+  // The hot path: 8-lane SoA kernels (lane_kernels.hpp) or, for corotational,
+  // scalar kernels (element_kernels.hpp); one instantiation per model.
   const double* xp = x.data();
   const int* T = m_mesh.tets.data();
   const double* dinv = m_mesh.dm_inv.data()->data();
@@ -259,63 +280,99 @@ void ElasticForces::compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d
   const int max_it = m_options.polar_max_iterations;
   const double tol = m_options.polar_tolerance;
   const auto* blocks = reinterpret_cast<const lanes::Block*>(m_lane_blocks.data());
+  ChunkHealth* chunk_health = m_chunk_health.data();
+  auto scatter = [&](int e, const double* out) {
+    if (!direct) {
+      std::copy(out, out + 12, buf + 12 * static_cast<size_t>(e));
+      return;
+    }
+    const int* t = T + 4 * e;
+    for (int a = 0; a < 4; ++a) {
+      double* fa = fp + 3 * t[a];
+      fa[0] += out[3 * a];
+      fa[1] += out[3 * a + 1];
+      fa[2] += out[3 * a + 2];
+    }
+  };
   auto run = [&](auto model_tag) {
     constexpr MaterialModel kModel = decltype(model_tag)::value;
     if constexpr (kModel != MaterialModel::Corotational) {
       // 8 elements at a time in lane loops; scatter in element order.
       for_chunks([&](int begin, int end) {
+        // Health in lane-wise accumulators (vectorised): energy partial sums,
+        // smallest det F and its element; merged in lane order at the end.
+        double lane_sum[lanes::kLanes] = {}, lane_min[lanes::kLanes], lane_arg[lanes::kLanes];
+        for (int l = 0; l < lanes::kLanes; ++l) {
+          lane_min[l] = std::numeric_limits<double>::infinity();
+          lane_arg[l] = -1;
+        }
         for (int e0 = begin; e0 < end; e0 += lanes::kLanes) {
           const int count = std::min(lanes::kLanes, end - e0);
+          const lanes::Block& block = blocks[e0 / lanes::kLanes];
           double out[lanes::kLanes][12];
-          lanes::block_forces<kModel>(xp, T + 4 * e0, count, blocks[e0 / lanes::kLanes], mu, lambda, out);
-          for (int l = 0; l < count; ++l) {
-            if (!direct) {
-              std::copy(out[l], out[l] + 12, buf + 12 * static_cast<size_t>(e0 + l));
-              continue;
-            }
-            const int* t = T + 4 * (e0 + l);
-            for (int a = 0; a < 4; ++a) {
-              double* fa = fp + 3 * t[a];
-              fa[0] += out[l][3 * a];
-              fa[1] += out[l][3 * a + 1];
-              fa[2] += out[l][3 * a + 2];
+          double psi[lanes::kLanes], det[lanes::kLanes];
+          lanes::block_forces<kModel, kHealth>(xp, T + 4 * e0, count, block, mu, lambda, out, psi, det);
+          if constexpr (kHealth) {
+            for (int l = 0; l < lanes::kLanes; ++l) {  // padding lanes: volume 0, det F = 0 ignored
+              const bool valid = l < count;
+              lane_sum[l] += valid ? block.volume[l] * psi[l] : 0.0;
+              const bool lower = valid && det[l] < lane_min[l];
+              lane_min[l] = lower ? det[l] : lane_min[l];
+              lane_arg[l] = lower ? static_cast<double>(e0 + l) : lane_arg[l];
             }
           }
+          for (int l = 0; l < count; ++l) scatter(e0 + l, out[l]);
         }
-        return 0.0;
+        double sum = 0;
+        if constexpr (kHealth) {
+          ChunkHealth ch;
+          for (int l = 0; l < lanes::kLanes; ++l) {
+            sum += lane_sum[l];
+            if (lane_arg[l] >= 0 && (lane_min[l] < ch.min_det ||
+                                     (lane_min[l] == ch.min_det && lane_arg[l] < ch.min_element))) {
+              ch.min_det = lane_min[l];
+              ch.min_element = static_cast<int>(lane_arg[l]);
+            }
+          }
+          ch.nonfinite = std::isfinite(sum) ? -1 : begin;  // located by health() on failure
+          chunk_health[begin / kChunk] = ch;
+        }
+        return sum;
       });
       return;
     }
     for_chunks([&](int begin, int end) {
+      double sum = 0;
+      ChunkHealth ch;
       for (int e = begin; e < end; ++e) {
         const int* t = T + 4 * e;
         const double* D = dinv + 9 * static_cast<size_t>(e);
-        double F[9], P[9], H[9];
+        double F[9], P[9], H[9], R[9];
         kernels::deformation_gradient(xp + 3 * t[0], xp + 3 * t[1], xp + 3 * t[2], xp + 3 * t[3], D, F);
-        if constexpr (kModel == MaterialModel::Linear) kernels::linear_stress(F, mu, lambda, P);
-        else if constexpr (kModel == MaterialModel::StVK) kernels::stvk_stress(F, mu, lambda, P);
-        else if constexpr (kModel == MaterialModel::StableNeoHookean)
-          kernels::stable_neo_hookean_stress(F, mu, lambda, P);
-        else kernels::corotational_stress(F, mu, lambda, rot[e], max_it, tol, P);
+        kernels::corotational_stress(F, mu, lambda, rot[e], max_it, tol, P, R);
+        if constexpr (kHealth) {
+          const double J = kernels::determinant(F);
+          if (J < ch.min_det) {
+            ch.min_det = J;
+            ch.min_element = e;
+          }
+          sum += vol[e] * kernels::corotational_energy(F, R, mu, lambda);
+        }
         kernels::nodal_forces(P, D, vol[e], H);
-        double* out;
-        double local[12];
-        out = direct ? local : buf + 12 * static_cast<size_t>(e);
+        double out[12];
         for (int r = 0; r < 3; ++r) {
           out[3 + r] = H[3 * r];
           out[6 + r] = H[3 * r + 1];
           out[9 + r] = H[3 * r + 2];
           out[r] = -(H[3 * r] + H[3 * r + 1] + H[3 * r + 2]);
         }
-        if (direct)
-          for (int a = 0; a < 4; ++a) {
-            double* fa = fp + 3 * t[a];
-            fa[0] += local[3 * a];
-            fa[1] += local[3 * a + 1];
-            fa[2] += local[3 * a + 2];
-          }
+        scatter(e, out);
       }
-      return 0.0;
+      if constexpr (kHealth) {
+        ch.nonfinite = std::isfinite(sum) ? -1 : begin;
+        chunk_health[begin / kChunk] = ch;
+      }
+      return sum;
     });
   };
   if (direct) f.setZero();
@@ -328,6 +385,23 @@ void ElasticForces::compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d
       break;
   }
   if (!direct) gather(fp);
+  if constexpr (kHealth) {
+    ElementHealth& h = *health;
+    h = ElementHealth{};
+    h.min_det_f = std::numeric_limits<double>::infinity();
+    bool nonfinite = false;
+    for (size_t c = 0; c < m_chunk_sum.size(); ++c) {
+      h.energy += m_chunk_sum[c];
+      const ChunkHealth& ch = m_chunk_health[c];
+      if (ch.min_element >= 0 && ch.min_det < h.min_det_f) {
+        h.min_det_f = ch.min_det;
+        h.min_det_f_element = ch.min_element;
+      }
+      nonfinite = nonfinite || ch.nonfinite >= 0;
+    }
+    // A NaN/Inf somewhere (a failing state): the separate pass names the first element exactly.
+    if (nonfinite || !std::isfinite(h.energy)) h = this->health(x);
+  }
 }
 
 double ElasticForces::compute_with_energy(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
@@ -387,6 +461,10 @@ void ElasticForces::differential(const Eigen::Ref<const MatX3d>& x, const Eigen:
   const long xs = x.outerStride(), ds = dx.outerStride();
   const int* T = m_mesh.tets.data();
   double* buf = m_element_forces.data();
+  if (xs == 3 && ds == 3 && df.outerStride() == 3 && m_material.model != MaterialModel::Corotational) {
+    differential_fast(xp, dp, df.data());
+    return;
+  }
   auto run = [&](const auto& ev) {
     for_chunks([&](int begin, int end) {
       for (int e = begin; e < end; ++e) {
@@ -408,6 +486,49 @@ void ElasticForces::differential(const Eigen::Ref<const MatX3d>& x, const Eigen:
     gather(tmp.data());
     df = tmp;
   }
+}
+
+void ElasticForces::differential_fast(const double* xp, const double* dp, double* df) {
+  // 8-lane kernels (lane_kernels.hpp); the Eigen laws of constitutive.hpp are the reference.
+  const int* T = m_mesh.tets.data();
+  const bool direct = m_options.num_threads == 1;
+  double* buf = m_element_forces.data();
+  const double mu = m_mu, lambda = m_lambda;
+  const auto* blocks = reinterpret_cast<const lanes::Block*>(m_lane_blocks.data());
+  auto run = [&](auto model_tag) {
+    constexpr MaterialModel kModel = decltype(model_tag)::value;
+    for_chunks([&](int begin, int end) {
+      for (int e0 = begin; e0 < end; e0 += lanes::kLanes) {
+        const int count = std::min(lanes::kLanes, end - e0);
+        double out[lanes::kLanes][12];
+        lanes::block_differential<kModel>(xp, dp, T + 4 * e0, count, blocks[e0 / lanes::kLanes], mu, lambda, out);
+        for (int l = 0; l < count; ++l) {
+          if (!direct) {
+            std::copy(out[l], out[l] + 12, buf + 12 * static_cast<size_t>(e0 + l));
+            continue;
+          }
+          const int* t = T + 4 * (e0 + l);
+          for (int a = 0; a < 4; ++a) {
+            double* fa = df + 3 * t[a];
+            fa[0] += out[l][3 * a];
+            fa[1] += out[l][3 * a + 1];
+            fa[2] += out[l][3 * a + 2];
+          }
+        }
+      }
+      return 0.0;
+    });
+  };
+  if (direct) std::fill_n(df, 3 * static_cast<size_t>(m_mesh.num_nodes), 0.0);
+  switch (m_material.model) {
+    case MaterialModel::Linear: run(std::integral_constant<MaterialModel, MaterialModel::Linear>{}); break;
+    case MaterialModel::StVK: run(std::integral_constant<MaterialModel, MaterialModel::StVK>{}); break;
+    case MaterialModel::StableNeoHookean:
+      run(std::integral_constant<MaterialModel, MaterialModel::StableNeoHookean>{});
+      break;
+    case MaterialModel::Corotational: assert(false && "corotational uses the Eigen path"); break;
+  }
+  if (!direct) gather(df);
 }
 
 const Eigen::SparseMatrix<double>& ElasticForces::stiffness(const Eigen::Ref<const MatX3d>& x) {

@@ -1,6 +1,7 @@
 #pragma once
 /// Internal elastic forces, energy, force differential and tangent stiffness
 /// of linear tetrahedra for every MaterialModel (paper section 3).
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -48,6 +49,12 @@ class ElasticForces {
 
   /// f = -dW/dx (overwritten). Throws ParameterError on a shape mismatch.
   void compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
+  /// Same as compute() and, from the same pass over the elements, the health
+  /// of x: smallest det F and its element as health(x), the energy equal to
+  /// health(x).energy up to the summation order (deterministic for any thread
+  /// count); where an energy is not finite, health(x) itself (naming the first
+  /// such element). Costs a fraction of a second pass.
+  ElementHealth compute_with_health(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
   /// Same as compute() and returns the elastic energy W(x) = sum_e V_e psi(F_e), J.
   double compute_with_energy(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
   /// Elastic energy W(x), J.
@@ -68,6 +75,14 @@ class ElasticForces {
   void check_shape(const Eigen::Ref<const MatX3d>& x, const char* what) const;
   void gather(double* f);
   template <bool kEnergy> double compute_impl(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
+  void differential_fast(const double* x, const double* dx, double* df);
+  template <bool kHealth>
+  void compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health);
+  struct ChunkHealth {
+    double min_det = std::numeric_limits<double>::infinity();
+    int min_element = -1;
+    int nonfinite = -1;
+  };
 
   TetMeshData m_mesh;
   Material m_material;
@@ -79,6 +94,7 @@ class ElasticForces {
   std::vector<double> m_element_forces;         // #T x 12 scratch for threaded scatter
   std::vector<int> m_node_offset, m_node_slot;  // node -> element slots (CSR, ascending element)
   std::vector<double> m_chunk_sum;
+  std::vector<ChunkHealth> m_chunk_health;
   std::vector<double> m_lane_blocks;            // lanes::Block per 8 elements (SoA Dm^-1, volume)
 };
 

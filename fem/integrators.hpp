@@ -21,18 +21,26 @@ struct State {
   MatX3d v;  ///< velocities (#V x 3), m/s
 };
 
-/// Explicit steppers with their scratch buffers (no allocation per step).
+/// Explicit steppers with their scratch buffers (no allocation per step once
+/// the buffers have the model's size). The out-of-place forms write the new
+/// state into `out` (a different object than `in`, resized if needed) and,
+/// when start_health is given, return the ElementHealth of in.x computed in
+/// the same element pass as the first force evaluation (which is at in.x):
+/// the Simulator's health checks cost no extra force evaluation.
 class ExplicitStepper {
  public:
   /// One symplectic Euler step of size h (s): v1 = v0 + h a(x0, v0), x1 = x0 + h v1.
   /// One force evaluation (two with stiffness damping).
   void symplectic_euler(Model& model, State& s, double h);
+  void symplectic_euler(Model& model, const State& in, State& out, double h, ElementHealth* start_health = nullptr);
   /// One classical RK4 step of size h on y = (x, v), y' = (v, a(x, v)): four evaluations.
   void rk4(Model& model, State& s, double h);
+  void rk4(Model& model, const State& in, State& out, double h, ElementHealth* start_health = nullptr);
 
  private:
   void resize(int n);
   MatX3d m_a, m_x, m_v, m_dx, m_dv;
+  State m_out;
 };
 
 }  // namespace icd::fem

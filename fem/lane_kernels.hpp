@@ -18,9 +18,12 @@ struct Block {
 /// Forces of the elements of one block. x: positions (#V x 3 row-major);
 /// tets: the block's first tet (4 indices each); count <= 8 valid lanes.
 /// Writes out[e][12] (nodal forces of node 0..3) for the valid lanes.
-template <MaterialModel kModel>
+/// kHealth: also writes the energy density psi[l] (J/m^3) and det F det[l] of
+/// every lane, with the same operations as kernels::*_energy and
+/// kernels::determinant (bitwise equal to ElasticForces::health()).
+template <MaterialModel kModel, bool kHealth = false>
 inline void block_forces(const double* x, const int* tets, int count, const Block& b, double mu, double lambda,
-                         double (*out)[12]) {
+                         double (*out)[12], double* psi = nullptr, double* det = nullptr) {
   double d[9][kLanes];
   for (int l = 0; l < kLanes; ++l) {
     if (l < count) {
@@ -43,6 +46,30 @@ inline void block_forces(const double* x, const int* tets, int count, const Bloc
       for (int l = 0; l < kLanes; ++l)
         F[3 * r + c][l] = d[3 * r][l] * b.dinv[3 * c][l] + d[3 * r + 1][l] * b.dinv[1 + 3 * c][l] +
                           d[3 * r + 2][l] * b.dinv[2 + 3 * c][l];
+  if constexpr (kHealth) {
+    for (int l = 0; l < kLanes; ++l)
+      det[l] = F[0][l] * (F[4][l] * F[8][l] - F[5][l] * F[7][l]) - F[1][l] * (F[3][l] * F[8][l] - F[5][l] * F[6][l]) +
+               F[2][l] * (F[3][l] * F[7][l] - F[4][l] * F[6][l]);
+    if constexpr (kModel == MaterialModel::Linear) {
+      for (int l = 0; l < kLanes; ++l) {
+        double sq = 0;
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            const double e = 0.5 * (F[3 * r + c][l] + F[3 * c + r][l]) - (r == c ? 1.0 : 0.0);
+            sq += e * e;
+          }
+        const double tr = F[0][l] + F[4][l] + F[8][l] - 3.0;
+        psi[l] = mu * sq + 0.5 * lambda * tr * tr;
+      }
+    } else if constexpr (kModel == MaterialModel::StableNeoHookean) {
+      for (int l = 0; l < kLanes; ++l) {
+        double ic = 0;
+        for (int k = 0; k < 9; ++k) ic += F[k][l] * F[k][l];
+        const double J = det[l];
+        psi[l] = 0.5 * mu * (ic - 3.0) - mu * (J - 1.0) + 0.5 * (lambda + mu) * (J - 1.0) * (J - 1.0);
+      }
+    }  // StVK: from E below
+  }
   double P[9][kLanes];
   if constexpr (kModel == MaterialModel::Linear) {
     for (int l = 0; l < kLanes; ++l) {
@@ -63,6 +90,15 @@ inline void block_forces(const double* x, const int* tets, int count, const Bloc
       E[0] -= 0.5;
       E[4] -= 0.5;
       E[8] -= 0.5;
+      if constexpr (kHealth) {
+        double sq = 0, tr = 0;
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            sq += E[3 * r + c] * E[3 * r + c];
+            if (r == c) tr += E[3 * r + c];
+          }
+        psi[l] = mu * sq + 0.5 * lambda * tr * tr;
+      }
       const double t = lambda * (E[0] + E[4] + E[8]);
       for (int k = 0; k < 9; ++k) S[k][l] = 2.0 * mu * E[k];
       S[0][l] += t;
@@ -101,6 +137,123 @@ inline void block_forces(const double* x, const int* tets, int count, const Bloc
       for (int l = 0; l < kLanes; ++l)
         H[3 * r + c][l] = -b.volume[l] * (P[3 * r][l] * b.dinv[c][l] + P[3 * r + 1][l] * b.dinv[c + 3][l] +
                                           P[3 * r + 2][l] * b.dinv[c + 6][l]);
+  for (int l = 0; l < count; ++l)
+    for (int r = 0; r < 3; ++r) {
+      out[l][3 + r] = H[3 * r][l];
+      out[l][6 + r] = H[3 * r + 1][l];
+      out[l][9 + r] = H[3 * r + 2][l];
+      out[l][r] = -(H[3 * r][l] + H[3 * r + 1][l] + H[3 * r + 2][l]);
+    }
+}
+
+/// Force differentials df = -K(x) dx of the elements of one block (the
+/// directional derivative of block_forces along dx), same layout as
+/// block_forces: out[e][12] for the valid lanes. Linear, StVK and stable
+/// Neo-Hookean (the laws of element_kernels.hpp, *_stress_differential).
+template <MaterialModel kModel>
+inline void block_differential(const double* x, const double* dx, const int* tets, int count, const Block& b,
+                               double mu, double lambda, double (*out)[12]) {
+  double d[9][kLanes], dd[9][kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    if (l < count) {
+      const int* t = tets + 4 * l;
+      const double* p0 = x + 3 * t[0];
+      const double* q0 = dx + 3 * t[0];
+      for (int c = 0; c < 3; ++c) {
+        const double* p = x + 3 * t[c + 1];
+        const double* q = dx + 3 * t[c + 1];
+        for (int r = 0; r < 3; ++r) {
+          d[3 * r + c][l] = p[r] - p0[r];
+          dd[3 * r + c][l] = q[r] - q0[r];
+        }
+      }
+    } else {
+      for (int k = 0; k < 9; ++k) d[k][l] = dd[k][l] = 0.0;
+    }
+  }
+  double F[9][kLanes], dF[9][kLanes];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < kLanes; ++l) {
+        F[3 * r + c][l] = d[3 * r][l] * b.dinv[3 * c][l] + d[3 * r + 1][l] * b.dinv[1 + 3 * c][l] +
+                          d[3 * r + 2][l] * b.dinv[2 + 3 * c][l];
+        dF[3 * r + c][l] = dd[3 * r][l] * b.dinv[3 * c][l] + dd[3 * r + 1][l] * b.dinv[1 + 3 * c][l] +
+                           dd[3 * r + 2][l] * b.dinv[2 + 3 * c][l];
+      }
+  double dP[9][kLanes];
+  if constexpr (kModel == MaterialModel::Linear) {
+    for (int l = 0; l < kLanes; ++l) {
+      const double t = lambda * (dF[0][l] + dF[4][l] + dF[8][l]);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) dP[3 * r + c][l] = mu * (dF[3 * r + c][l] + dF[3 * c + r][l]);
+      dP[0][l] += t;
+      dP[4][l] += t;
+      dP[8][l] += t;
+    }
+  } else if constexpr (kModel == MaterialModel::StVK) {
+    double S[9][kLanes], dS[9][kLanes];  // first F^T F and F^T dF + dF^T F
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        for (int l = 0; l < kLanes; ++l) {
+          S[3 * r + c][l] = F[r][l] * F[c][l] + F[3 + r][l] * F[3 + c][l] + F[6 + r][l] * F[6 + c][l];
+          dS[3 * r + c][l] = F[r][l] * dF[c][l] + F[3 + r][l] * dF[3 + c][l] + F[6 + r][l] * dF[6 + c][l] +
+                             dF[r][l] * F[c][l] + dF[3 + r][l] * F[3 + c][l] + dF[6 + r][l] * F[6 + c][l];
+        }
+    // S = mu (F^T F - I) + lambda tr(E) I, dS = mu (F^T dF + dF^T F) + lambda tr(dE) I.
+    for (int l = 0; l < kLanes; ++l) {
+      const double trE = 0.5 * (S[0][l] + S[4][l] + S[8][l]) - 1.5;
+      const double trdE = 0.5 * (dS[0][l] + dS[4][l] + dS[8][l]);
+      for (int k = 0; k < 9; ++k) {
+        S[k][l] *= mu;
+        dS[k][l] *= mu;
+      }
+      for (int k = 0; k < 9; k += 4) {
+        S[k][l] += lambda * trE - mu;
+        dS[k][l] += lambda * trdE;
+      }
+    }
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        for (int l = 0; l < kLanes; ++l)
+          dP[3 * r + c][l] = dF[3 * r][l] * S[c][l] + dF[3 * r + 1][l] * S[3 + c][l] + dF[3 * r + 2][l] * S[6 + c][l] +
+                             F[3 * r][l] * dS[c][l] + F[3 * r + 1][l] * dS[3 + c][l] + F[3 * r + 2][l] * dS[6 + c][l];
+  } else {
+    static_assert(kModel == MaterialModel::StableNeoHookean, "no lane differential for this model");
+    const double lp = lambda + mu;
+    for (int l = 0; l < kLanes; ++l) {
+      double f[9], g[9], C[9], dC[9], dC2[9];
+      for (int k = 0; k < 9; ++k) {
+        f[k] = F[k][l];
+        g[k] = dF[k][l];
+      }
+      // cofactor_bilinear(A, B) as in element_kernels.hpp.
+      auto cof = [](const double* A, const double* B, double* o) {
+        o[0] = A[4] * B[8] - A[7] * B[5];
+        o[1] = A[5] * B[6] - A[8] * B[3];
+        o[2] = A[3] * B[7] - A[6] * B[4];
+        o[3] = A[7] * B[2] - A[1] * B[8];
+        o[4] = A[8] * B[0] - A[2] * B[6];
+        o[5] = A[6] * B[1] - A[0] * B[7];
+        o[6] = A[1] * B[5] - A[4] * B[2];
+        o[7] = A[2] * B[3] - A[5] * B[0];
+        o[8] = A[0] * B[4] - A[3] * B[1];
+      };
+      cof(f, f, C);
+      cof(g, f, dC);
+      cof(f, g, dC2);
+      const double J = f[0] * C[0] + f[3] * C[3] + f[6] * C[6];
+      double cdf = 0;
+      for (int k = 0; k < 9; ++k) cdf += C[k] * g[k];
+      const double s = lp * (J - 1.0) - mu;
+      for (int k = 0; k < 9; ++k) dP[k][l] = mu * g[k] + lp * cdf * C[k] + s * (dC[k] + dC2[k]);
+    }
+  }
+  double H[9][kLanes];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < kLanes; ++l)
+        H[3 * r + c][l] = -b.volume[l] * (dP[3 * r][l] * b.dinv[c][l] + dP[3 * r + 1][l] * b.dinv[c + 3][l] +
+                                          dP[3 * r + 2][l] * b.dinv[c + 6][l]);
   for (int l = 0; l < count; ++l)
     for (int r = 0; r < 3; ++r) {
       out[l][3 + r] = H[3 * r][l];

@@ -13,6 +13,7 @@ Model::Model(const Eigen::Ref<const MatX3d>& rest_positions, const Eigen::Ref<co
     : m_forces(make_tet_mesh_data(rest_positions, tets), material, options.forces) {
   m_mass = lumped_mass(m_forces.mesh(), material.density);
   m_fixed.assign(num_nodes(), 0);
+  m_inv_mass = m_mass.cwiseInverse();
   m_external = MatX3d::Zero(num_nodes(), 3);
   m_scratch.resize(num_nodes(), 3);
   set_gravity(options.gravity);
@@ -28,6 +29,13 @@ void Model::set_fixed_nodes(const std::vector<int>& nodes) {
     fixed[i] = 1;
   }
   m_fixed = std::move(fixed);
+  update_load();
+}
+
+void Model::update_load() {
+  m_load.resize(num_nodes(), 3);
+  for (int i = 0; i < num_nodes(); ++i)
+    for (int c = 0; c < 3; ++c) m_load(i, c) = m_fixed[i] ? 0.0 : m_external(i, c) + m_mass[i] * m_gravity[c];
 }
 
 std::vector<char> Model::fixed_dofs() const {
@@ -45,11 +53,13 @@ void Model::set_external_forces(const Eigen::Ref<const MatX3d>& forces) {
       throw ParameterError("fem::Model::set_external_forces: force on node " + std::to_string(i) +
                            " is not finite");
   m_external = forces;
+  update_load();
 }
 
 void Model::set_gravity(const Eigen::Vector3d& gravity) {
   if (!gravity.allFinite()) throw ParameterError("fem::Model: gravity is not finite");
   m_gravity = gravity;
+  update_load();
 }
 
 void Model::set_damping(const RayleighDamping& damping) {
@@ -80,9 +90,28 @@ void Model::total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<cons
 }
 
 void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                         Eigen::Ref<MatX3d> a) {
-  total_force(x, v, a);
-  for (int i = 0; i < num_nodes(); ++i) a.row(i) /= m_mass[i];
+                         Eigen::Ref<MatX3d> a, ElementHealth* health) {
+  if (health) *health = m_forces.compute_with_health(x, a);
+  else m_forces.compute(x, a);
+  if (m_damping.beta > 0) {
+    m_forces.differential(x, v, m_scratch);  // -K v
+    a += m_damping.beta * m_scratch;
+  }
+  const int n = num_nodes();
+  const double alpha = m_damping.alpha;
+  const double* load = m_load.data();
+  const double* vp = v.data();
+  const long vs = v.outerStride();
+  for (int i = 0; i < n; ++i) {
+    const double w = m_inv_mass[i], m = m_mass[i];
+    double* ai = a.data() + a.outerStride() * i;
+    if (m_fixed[i]) {  // exactly zero, even where the elastic force is not finite
+      ai[0] = ai[1] = ai[2] = 0.0;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c)
+      ai[c] = w * (ai[c] + load[3 * i + c] - m * alpha * vp[vs * i + c]);
+  }
 }
 
 double Model::kinetic_energy(const Eigen::Ref<const MatX3d>& v) const {
@@ -90,10 +119,7 @@ double Model::kinetic_energy(const Eigen::Ref<const MatX3d>& v) const {
 }
 
 double Model::load_potential(const Eigen::Ref<const MatX3d>& x) const {
-  double p = 0;
-  for (int i = 0; i < num_nodes(); ++i)
-    if (!m_fixed[i]) p -= (m_external.row(i) + m_mass[i] * m_gravity.transpose()).dot(x.row(i));
-  return p;
+  return -(m_load.array() * x.array()).sum();
 }
 
 }  // namespace icd::fem

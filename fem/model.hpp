@@ -61,9 +61,11 @@ class Model {
   /// - beta K(x) v; zero rows at fixed nodes.
   void total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
                    Eigen::Ref<MatX3d> f);
-  /// Accelerations M^-1 total_force (#V x 3, m/s^2), zero at fixed nodes.
+  /// Accelerations M^-1 total_force (#V x 3, m/s^2), zero at fixed nodes, in
+  /// one pass over the nodes after the element loop. health (optional): the
+  /// health of x from the same element pass (ElasticForces::compute_with_health).
   void acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                    Eigen::Ref<MatX3d> a);
+                    Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr);
   /// Kinetic energy 1/2 sum m |v|^2, J.
   double kinetic_energy(const Eigen::Ref<const MatX3d>& v) const;
   /// Potential of the conservative loads: -sum (f_ext + m g) . x, J.
@@ -72,8 +74,11 @@ class Model {
  private:
   ElasticForces m_forces;
   Eigen::VectorXd m_mass;
+  Eigen::VectorXd m_inv_mass;  ///< 1/m (#V)
   std::vector<char> m_fixed;
+  void update_load();
   MatX3d m_external;
+  MatX3d m_load;  ///< f_ext + m g at free nodes, 0 at fixed ones (#V x 3), N
   Eigen::Vector3d m_gravity;
   RayleighDamping m_damping;
   MatX3d m_scratch;

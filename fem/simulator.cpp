@@ -1,6 +1,7 @@
 #include "fem/simulator.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -22,6 +23,8 @@ Simulator::Simulator(Model model, const SimulatorOptions& options)
   if (options.frequency_refresh_iterations < 1)
     bad("frequency_refresh_iterations", options.frequency_refresh_iterations, ">= 1");
   if (options.check_interval < 1) bad("check_interval", options.check_interval, ">= 1");
+  if (!(options.frequency_refresh_tolerance > 0) || !(options.frequency_refresh_tolerance < 1))
+    bad("frequency_refresh_tolerance", options.frequency_refresh_tolerance, "(0, 1)");
   if (!(options.max_energy_growth > 0)) bad("max_energy_growth", options.max_energy_growth, "> 0");
   if (options.max_retries < 0) bad("max_retries", options.max_retries, ">= 0");
   if (!(options.frequency_reuse_time >= 0) || !std::isfinite(options.frequency_reuse_time))
@@ -37,6 +40,7 @@ void Simulator::set_positions(const Eigen::Ref<const MatX3d>& x) {
                          std::to_string(m_model.num_nodes()));
   m_state.x = x;
   m_estimate_time = -1;  // a new configuration: estimate again
+  m_checked_valid = false;
 }
 
 void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
@@ -54,13 +58,15 @@ double Simulator::stable_step_limit() {
   const bool fresh = m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
   if (fresh) return m_cached_limit;
   FrequencyOptions fo = m_options.frequency;
-  if (m_warm_mode.size() == 3 * m_model.num_nodes())
+  if (m_warm_mode.size() == 3 * m_model.num_nodes()) {
     fo.max_iterations = std::min(fo.max_iterations, m_options.frequency_refresh_iterations);
+    fo.tolerance = std::max(fo.tolerance, m_options.frequency_refresh_tolerance);
+  }
   m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode);
   m_estimate_time = m_time;
-  m_cached_limit = m_frequency.omega_max <= 0  // all fixed
+  m_cached_limit = m_frequency.omega_bound <= 0  // all fixed
                        ? std::numeric_limits<double>::infinity()
-                       : fem::stable_step_limit(m_options.integrator, m_frequency.omega_max, m_model.damping());
+                       : fem::stable_step_limit(m_options.integrator, m_frequency.omega_bound, m_model.damping());
   return m_cached_limit;
 }
 
@@ -74,18 +80,20 @@ void Simulator::refuse_if_above_limit(double h, double limit, const char* what) 
   std::ostringstream os;
   os << "fem::Simulator: " << what << " " << h << " s exceeds the stable step limit " << limit << " s of "
      << to_string(m_options.integrator) << " for the current state (largest eigenfrequency "
-     << m_frequency.omega_max << " rad/s, Rayleigh alpha " << m_model.damping().alpha << ", beta "
+     << m_frequency.omega_bound << " rad/s, Rayleigh alpha " << m_model.damping().alpha << ", beta "
      << m_model.damping().beta << ", contact stiffness " << m_options.frequency.contact_stiffness
      << " N/m); use a step <= " << limit << " s or automatic stepping (fixed_step = 0)";
   throw ParameterError(os.str());
 }
 
-std::string Simulator::integrate(double h) {
+std::string Simulator::integrate(double h, ElementHealth* start_health) {
   switch (m_options.integrator) {
-    case Integrator::RK4: m_explicit.rk4(m_model, m_state, h); break;
-    case Integrator::SymplecticEuler: m_explicit.symplectic_euler(m_model, m_state, h); break;
+    case Integrator::RK4: m_explicit.rk4(m_model, m_state, m_next, h, start_health); break;
+    case Integrator::SymplecticEuler: m_explicit.symplectic_euler(m_model, m_state, m_next, h, start_health); break;
     case Integrator::BackwardEuler: {
-      const NewtonReport rep = m_implicit.step(m_model, m_state, h, m_options.newton);
+      assert(!start_health);
+      m_next = m_state;
+      const NewtonReport rep = m_implicit.step(m_model, m_next, h, m_options.newton);
       if (!rep.converged) {
         std::ostringstream os;
         os << "backward Euler Newton did not converge in " << rep.iterations << " iterations: residual "
@@ -98,19 +106,19 @@ std::string Simulator::integrate(double h) {
   return {};
 }
 
-Simulator::Check Simulator::check(const Check& before) {
+Simulator::Check Simulator::evaluate(const Check& before, const State& s, const ElementHealth& h) const {
   Check c;
-  const int n = m_model.num_nodes();
-  for (int i = 0; i < n; ++i)
-    if (!m_state.x.row(i).allFinite() || !m_state.v.row(i).allFinite()) {
-      std::ostringstream os;
-      os << "node " << i << " has a non-finite state: x = (" << m_state.x.row(i) << "), v = ("
-         << m_state.v.row(i) << ")";
-      c.ok = false;
-      c.message = os.str();
-      return c;
-    }
-  const ElementHealth h = m_model.elastic().health(m_state.x);
+  if (!s.x.allFinite() || !s.v.allFinite()) {
+    const int n = m_model.num_nodes();
+    for (int i = 0; i < n; ++i)
+      if (!s.x.row(i).allFinite() || !s.v.row(i).allFinite()) {
+        std::ostringstream os;
+        os << "node " << i << " has a non-finite state: x = (" << s.x.row(i) << "), v = (" << s.v.row(i) << ")";
+        c.ok = false;
+        c.message = os.str();
+        return c;
+      }
+  }
   const bool allow_inversion =
       m_options.inversion == InversionPolicy::Allow ||
       (m_options.inversion == InversionPolicy::Auto && m_model.material().model == MaterialModel::StableNeoHookean);
@@ -119,14 +127,14 @@ Simulator::Check Simulator::check(const Check& before) {
     std::ostringstream os;
     os << "element " << e << " (nodes " << m_model.mesh().tets.row(e) << ") "
        << (h.first_nonfinite_element >= 0 ? "has a non-finite energy" : "is inverted")
-       << ": det F = " << m_model.mesh().deformation_gradient(m_state.x, e).determinant();
+       << ": det F = " << m_model.mesh().deformation_gradient(s.x, e).determinant();
     c.ok = false;
     c.message = os.str();
     return c;
   }
-  c.kinetic = m_model.kinetic_energy(m_state.v);
+  c.kinetic = m_model.kinetic_energy(s.v);
   c.elastic = h.energy;
-  c.load = m_model.load_potential(m_state.x);
+  c.load = m_model.load_potential(s.x);
   const double growth = (c.kinetic + c.elastic) - (before.kinetic + before.elastic) + (c.load - before.load);
   const double allowed = m_options.max_energy_growth *
                              (before.kinetic + before.elastic + std::abs(c.load - before.load)) +
@@ -142,56 +150,100 @@ Simulator::Check Simulator::check(const Check& before) {
   return c;
 }
 
+namespace {
+
+void swap_states(State& a, State& b) {
+  a.x.swap(b.x);
+  a.v.swap(b.v);
+}
+
+}  // namespace
+
 AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
-  State good = m_state;
+  // Explicit integrators check state n in the element pass of the first force
+  // evaluation of step n + 1 (which is at x_n), so a check costs no extra
+  // pass; the last state of the call is checked by a separate pass. Buffers
+  // rotate: m_good (last checked state), m_state (current), m_next (step output).
+  const bool fused = m_options.integrator != Integrator::BackwardEuler;
+  m_good = m_state;
   double t_good = 0, t = 0;
   Check before;
-  {
-    const ElementHealth eh = m_model.elastic().health(m_state.x);
-    before.kinetic = m_model.kinetic_energy(m_state.v);
-    before.elastic = eh.energy;
-    before.load = m_model.load_potential(m_state.x);
-  }
+  before.kinetic = m_model.kinetic_energy(m_state.v);
+  before.elastic = m_checked_valid ? m_checked_elastic : m_model.elastic().energy(m_state.x);
+  before.load = m_model.load_potential(m_state.x);
+  m_checked_valid = false;
   const double h0 = h;
   int since_check = 0, steps = 0, steps_good = 0;
-  while (t < total) {
-    const int remaining = static_cast<int>(std::ceil((total - t) / h * (1 - 1e-12)));
-    const double hh = (total - t) / std::max(remaining, 1);
-    const std::string step_failure = integrate(hh);
-    ++steps;
-    t = (remaining <= 1) ? total : t + hh;
-    ++since_check;
-    if (step_failure.empty() && since_check < m_options.check_interval && t < total) continue;
-    since_check = 0;
-    Check c;
-    if (step_failure.empty()) {
-      c = check(before);
-    } else {
-      c.ok = false;
-      c.message = step_failure;
-    }
-    if (c.ok) {
-      good = m_state;
-      t_good = t;
-      before = c;
-      steps_good = steps;
-      continue;
-    }
+  bool pending = false;  // m_state is a step's result that is due a check
+  double hh = h;
+  // Rolls back to the last checked state and halves the step, or throws.
+  auto reject = [&](const Check& c) {
     if (rep.retries >= m_options.max_retries) {
       std::ostringstream os;
       os << "fem::Simulator: " << to_string(m_options.integrator) << " failed the health check after "
          << rep.retries << " retries at t = " << m_time + t << " s (step reduced from " << h0 << " to " << hh
          << " s): " << c.message;
-      m_state = good;
+      m_state = m_good;
       m_time += t_good;
       throw NumericalError(os.str());
     }
     ++rep.retries;
-    m_state = good;
+    m_state = m_good;
     t = t_good;
     steps = steps_good;
     h *= 0.5;
+    since_check = 0;
+    pending = false;
+  };
+  while (true) {
+    if (pending && (t >= total || !fused)) {
+      pending = false;
+      const Check c = evaluate(before, m_state, m_model.elastic().health(m_state.x));
+      if (!c.ok) {
+        reject(c);
+        continue;
+      }
+      before = c;
+      if (t >= total) break;
+      m_good = m_state;
+      t_good = t;
+      steps_good = steps;
+    }
+    if (t >= total) break;
+    const int remaining = static_cast<int>(std::ceil((total - t) / h * (1 - 1e-12)));
+    hh = (total - t) / std::max(remaining, 1);
+    ElementHealth health;
+    const bool check_now = pending;
+    const std::string step_failure = integrate(hh, check_now ? &health : nullptr);
+    if (check_now) {
+      pending = false;
+      const Check c = evaluate(before, m_state, health);
+      if (!c.ok) {
+        reject(c);  // the step just taken from the bad state is discarded
+        continue;
+      }
+      before = c;
+      swap_states(m_good, m_state);
+      t_good = t;
+      steps_good = steps;
+    }
+    swap_states(m_state, m_next);
+    ++steps;
+    t = (remaining <= 1) ? total : t + hh;
+    if (!step_failure.empty()) {
+      Check c;
+      c.ok = false;
+      c.message = step_failure;
+      reject(c);
+      continue;
+    }
+    if (++since_check >= m_options.check_interval || t >= total) {
+      since_check = 0;
+      pending = true;
+    }
   }
+  m_checked_elastic = before.elastic;
+  m_checked_valid = true;
   rep.step = h;
   rep.substeps = steps;
   m_time += total;
@@ -203,7 +255,7 @@ AdvanceReport Simulator::advance(double frame_dt) {
     throw ParameterError("fem::Simulator::advance: frame_dt = " + std::to_string(frame_dt) + " must be > 0");
   AdvanceReport rep;
   rep.step_limit = stable_step_limit();
-  rep.omega_max = m_frequency.omega_max;
+  rep.omega_max = m_frequency.omega_bound;
   double h;
   if (m_options.fixed_step > 0) {
     refuse_if_above_limit(m_options.fixed_step, rep.step_limit, "fixed_step");
@@ -219,7 +271,7 @@ AdvanceReport Simulator::step(double dt) {
     throw ParameterError("fem::Simulator::step: dt = " + std::to_string(dt) + " must be > 0");
   AdvanceReport rep;
   rep.step_limit = stable_step_limit();
-  rep.omega_max = m_frequency.omega_max;
+  rep.omega_max = m_frequency.omega_bound;
   refuse_if_above_limit(dt, rep.step_limit, "step dt");
   return run(dt, dt, rep);
 }

@@ -31,15 +31,24 @@ struct SimulatorOptions {
   /// Lanczos iterations of the per-frame re-estimate once a previous Ritz
   /// vector exists (warm start; the first estimate uses frequency.max_iterations).
   int frequency_refresh_iterations = 4;
+  /// Lanczos tolerance (residual / Ritz value) of those warm re-estimates;
+  /// the step limit uses FrequencyEstimate::omega_bound, which includes the
+  /// residual, so a looser tolerance shortens the step by at most half of it.
+  double frequency_refresh_tolerance = 1e-3;
   /// Reuse the last largest-eigenfrequency estimate for calls of advance() /
   /// step() within this much simulated time (s, >= 0; 0 = estimate at every
   /// call). For callers that advance in many short pieces (the runner's
   /// detection/response cycles); the health checks still guard every step.
   double frequency_reuse_time = 0;
-  /// Sub-steps between health checks (>= 1). A check costs about one force
-  /// evaluation; a blow-up is caught at most this many steps late and rolled
-  /// back to the last checked state.
-  int check_interval = 4;
+  /// Sub-steps between health checks (>= 1; default: every step). With the
+  /// explicit integrators a check rides on the element pass of the next
+  /// step's first force evaluation (energy, det F and finiteness of state n
+  /// computed while evaluating f(x_n)) plus O(#V) passes, so it costs a few
+  /// percent of a step (measured in experiments/fem/results/README.md); only
+  /// the last state of an advance()/step() call needs a separate element
+  /// pass. A blow-up is caught at most this many steps late and rolled back
+  /// to the last checked state.
+  int check_interval = 1;
   /// A check fails when KE + W grows by more than this fraction of
   /// (KE + W + |work of the loads|) since the last check (explicit blow-up).
   double max_energy_growth = 1.0;
@@ -54,7 +63,7 @@ struct AdvanceReport {
   int retries = 0;        ///< rollbacks
   double step = 0;        ///< last sub-step used, s
   double step_limit = 0;  ///< stable limit at the start of the frame, s (inf for backward Euler)
-  double omega_max = 0;   ///< estimated largest eigenfrequency at the start, rad/s
+  double omega_max = 0;   ///< largest eigenfrequency bound at the start (FrequencyEstimate::omega_bound), rad/s
 };
 
 /// One object over time. Starts at rest in the rest configuration.
@@ -99,15 +108,18 @@ class Simulator {
     std::string message;
     double kinetic = 0, elastic = 0, load = 0;
   };
-  Check check(const Check& before);
-  /// One step; returns an empty string, or why the step failed (Newton).
-  std::string integrate(double h);
+  /// Health check of state s with the element health h of s.x, against the last accepted check.
+  Check evaluate(const Check& before, const State& s, const ElementHealth& h) const;
+  /// One step from m_state into m_next; returns an empty string, or why the
+  /// step failed (Newton). start_health: health of m_state.x (explicit only).
+  std::string integrate(double h, ElementHealth* start_health = nullptr);
   AdvanceReport run(double total, double h, AdvanceReport rep);
   void refuse_if_above_limit(double h, double limit, const char* what) const;
 
   Model m_model;
   SimulatorOptions m_options;
   State m_state;
+  State m_next, m_good;  ///< step output and last checked state (run())
   double m_time = 0;
   ExplicitStepper m_explicit;
   BackwardEulerStepper m_implicit;
@@ -116,6 +128,8 @@ class Simulator {
   double m_energy_floor = 0;
   double m_estimate_time = -1;  ///< simulated time of the last frequency estimate (-1: none)
   double m_cached_limit = 0;    ///< stable step limit of that estimate, s
+  bool m_checked_valid = false; ///< m_checked_elastic is the elastic energy of m_state
+  double m_checked_elastic = 0;
 };
 
 }  // namespace icd::fem

@@ -22,6 +22,11 @@ struct FrequencyEstimate {
   int iterations = 0;    ///< Lanczos iterations used
   bool converged = false;
   double residual = 0;   ///< Ritz residual / Ritz value at exit
+  /// sqrt(theta + |r|) = omega_max sqrt(1 + residual), rad/s: the Ritz value
+  /// theta is a lower bound of lambda_max and some eigenvalue lies within the
+  /// residual norm |r| of it, so this bounds omega_max from above once the
+  /// Ritz pair is the top one. The Simulator's step limits use it.
+  double omega_bound = 0;
 };
 
 /// Largest eigenvalue of the generalized problem (K(x) + k_c I) u = omega^2 M u
