@@ -107,6 +107,28 @@ void build_topology(SphereTree& tree, const std::vector<int32_t>& parent) {
   if (tree.rest_spheres.size() != n) tree.rest_spheres = tree.spheres;
 }
 
+void truncate_levels(SphereTree& tree, int max_level) {
+  if (max_level < 0)
+    throw ParameterError("truncate_levels: max_level must be >= 0, got " + std::to_string(max_level));
+  if (max_level + 1 >= tree.num_levels()) return;
+  const int32_t keep = tree.level_offset[max_level + 1];
+  tree.spheres.resize(keep);
+  tree.rest_spheres.resize(keep);
+  tree.first_child.resize(keep);
+  tree.child_count.resize(keep);
+  tree.level.resize(keep);
+  tree.level_offset.resize(max_level + 2);
+  for (int32_t i = tree.level_offset[max_level]; i < keep; ++i) {
+    tree.first_child[i] = -1;
+    tree.child_count[i] = 0;
+  }
+  if (!tree.assoc_offset.empty()) {
+    tree.assoc_offset.resize(keep + 1);
+    tree.assoc_nodes.resize(tree.assoc_offset.back());
+    tree.assoc_rest_dist.resize(tree.assoc_offset.back());
+  }
+}
+
 std::vector<int32_t> parents(const SphereTree& tree) {
   std::vector<int32_t> p(tree.spheres.size(), -1);
   for (int i = 0; i < tree.num_nodes(); ++i)

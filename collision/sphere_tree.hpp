@@ -65,6 +65,14 @@ void validate(const SphereTree& tree);
 /// Throws icd::ParameterError when `parent` is not a breadth-first listing.
 void build_topology(SphereTree& tree, const std::vector<int32_t>& parent);
 
+/// Drops every level below `max_level` (>= 0): the nodes of level max_level
+/// become leaves. Because the layout is breadth-first, the kept nodes are a
+/// prefix of every array (association data included), so indices do not
+/// change. A wrapped tree stays covering (each kept node covers its subtree's
+/// surface patch). No-op when the tree is not deeper. Throws ParameterError
+/// for a negative max_level.
+void truncate_levels(SphereTree& tree, int max_level);
+
 /// Parent index of every node (-1 for the root), the inverse of build_topology.
 std::vector<int32_t> parents(const SphereTree& tree);
 

@@ -1,8 +1,19 @@
 #include "experiments/runner/plan.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace icd::runner {
+
+int max_usable_level(int64_t budget_tests, double budget_seconds) {
+  double tests = std::numeric_limits<double>::infinity();
+  if (budget_tests >= 0) tests = static_cast<double>(budget_tests);
+  if (std::isfinite(budget_seconds)) tests = std::min(tests, budget_seconds / kFastestTestSeconds);
+  if (!std::isfinite(tests) || tests >= 2.0 * 64) return std::numeric_limits<int>::max();
+  // Largest L with 2L - 1 <= tests (L = 0: the root pair only).
+  return static_cast<int>(std::floor((tests + 1) / 2));
+}
 
 StagePlan make_plan(const Scene& scene) {
   StagePlan plan;
@@ -25,6 +36,11 @@ StagePlan make_plan(const Scene& scene) {
       plan.response |= scene.objects[k].kind == ObjectKind::Deformable;
     }
   plan.broad_phase = plan.pairs.size() > 1;
+  if (!plan.pairs.empty()) {
+    const CollisionSpec& c = scene.collision;
+    plan.max_tree_level = max_usable_level(c.budget_tests, c.budget_seconds);
+    if (c.depth_cap >= 0) plan.max_tree_level = std::min(plan.max_tree_level, c.depth_cap);
+  }
   plan.vtu_output = scene.output.vtu_every > 0;
   plan.exact_reference = scene.output.exact_reference && !plan.pairs.empty();
   for (int i = 0; i < n; ++i) {
@@ -57,6 +73,13 @@ std::vector<std::string> StagePlan::describe(const Scene& scene) const {
     lines.emplace_back("collision: none");
   } else {
     if (broad_phase) lines.emplace_back("broad phase: root-sphere culling");
+    if (max_tree_level == std::numeric_limits<int>::max())
+      lines.emplace_back("sphere trees: every level (the budget and depth cap reach the leaves)");
+    else
+      lines.push_back("sphere trees: levels 0.." + std::to_string(max_tree_level) +
+                      " only (deeper levels are beyond the " +
+                      (scene.collision.depth_cap == max_tree_level ? "depth cap" : "budget") +
+                      "; not loaded, not updated)");
     for (const auto& [i, j] : pairs)
       lines.push_back("collision: " + scene.objects[i].name + " <-> " + scene.objects[j].name);
   }

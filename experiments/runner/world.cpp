@@ -43,6 +43,9 @@ World::World(const Scene& scene, const std::filesystem::path& cache_dir,
     o.plan = m_plan.objects[i];
     o.asset = load_object_asset(o.spec, cache_dir, tool_dir);
     place_object(o.asset, o.spec);
+    // No tree levels deeper than the queries can reach.
+    if (o.plan.sphere_tree && m_plan.max_tree_level != std::numeric_limits<int>::max())
+      collision::truncate_levels(o.asset.spheres, m_plan.max_tree_level);
     // Static objects are never updated: make their trees layered once here.
     if (scene.collision.layered) enclose_children(o.asset.spheres);
     o.rest = o.asset.coarse.V;
