@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "mesh/io/atomic_write.hpp"
 #include "mesh/io/error.hpp"
@@ -101,6 +102,7 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   if (opt.out_dir.empty()) throw ParameterError("run_scene: an output folder is required");
   Scene scene = scene_in;
   if (opt.frames >= 0) scene.frames = opt.frames;
+  if (opt.target_fps >= 0) scene.target_fps = opt.target_fps;
   std::filesystem::create_directories(opt.out_dir);
   // Remove a previous run's results first: nothing stale that looks complete.
   std::filesystem::remove(opt.out_dir / "frames.csv");
@@ -119,12 +121,28 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
     series.resize(world.objects().size() * 2 + world.plan().pairs.size() * 2);
   }
   const auto start = std::chrono::steady_clock::now();
+  // Real-time mode: frame f is due at start + (f + 1) / target_fps. Collision
+  // detection gets what is left of each frame (World::step); an early frame
+  // waits for its deadline, so the rate is held, not exceeded.
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(scene.target_fps > 0 ? 1.0 / scene.target_fps : 0.0));
+  auto deadline = start;
+  int missed = 0;
   for (int f = 0; f < scene.frames; ++f) {
+    deadline += period;
     FrameMetrics m = world.step();
     if (scene.output.vtu_every > 0 && (f % scene.output.vtu_every == 0 || f + 1 == scene.frames)) {
       const auto t0 = std::chrono::steady_clock::now();
       write_frame_vtu(world, f, vtu_tmp, series);
       m.times.output = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    if (scene.target_fps > 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ++missed;
+        deadline = std::chrono::steady_clock::now();  // late: the next frame starts now
+      } else {
+        std::this_thread::sleep_until(deadline);
+      }
     }
     frames.push_back(m);
     if (opt.progress && (tty ? true : (f + 1) % std::max(1, scene.frames / 10) == 0)) {
@@ -174,6 +192,11 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
     }
   }
 
+  if (opt.log && scene.target_fps > 0) {
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(opt.log, "real-time mode: target %.1f fps, held %.1f fps, %d of %d frames over their deadline\n",
+                 scene.target_fps, scene.frames / el, missed, scene.frames);
+  }
   if (scene.output.csv) write_file_atomically(opt.out_dir / "frames.csv", metrics_csv(frames));
   if (scene.output.vtu_every > 0) {
     for (size_t s = 0; s < series.size(); ++s) {

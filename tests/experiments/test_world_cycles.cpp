@@ -3,6 +3,10 @@
 #include <cmath>
 #include <string>
 
+#include <chrono>
+#include <filesystem>
+
+#include "experiments/runner/run.hpp"
 #include "experiments/runner/world.hpp"
 
 namespace icd::runner {
@@ -96,6 +100,62 @@ TEST(WorldCycles, InterruptedQueryReusesThePreviousCompleteAnswer) {
   ASSERT_GT(e.contact_force, 0);
   EXPECT_NEAR(p.contact_force, e.contact_force, 0.25 * e.contact_force);
   EXPECT_GT(u.max_penetration, 3 * e.max_penetration);
+}
+
+}  // namespace
+}  // namespace icd::runner
+
+namespace icd::runner {
+namespace {
+
+// Two overlapping soft spheres (in contact from the first frame).
+Scene overlapping_scene(double target_fps) {
+  const std::string text = R"({
+    "frames": 10, "frame_rate": 60, "target_fps": )" + std::to_string(target_fps) + R"(,
+    "objects": [
+      {"name": "a", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 3, "cells": 4}, "position": [-0.09, 0, 0]},
+      {"name": "b", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 3, "cells": 4}, "position": [0.09, 0, 0]}
+    ],
+    "collision": {"budget_seconds": 0.001, "stiffness": 100},
+    "output": {"csv": false}})";
+  return parse_scene(parse_json(text, "realtime"), "realtime", ".");
+}
+
+// Real-time mode: collision detection gets what is left of the frame. A slow
+// target leaves most of a 0.5 s frame to the query (which then completes); an
+// impossible target leaves nothing, so every query gets the minimum budget and
+// answers interrupted -- and the simulation carries on without NaN.
+TEST(RealTime, CollisionGetsWhatIsLeftOfTheFrame) {
+  World slow(overlapping_scene(2), "", "");
+  const FrameMetrics s = slow.step();
+  EXPECT_GT(s.budget, 0.25);  // 0.5 s frame minus the FEM time of its last cycle
+  EXPECT_LE(s.budget, 0.5);
+  EXPECT_EQ(s.interrupted, 0);
+
+  World fast(overlapping_scene(1e5), "", "");
+  for (int f = 0; f < 3; ++f) {
+    const FrameMetrics m = fast.step();
+    EXPECT_EQ(m.budget, 1e-6);  // the 10 us frame is over before the query starts
+    EXPECT_GE(m.interrupted, 1);
+    EXPECT_TRUE(fast.objects()[0].positions.allFinite());
+  }
+}
+
+// run_scene holds the rate: early frames wait for their deadline, so N frames
+// take at least N / target_fps seconds.
+TEST(RealTime, RunSceneWaitsForEachFrameDeadline) {
+  Scene scene = overlapping_scene(50);
+  scene.frames = 10;
+  RunOptions opt;
+  opt.out_dir = std::filesystem::temp_directory_path() / "icd_test_realtime";
+  opt.progress = false;
+  opt.log = nullptr;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<FrameMetrics> frames = run_scene(scene, opt);
+  const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(frames.size(), 10u);
+  EXPECT_GE(el, 10 / 50.0);
+  std::filesystem::remove_all(opt.out_dir);
 }
 
 }  // namespace
