@@ -18,6 +18,12 @@ Model::Model(const Eigen::Ref<const MatX3d>& rest_positions, const Eigen::Ref<co
   m_scratch.resize(num_nodes(), 3);
   set_gravity(options.gravity);
   set_damping(options.damping);
+  set_strain_rate_damping(options.strain_rate_damping);
+}
+
+void Model::set_strain_rate_damping(const StrainRateDamping& damping) {
+  validate(damping);
+  m_strain_rate_damping = damping;
 }
 
 void Model::set_fixed_nodes(const std::vector<int>& nodes) {
@@ -78,6 +84,7 @@ void Model::total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<cons
     m_forces.differential(x, v, m_scratch);  // -K v
     f += m_damping.beta * m_scratch;
   }
+  add_strain_rate_damping_forces(mesh(), m_strain_rate_damping, x, v, f);
   const int n = num_nodes();
   for (int i = 0; i < n; ++i) {
     if (m_fixed[i]) {
@@ -97,6 +104,7 @@ void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<con
     m_forces.differential(x, v, m_scratch);  // -K v
     a += m_damping.beta * m_scratch;
   }
+  add_strain_rate_damping_forces(mesh(), m_strain_rate_damping, x, v, a);
   const int n = num_nodes();
   const double alpha = m_damping.alpha;
   const double* load = m_load.data();

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "fem/forces.hpp"
+#include "fem/strain_rate_damping.hpp"
 
 namespace icd::fem {
 
@@ -19,6 +20,8 @@ struct RayleighDamping {
 /// Options of a Model.
 struct ModelOptions {
   RayleighDamping damping;
+  /// O'Brien-Hodgins damping on the Green strain rate (in addition to Rayleigh).
+  StrainRateDamping strain_rate_damping;
   Eigen::Vector3d gravity{0.0, 0.0, 0.0};  ///< m/s^2
   ForceOptions forces;
 };
@@ -56,9 +59,12 @@ class Model {
   /// Throws ParameterError for negative or non-finite coefficients.
   void set_damping(const RayleighDamping& damping);
   const RayleighDamping& damping() const { return m_damping; }
+  /// Throws ParameterError for negative or non-finite viscosities.
+  void set_strain_rate_damping(const StrainRateDamping& damping);
+  const StrainRateDamping& strain_rate_damping() const { return m_strain_rate_damping; }
 
   /// Total force on every node (#V x 3, N): f_int(x) + f_ext + m g - alpha m v
-  /// - beta K(x) v; zero rows at fixed nodes.
+  /// - beta K(x) v + the strain-rate damping force; zero rows at fixed nodes.
   void total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
                    Eigen::Ref<MatX3d> f);
   /// Accelerations M^-1 total_force (#V x 3, m/s^2), zero at fixed nodes, in
@@ -81,6 +87,7 @@ class Model {
   MatX3d m_load;  ///< f_ext + m g at free nodes, 0 at fixed ones (#V x 3), N
   Eigen::Vector3d m_gravity;
   RayleighDamping m_damping;
+  StrainRateDamping m_strain_rate_damping;
   MatX3d m_scratch;
 };
 

@@ -63,10 +63,21 @@ double Simulator::stable_step_limit() {
     fo.tolerance = std::max(fo.tolerance, m_options.frequency_refresh_tolerance);
   }
   m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode);
+  if (m_model.strain_rate_damping().enabled()) {
+    FrequencyOptions fd = m_options.frequency;
+    if (m_warm_damping.size() == 3 * m_model.num_nodes()) {
+      fd.max_iterations = std::min(fd.max_iterations, m_options.frequency_refresh_iterations);
+      fd.tolerance = std::max(fd.tolerance, m_options.frequency_refresh_tolerance);
+    }
+    m_damping_rate = estimate_max_damping_rate(m_model, m_state.x, fd, &m_warm_damping);
+  } else {
+    m_damping_rate = 0;
+  }
   m_estimate_time = m_time;
   m_cached_limit = m_frequency.omega_bound <= 0  // all fixed
                        ? std::numeric_limits<double>::infinity()
-                       : fem::stable_step_limit(m_options.integrator, m_frequency.omega_bound, m_model.damping());
+                       : fem::stable_step_limit(m_options.integrator, m_frequency.omega_bound, m_model.damping(),
+                                                m_damping_rate);
   return m_cached_limit;
 }
 
@@ -81,7 +92,7 @@ void Simulator::refuse_if_above_limit(double h, double limit, const char* what) 
   os << "fem::Simulator: " << what << " " << h << " s exceeds the stable step limit " << limit << " s of "
      << to_string(m_options.integrator) << " for the current state (largest eigenfrequency "
      << m_frequency.omega_bound << " rad/s, Rayleigh alpha " << m_model.damping().alpha << ", beta "
-     << m_model.damping().beta << ", contact stiffness " << m_options.frequency.contact_stiffness
+     << m_model.damping().beta << ", strain-rate damping rate up to " << m_damping_rate << " 1/s, contact stiffness " << m_options.frequency.contact_stiffness
      << " N/m); use a step <= " << limit << " s or automatic stepping (fixed_step = 0)";
   throw ParameterError(os.str());
 }

@@ -124,7 +124,8 @@ class Simulator {
   ExplicitStepper m_explicit;
   BackwardEulerStepper m_implicit;
   FrequencyEstimate m_frequency;
-  Eigen::VectorXd m_warm_mode;
+  Eigen::VectorXd m_warm_mode, m_warm_damping;
+  double m_damping_rate = 0;  ///< estimate_max_damping_rate() of the last estimate, 1/s
   double m_energy_floor = 0;
   double m_estimate_time = -1;  ///< simulated time of the last frequency estimate (-1: none)
   double m_cached_limit = 0;    ///< stable step limit of that estimate, s

@@ -45,48 +45,42 @@ double symplectic_euler_mode_limit(double omega, double c) {
 
 }  // namespace
 
-double stable_step_limit(Integrator integrator, double omega_max, const RayleighDamping& damping) {
+double stable_step_limit(Integrator integrator, double omega_max, const RayleighDamping& damping,
+                         double max_damping_rate) {
   if (!(omega_max > 0) || !std::isfinite(omega_max))
     throw ParameterError("fem::stable_step_limit: omega_max = " + std::to_string(omega_max) +
                          " must be finite and > 0");
+  if (!(max_damping_rate >= 0) || !std::isfinite(max_damping_rate))
+    throw ParameterError("fem::stable_step_limit: max_damping_rate = " + std::to_string(max_damping_rate) +
+                         " must be finite and >= 0");
   if (integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
   double limit = std::numeric_limits<double>::infinity();
+  // Extra modal damping in [0, max_damping_rate]: 9 levels (0 and the maximum included).
+  const int levels = max_damping_rate > 0 ? 8 : 0;
   for (int k = 0; k <= 96; ++k) {  // omega_max * 10^(-6 .. 0)
     const double omega = omega_max * std::pow(10.0, -6.0 * (96 - k) / 96.0);
-    const double c = damping.alpha + damping.beta * omega * omega;
-    const double h = integrator == Integrator::RK4 ? rk4_mode_limit(omega, c)
-                                                   : symplectic_euler_mode_limit(omega, c);
-    limit = std::min(limit, h);
+    for (int j = 0; j <= levels; ++j) {
+      const double c = damping.alpha + damping.beta * omega * omega + (levels ? max_damping_rate * j / levels : 0.0);
+      const double h = integrator == Integrator::RK4 ? rk4_mode_limit(omega, c)
+                                                     : symplectic_euler_mode_limit(omega, c);
+      limit = std::min(limit, h);
+    }
   }
   return limit;
 }
 
-FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const MatX3d>& x,
-                                         const FrequencyOptions& options, Eigen::VectorXd* warm) {
-  if (options.max_iterations < 1 || !(options.contact_stiffness >= 0) || !(options.tolerance > 0))
-    throw ParameterError("fem::FrequencyOptions: expected max_iterations >= 1, tolerance > 0 and "
-                         "contact_stiffness >= 0");
-  const int n = model.num_nodes();
-  const int ndof = 3 * n;
-  Eigen::VectorXd free = Eigen::VectorXd::Zero(ndof), inv_sqrt_m(ndof);
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) {
-      free[3 * i + c] = model.fixed_nodes()[i] ? 0.0 : 1.0;
-      inv_sqrt_m[3 * i + c] = 1.0 / std::sqrt(model.mass()[i]);
-    }
+namespace {
+
+// Top eigenpair of a symmetric operator on the free dofs by Lanczos with full
+// reorthogonalisation; apply(q, out) computes out = A q for A = M^-1/2 B M^-1/2.
+template <class Apply>
+FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free, const FrequencyOptions& options,
+                              Eigen::VectorXd* warm, double* theta_out) {
+  const int ndof = static_cast<int>(free.size());
   const int nfree = static_cast<int>(free.sum());
   FrequencyEstimate est;
+  *theta_out = 0;
   if (nfree == 0) return est;
-
-  MatX3d u(n, 3), du(n, 3);
-  auto apply = [&](const Eigen::VectorXd& q, Eigen::VectorXd& out) {
-    Eigen::Map<Eigen::VectorXd>(u.data(), ndof) = inv_sqrt_m.cwiseProduct(q).cwiseProduct(free);
-    model.elastic().differential(x, u, du);  // -K u
-    out = (-inv_sqrt_m.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(du.data(), ndof)) +
-           options.contact_stiffness * inv_sqrt_m.cwiseProduct(inv_sqrt_m).cwiseProduct(q))
-              .cwiseProduct(free);
-  };
-
   Eigen::VectorXd q0(ndof);
   if (warm && warm->size() == ndof && warm->cwiseProduct(free).norm() > 0) {
     q0 = warm->cwiseProduct(free);
@@ -127,16 +121,79 @@ FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const Ma
     }
     Q.push_back(w / beta[j]);
   }
-  if (!std::isfinite(theta))
-    throw NumericalError("fem::estimate_max_frequency: the stiffness of the current state is not finite");
-  est.omega_max = std::sqrt(std::max(theta, 0.0));
-  est.omega_bound = est.omega_max * std::sqrt(1.0 + est.residual);
   if (warm) {
     ritz = Eigen::VectorXd::Zero(ndof);
     for (int i = 0; i < static_cast<int>(s_top.size()); ++i) ritz += s_top[i] * Q[i];
     *warm = ritz;
   }
+  *theta_out = theta;
   return est;
+}
+
+void check_options(const FrequencyOptions& options) {
+  if (options.max_iterations < 1 || !(options.contact_stiffness >= 0) || !(options.tolerance > 0))
+    throw ParameterError("fem::FrequencyOptions: expected max_iterations >= 1, tolerance > 0 and "
+                         "contact_stiffness >= 0");
+}
+
+// Free-dof mask and M^-1/2 per dof.
+void free_dofs(const Model& model, Eigen::VectorXd& free, Eigen::VectorXd& inv_sqrt_m) {
+  const int n = model.num_nodes();
+  free = Eigen::VectorXd::Zero(3 * n);
+  inv_sqrt_m.resize(3 * n);
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      free[3 * i + c] = model.fixed_nodes()[i] ? 0.0 : 1.0;
+      inv_sqrt_m[3 * i + c] = 1.0 / std::sqrt(model.mass()[i]);
+    }
+}
+
+}  // namespace
+
+FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const MatX3d>& x,
+                                         const FrequencyOptions& options, Eigen::VectorXd* warm) {
+  check_options(options);
+  const int n = model.num_nodes();
+  const int ndof = 3 * n;
+  Eigen::VectorXd free, inv_sqrt_m;
+  free_dofs(model, free, inv_sqrt_m);
+  MatX3d u(n, 3), du(n, 3);
+  auto apply = [&](const Eigen::VectorXd& q, Eigen::VectorXd& out) {
+    Eigen::Map<Eigen::VectorXd>(u.data(), ndof) = inv_sqrt_m.cwiseProduct(q).cwiseProduct(free);
+    model.elastic().differential(x, u, du);  // -K u
+    out = (-inv_sqrt_m.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(du.data(), ndof)) +
+           options.contact_stiffness * inv_sqrt_m.cwiseProduct(inv_sqrt_m).cwiseProduct(q))
+              .cwiseProduct(free);
+  };
+  double theta = 0;
+  FrequencyEstimate est = lanczos_top(apply, free, options, warm, &theta);
+  if (!std::isfinite(theta))
+    throw NumericalError("fem::estimate_max_frequency: the stiffness of the current state is not finite");
+  est.omega_max = std::sqrt(std::max(theta, 0.0));
+  est.omega_bound = est.omega_max * std::sqrt(1.0 + est.residual);
+  return est;
+}
+
+double estimate_max_damping_rate(Model& model, const Eigen::Ref<const MatX3d>& x, const FrequencyOptions& options,
+                                 Eigen::VectorXd* warm) {
+  check_options(options);
+  if (!model.strain_rate_damping().enabled()) return 0;
+  const int n = model.num_nodes();
+  const int ndof = 3 * n;
+  Eigen::VectorXd free, inv_sqrt_m;
+  free_dofs(model, free, inv_sqrt_m);
+  MatX3d u(n, 3), fd(n, 3);
+  auto apply = [&](const Eigen::VectorXd& q, Eigen::VectorXd& out) {
+    Eigen::Map<Eigen::VectorXd>(u.data(), ndof) = inv_sqrt_m.cwiseProduct(q).cwiseProduct(free);
+    fd.setZero();
+    add_strain_rate_damping_forces(model.mesh(), model.strain_rate_damping(), x, u, fd);  // -D u
+    out = (-inv_sqrt_m.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(fd.data(), ndof))).cwiseProduct(free);
+  };
+  double theta = 0;
+  const FrequencyEstimate est = lanczos_top(apply, free, options, warm, &theta);
+  if (!std::isfinite(theta))
+    throw NumericalError("fem::estimate_max_damping_rate: the damping matrix of the current state is not finite");
+  return std::max(theta, 0.0) * (1.0 + est.residual);
 }
 
 }  // namespace icd::fem

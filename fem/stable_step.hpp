@@ -50,7 +50,19 @@ FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const Ma
 ///    R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24 (2 sqrt 2 / omega undamped);
 ///  - backward Euler: unbounded (returns +infinity).
 /// The minimum is taken over omega in (0, omega_max] (log grid), since damping
-/// can make a lower mode the limiting one.
-double stable_step_limit(Integrator integrator, double omega_max, const RayleighDamping& damping);
+/// can make a lower mode the limiting one. max_damping_rate (1/s, >= 0): the
+/// largest modal rate of the strain-rate damping (estimate_max_damping_rate);
+/// its modes need not be the elastic ones, so every mode is also taken with
+/// any extra damping in [0, max_damping_rate] (9 levels): conservative.
+double stable_step_limit(Integrator integrator, double omega_max, const RayleighDamping& damping,
+                         double max_damping_rate = 0);
+
+/// Largest eigenvalue c_max (1/s) of M^-1 D(x) on the free dofs, D = -df_d/dv
+/// the (symmetric, positive semi-definite) matrix of the strain-rate damping
+/// forces at positions x: the largest modal damping rate. Lanczos as in
+/// estimate_max_frequency (options.contact_stiffness unused); returns the
+/// residual upper bound theta (1 + residual). 0 when the damping is off.
+double estimate_max_damping_rate(Model& model, const Eigen::Ref<const MatX3d>& x, const FrequencyOptions& options,
+                                 Eigen::VectorXd* warm = nullptr);
 
 }  // namespace icd::fem

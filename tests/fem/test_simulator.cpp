@@ -131,6 +131,29 @@ TEST(Simulator, HealthCheckRollsBackAndRetriesThenNamesTheElement) {
   EXPECT_TRUE(sim.velocities().allFinite());
 }
 
+TEST(Simulator, ChecksDoNotChangeTheTrajectory) {
+  // The health checks ride on the force passes (every step) or run every 4th
+  // step: the trajectory is the same, bitwise, for both integrators; the
+  // reported sub-step counts are equal.
+  for (Integrator integ : {Integrator::RK4, Integrator::SymplecticEuler}) {
+    const Material mat = test::material(MaterialModel::StVK, 1e6, 0.3);
+    MatX3d x[2];
+    int substeps[2];
+    for (int k = 0; k < 2; ++k) {
+      SimulatorOptions o;
+      o.integrator = integ;
+      o.check_interval = k == 0 ? 1 : 4;
+      Simulator sim(test::cantilever(1, mat), o);
+      substeps[k] = 0;
+      for (int f = 0; f < 5; ++f) substeps[k] += sim.advance(1.0 / 60).substeps;
+      x[k] = sim.positions();
+    }
+    EXPECT_TRUE(x[0].cwiseEqual(x[1]).all()) << to_string(integ);
+    EXPECT_EQ(substeps[0], substeps[1]);
+    EXPECT_LT(test::tip_deflection(test::cantilever(1, mat), x[0]), 0.0);
+  }
+}
+
 TEST(Simulator, RejectsBadOptionsAndInputs) {
   const Material mat = test::material(MaterialModel::StVK);
   SimulatorOptions o;
