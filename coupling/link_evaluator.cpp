@@ -69,7 +69,6 @@ LinkEvaluator::LinkEvaluator(const RigidLinks& links, const LinkEvaluatorOptions
   m_weights.topRows(3) = links.alpha.transpose();
   m_weights.bottomRows(3) = links.coeffs.transpose();
   const int T = num_triples();
-  m_degenerate.assign(T, 0);
   m_table.setZero(24, T);
   m_has_frame.assign(T, 0);
 }
@@ -85,14 +84,7 @@ LinkApplyResult LinkEvaluator::apply(const Eigen::Ref<const MatX3d>& coarse_posi
   if (dense_out.rows() != num_links())
     throw ParameterError("LinkEvaluator::apply: dense_out has " + std::to_string(dense_out.rows()) +
                          " rows, expected " + std::to_string(num_links()));
-  LinkApplyResult result;
-  result.degenerate_triples = update_triples(coarse_positions);
-  if (result.degenerate_triples > 0)
-    for (int t = 0; t < num_triples(); ++t)
-      if (m_degenerate[t]) {
-        fallback_frame(t);
-        result.degenerate_links += m_links_per_triple[t];
-      }
+  const LinkApplyResult result = update_triples(coarse_positions);
   evaluate_links(dense_out);
   return result;
 }
@@ -106,62 +98,73 @@ void LinkEvaluator::check_finite(const Eigen::Ref<const MatX3d>& coarse_position
   }
 }
 
-// Eqs. 4-6 for kLanes triples at a time: the triples' nodes are gathered into
-// fixed-size lane arrays (the last chunk repeats its last triple), on which
-// Eigen's packet arithmetic (sqrt included) runs; then nodes and frames are
-// stored into the per-triple table, except the frames of degenerate triples.
-// Returns the number of degenerate triples; throws when a node is not finite.
-int LinkEvaluator::update_triples(const Eigen::Ref<const MatX3d>& coarse_positions) {
-  constexpr int kLanes = 8;
+// Gathers the triples' nodes into the table (x, y, z, pad columns, for the
+// link loop); then Eqs. 4-6 for kLanes triples at a time with Eigen's packet
+// arithmetic (sqrt included), reading the nodes back from the table, and the
+// frames stored into the table; degenerate triples get fallback_frame().
+// Throws when a node is not finite (before any fallback frame of its chunk).
+LinkApplyResult LinkEvaluator::update_triples(const Eigen::Ref<const MatX3d>& coarse_positions) {
+  constexpr int kLanes = 2;  // one SSE2 packet: wider lanes spill more than they gain
   using Lane = Eigen::Array<double, kLanes, 1>;
   const int T = num_triples();
   const double* X = coarse_positions.data();
   const Eigen::Index stride = coarse_positions.outerStride();
-  const double tol2 = m_options.degenerate_tolerance * m_options.degenerate_tolerance;
-  int degenerate = 0;
-  bool finite = true;
-  for (int t0 = 0; t0 < T; t0 += kLanes) {
-    Lane q[9];  // q0x q0y q0z q1x ... q2z
-    for (int l = 0; l < kLanes; ++l) {
-      const int t = std::min(t0 + l, T - 1);
-      for (int i = 0; i < 3; ++i) {
-        const double* row = X + m_triple_nodes[3 * t + i] * stride;
-        for (int d = 0; d < 3; ++d) q[3 * i + d][l] = row[d];
-      }
+  double* table = m_table.data();
+  for (int t = 0; t < T; ++t)
+    for (int i = 0; i < 3; ++i) {
+      const double* row = X + m_triple_nodes[3 * t + i] * stride;
+      double* col = table + 24 * static_cast<Eigen::Index>(t) + 4 * i;
+      col[0] = row[0];
+      col[1] = row[1];
+      col[2] = row[2];
     }
-    const Lane ux = q[3] - q[0], uy = q[4] - q[1], uz = q[5] - q[2];
-    const Lane vx = q[6] - q[0], vy = q[7] - q[1], vz = q[8] - q[2];
+
+  const double tol2 = m_options.degenerate_tolerance * m_options.degenerate_tolerance;
+  LinkApplyResult result;
+  for (int t0 = 0; t0 < T; t0 += kLanes) {
+    // Lane l holds triple t0 + l (the last one repeated past the end).
+    const double* col0 = table + 24 * static_cast<Eigen::Index>(t0);
+    const double* col1 = t0 + 1 < T ? col0 + 24 : col0;
+    const auto q = [&](int c) {
+      return Lane(col0[4 * (c / 3) + c % 3], col1[4 * (c / 3) + c % 3]);
+    };
+    const Lane ux = q(3) - q(0), uy = q(4) - q(1), uz = q(5) - q(2);
+    const Lane vx = q(6) - q(0), vy = q(7) - q(1), vz = q(8) - q(2);
     const Lane nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;  // Eq. 4
     const Lane ax = uy * nz - uz * ny, ay = uz * nx - ux * nz, az = ux * ny - uy * nx;  // Eq. 5
     const Lane nn = nx.square() + ny.square() + nz.square();
     const Lane uu = ux.square() + uy.square() + uz.square();
     const Lane vv = vx.square() + vy.square() + vz.square();
     // Eq. 6: e0 = n / |n|, e1 = (q0 - q1) / |q0 - q1| = -u / |u|, e2 = a / |a|
-    // with |a| = |u| |n| (u is orthogonal to n).
-    const Lane inv_n = nn.sqrt().inverse();
-    const Lane minus_inv_u = -uu.sqrt().inverse();
-    const Lane inv_a = -inv_n * minus_inv_u;
-    const Lane* e[9] = {&nx, &ny, &nz, &ux, &uy, &uz, &ax, &ay, &az};
-    const Lane* scale[3] = {&inv_n, &minus_inv_u, &inv_a};
+    // with |a| = |u| |n| (u is orthogonal to n); one division.
+    const Lane len_n = nn.sqrt(), len_u = uu.sqrt();
+    const Lane inv_a = (len_n * len_u).inverse();
+    const Lane inv_n = len_u * inv_a;
+    const Lane minus_inv_u = -len_n * inv_a;
+    const Lane e[9] = {nx * inv_n,       ny * inv_n, nz * inv_n, ux * minus_inv_u, uy * minus_inv_u,
+                       uz * minus_inv_u, ax * inv_a, ay * inv_a, az * inv_a};
+    const Eigen::Array<bool, kLanes, 1> ok =
+        (nn > 0.0) && (nn > tol2 * uu * vv) && (nn < std::numeric_limits<double>::infinity());
     const int lanes = std::min(kLanes, T - t0);
+    const bool all_ok = ok.head(lanes).all();
+    // A non-finite node makes |u|^2 or |v|^2 non-finite (so does overflow,
+    // which check_finite() lets through as a degenerate frame).
+    if (!all_ok && !((uu + vv).head(lanes) < std::numeric_limits<double>::infinity()).all())
+      check_finite(coarse_positions);
     for (int l = 0; l < lanes; ++l) {
       const int t = t0 + l;
-      double* col = m_table.col(t).data();
-      for (int i = 0; i < 9; ++i) col[4 * (i / 3) + i % 3] = q[i][l];
-      finite = finite && std::isfinite(nn[l] + uu[l] + vv[l]);
-      const bool ok = nn[l] > 0.0 && nn[l] > tol2 * uu[l] * vv[l] &&
-                      nn[l] < std::numeric_limits<double>::infinity();
-      m_degenerate[t] = !ok;
-      if (!ok) {
-        ++degenerate;
+      if (!all_ok && !ok[l]) {  // keeps the previous frame for the fallback
+        fallback_frame(t);
+        ++result.degenerate_triples;
+        result.degenerate_links += m_links_per_triple[t];
         continue;
       }
-      for (int i = 0; i < 9; ++i) col[12 + 4 * (i / 3) + i % 3] = (*e[i])[l] * (*scale[i / 3])[l];
+      double* col = table + 24 * static_cast<Eigen::Index>(t) + 12;
+      for (int i = 0; i < 9; ++i) col[4 * (i / 3) + i % 3] = e[i][l];
       m_has_frame[t] = 1;
     }
   }
-  if (!finite) check_finite(coarse_positions);
-  return degenerate;
+  return result;
 }
 
 void LinkEvaluator::fallback_frame(int t) {

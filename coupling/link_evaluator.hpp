@@ -87,7 +87,7 @@ class LinkEvaluator {
 
  private:
   void check_finite(const Eigen::Ref<const MatX3d>& coarse_positions) const;
-  int update_triples(const Eigen::Ref<const MatX3d>& coarse_positions);
+  LinkApplyResult update_triples(const Eigen::Ref<const MatX3d>& coarse_positions);
   void fallback_frame(int t);
   void evaluate_links(Eigen::Ref<MatX3d> dense_out) const;
 
@@ -103,8 +103,7 @@ class LinkEvaluator {
   /// 24 x #T, column t: q0, q1, q2, e0, e1, e2 of triple t, each padded to 4
   /// doubles (aligned packets). The frame part is the state kept between calls.
   Eigen::Matrix<double, 24, Eigen::Dynamic> m_table;
-  std::vector<char> m_has_frame;   ///< #T: m_table holds a frame of this triple
-  std::vector<char> m_degenerate;  ///< #T: degenerate at the last apply()
+  std::vector<char> m_has_frame;  ///< #T: m_table holds a frame of this triple
 };
 
 }  // namespace icd::coupling
