@@ -1,11 +1,10 @@
 #include "coupling/link_evaluator.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <limits>
-#include <numeric>
 #include <string>
 
 #include "mesh/io/error.hpp"
@@ -40,30 +39,30 @@ LinkEvaluator::LinkEvaluator(const RigidLinks& links, const LinkEvaluatorOptions
   validate(links, "LinkEvaluator");
   const int N = links.num_links();
   // Distinct ordered triples, numbered in order of first use (so that the
-  // link loop walks the triple table mostly forwards).
-  std::vector<int32_t> order(N);
-  std::iota(order.begin(), order.end(), 0);
-  const auto key = [&](int32_t k) {
-    return std::array<int32_t, 4>{links.nodes(k, 0), links.nodes(k, 1), links.nodes(k, 2), k};
-  };
-  std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return key(a) < key(b); });
-  m_link_triple.assign(N, -1);
-  for (int j = 0; j < N;) {  // one run of equal triples: all get the id of its first link
-    int end = j + 1;
-    while (end < N && links.nodes.row(order[end]) == links.nodes.row(order[j])) ++end;
-    for (int i = j; i < end; ++i) m_link_triple[order[i]] = order[j];
-    j = end;
-  }
-  std::vector<int32_t> id(N, -1);  // first link -> triple number
+  // link loop walks the triple table mostly forwards): an open-addressing
+  // hash table of triple numbers, at most half full.
+  size_t capacity = 16;
+  while (capacity < 2 * static_cast<size_t>(N)) capacity *= 2;
+  std::vector<int32_t> slot(capacity, -1);
+  m_link_triple.resize(N);
   for (int k = 0; k < N; ++k) {
-    int32_t& t = id[m_link_triple[k]];
-    if (t < 0) {
-      t = static_cast<int32_t>(m_links_per_triple.size());
-      m_links_per_triple.push_back(0);
-      for (int i = 0; i < 3; ++i) m_triple_nodes.push_back(links.nodes(k, i));
+    const int32_t* nodes = &links.nodes(k, 0);  // row-major: three consecutive ints
+    uint64_t h = 0;
+    for (int i = 0; i < 3; ++i)  // splitmix64-style mixing of the three indices
+      h = (h ^ static_cast<uint32_t>(nodes[i])) * 0x9E3779B97F4A7C15ull, h ^= h >> 29;
+    size_t at = h & (capacity - 1);
+    for (;; at = (at + 1) & (capacity - 1)) {
+      const int32_t t = slot[at];
+      if (t < 0) {  // a new triple
+        slot[at] = static_cast<int32_t>(m_links_per_triple.size());
+        m_links_per_triple.push_back(0);
+        m_triple_nodes.insert(m_triple_nodes.end(), nodes, nodes + 3);
+        break;
+      }
+      if (std::equal(nodes, nodes + 3, &m_triple_nodes[3 * static_cast<size_t>(t)])) break;
     }
-    m_link_triple[k] = t;
-    ++m_links_per_triple[t];
+    m_link_triple[k] = slot[at];
+    ++m_links_per_triple[slot[at]];
   }
   m_weights.resize(6, N);
   m_weights.topRows(3) = links.alpha.transpose();

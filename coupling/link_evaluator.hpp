@@ -1,15 +1,19 @@
 #pragma once
 /// Fast evaluation of the rigid links (paper section 3.2, Eqs. 1, 9, 10).
 ///
-/// Many dense vertices share the same ordered coarse node triple (q0, q1, q2).
-/// LinkEvaluator groups the links by triple once; each apply() then computes
-/// the deformed frame (e0, e1, e2) of Eqs. 4-6 once per unique triple and
-/// evaluates every link of the triple as a 3 x 6 matrix times its six stored
-/// numbers,
-///   p = [q0 q1 q2 | e0 e1 e2] (alpha_0, alpha_1, alpha_2, c_0, c_1, c_2)^T,
-/// in structure-of-arrays loops that the compiler vectorises. The arithmetic is
-/// the same, in the same order, as apply_reference(), so results agree with it
-/// to rounding (bit for bit when the compiler contracts no multiply-adds).
+/// Many dense vertices share the same ordered coarse node triple (q0, q1, q2)
+/// (measured: 5.0 links per triple on the bunny bundle, 2.1 on the dragon).
+/// LinkEvaluator numbers the distinct triples once; each apply() then
+///   1. gathers each triple's nodes into a per-triple table and computes its
+///      deformed frame (e0, e1, e2) of Eqs. 4-6 on two triples at a time
+///      (SSE2 packets through Eigen, square roots included; one division per
+///      triple: 1/|a| = 1/(|u| |n|), 1/|n| = |u|/|a|, 1/|u| = |n|/|a|);
+///   2. evaluates every link, in dense-vertex order, as the triple's 3 x 6
+///      matrix times the link's six stored numbers,
+///        p = [q0 q1 q2 | e0 e1 e2] (alpha_0, alpha_1, alpha_2, c_0, c_1, c_2)^T,
+///      summed in the order of apply_reference(), on (x, y, z, pad) packets.
+/// Results equal apply_reference() to rounding (measured <= 2e-16 relative;
+/// the reciprocals above are the only difference).
 ///
 /// Degenerate frames. When the deformed triangle (q0, q1, q2) is degenerate
 /// (|n| <= degenerate_tolerance * |q1 - q0| * |q2 - q0|: collinear or
@@ -55,10 +59,10 @@ struct LinkApplyResult {
 };
 
 /// The rigid links of one object, grouped by coarse node triple for fast
-/// per-frame evaluation. Build once per RigidLinks (cost O(N log N), memory
-/// about 60 bytes per link plus 220 per unique triple), then call apply()
-/// every frame. apply() allocates nothing. Not thread-safe: apply() updates
-/// the per-triple frame state used by the degenerate-frame fallback.
+/// per-frame evaluation. Build once per RigidLinks (a hash of the triples,
+/// O(N); memory 52 bytes per link plus ~210 per distinct triple), then call
+/// apply() every frame. apply() allocates nothing. Not thread-safe: apply()
+/// updates the per-triple frame state used by the degenerate-frame fallback.
 class LinkEvaluator {
  public:
   LinkEvaluator() = default;
