@@ -146,6 +146,7 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     }
     ++stats.active_pairs;
     stats.max_penetration = std::max(stats.max_penetration, delta);
+    stats.penalty_energy += 0.5 * k * delta * delta;
   };
   for (const NodePair& p : result.colliding) respond(p);
   if (options.use_untested)

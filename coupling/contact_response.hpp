@@ -54,6 +54,9 @@ struct ContactOptions {
 struct ContactStats {
   int active_pairs = 0;         ///< pairs with positive penetration
   double max_penetration = 0;   ///< largest delta (model units)
+  /// Energy stored in the penalty springs, sum of k delta^2 / 2 over the
+  /// active pairs (J when lengths are in m).
+  double penalty_energy = 0;
   Eigen::Vector3d total_force_a = Eigen::Vector3d::Zero();  ///< sum of forces on object a
   Eigen::Vector3d total_force_b = Eigen::Vector3d::Zero();  ///< sum of forces on object b
   /// Largest added stiffness on one coarse node (k times the node's share of

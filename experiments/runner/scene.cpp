@@ -225,6 +225,7 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.temporal_coherence = f.boolean("temporal_coherence", false);
   c.layered = f.boolean("layered", true);
   c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", true);
+  c.midpoint = f.boolean("midpoint", true);
   const std::string upd = f.string("sphere_update", "paper", {"paper", "conservative"});
   c.update.mode = upd == "paper" ? collision::SphereUpdateMode::PaperRatio
                                  : collision::SphereUpdateMode::DisplacementBound;

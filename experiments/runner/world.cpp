@@ -31,6 +31,16 @@ void enclose_children(collision::SphereTree& t) {
   }
 }
 
+// Kinetic + elastic + gravity potential (J). Not fem::Simulator::total_energy(),
+// which also counts -f_ext . x for the external (here: contact) forces: a
+// penalty force is not a constant load, and that term depends on the origin.
+double mechanical_energy(fem::Simulator& sim, const Eigen::Vector3d& gravity) {
+  const fem::Model& model = sim.model();
+  const MatX3d& x = sim.positions();
+  return model.kinetic_energy(sim.velocities()) + sim.model().elastic().energy(x) -
+         (x.transpose() * model.mass()).dot(gravity);
+}
+
 }  // namespace
 
 World::World(const Scene& scene, const std::filesystem::path& cache_dir,
@@ -117,7 +127,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       o.positions = o.sim->positions();
       m.substeps += rep.substeps;
       m.min_step = std::min(m.min_step, rep.step);
-      if (last) m.energy += o.sim->total_energy();
+      if (last) m.energy += mechanical_energy(*o.sim, m_scene.gravity);
     } else if (o.plan.kinematic) {
       o.positions.rowwise() += (h * o.spec.velocity).transpose();
     }
@@ -137,7 +147,14 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
   for (RuntimeObject& o : m_objects)
     if (o.plan.sphere_update)
     {
-      collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_scene.collision.update);
+      if (m_scene.collision.midpoint && o.sim && m_plan.response) {
+        // Midpoint sampling: the forces of this query act during the next
+        // cycle, so detect at the positions predicted for its middle.
+        o.predicted = o.positions + (0.5 * h) * o.sim->velocities();
+        collision::update_spheres(o.asset.spheres, o.rest, o.predicted, m_scene.collision.update);
+      } else {
+        collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_scene.collision.update);
+      }
       if (m_scene.collision.layered) enclose_children(o.asset.spheres);
     }
   m.times.sphere_update += seconds_since(t0);
@@ -196,6 +213,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
   if (m_plan.response) {
     for (RuntimeObject& o : m_objects) o.contact_forces.setZero();
     m_node_stiffness = 0;
+    m_penalty_energy = 0;
     for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
       const auto [i, j] = m_plan.pairs[p];
       RuntimeObject& a = m_objects[i];
@@ -217,6 +235,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
           a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : m_results[p], co,
           a.contact_forces, b.contact_forces);
       m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
+      m_penalty_energy += st.penalty_energy;
       m.max_penetration = std::max(m.max_penetration, st.max_penetration);
       if (last) {
         m.active_pairs += st.active_pairs;
@@ -225,6 +244,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     }
   }
   m.times.response += seconds_since(t0);
+  if (last) m.energy += m_penalty_energy;
 
 }
 
@@ -262,6 +282,7 @@ void World::restore(const Snapshot& s) {
   m_complete = s.complete;
   m_complete_time = s.complete_time;
   m_node_stiffness = s.node_stiffness;
+  m_penalty_energy = 0;  // the trial started contact-free
 }
 
 FrameMetrics World::step(double budget) {

@@ -45,7 +45,10 @@ struct FrameMetrics {
   int reused = 0;
   int substeps = 0;            ///< FEM sub-steps summed over objects
   double min_step = 0;         ///< smallest FEM step used, s
-  double energy = 0;           ///< total mechanical energy of the deformable objects, J
+  /// Mechanical energy of the deformable objects, J: kinetic + elastic +
+  /// gravity potential, plus the energy in the penalty springs of the last
+  /// response (contact forces are not counted as loads with a potential).
+  double energy = 0;
   int exact_contacts = -1;     ///< exact intersecting dense triangle pairs (-1: not computed)
 };
 
@@ -59,6 +62,7 @@ struct RuntimeObject {
   MatX3d rest;            ///< rest coarse positions, placed in the scene
   MatX3d contact_forces;  ///< forces from the last collision response (#V x 3)
   MatX3d dense;           ///< current dense positions (when the plan updates them)
+  MatX3d predicted;       ///< coarse positions half a cycle ahead (collision.midpoint)
   Eigen::VectorXd node_mass;  ///< lumped coarse node masses (kg); huge for objects without FEM
 };
 
@@ -123,6 +127,7 @@ class World {
   std::vector<double> m_complete_time;
   double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
   double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
+  double m_penalty_energy = 0;  ///< penalty spring energy of the last response, J
   Snapshot m_snapshot;          ///< reused storage for the single-cycle trial
   int m_frame = 0;
   double m_time = 0;
