@@ -72,9 +72,10 @@ class Model {
   /// health of x from the same element pass (ElasticForces::compute_with_health).
   void acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
                     Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr);
-  /// Kinetic energy 1/2 sum m |v|^2, J.
+  /// Kinetic energy 1/2 sum m |v|^2, J; not finite if any entry of v is not.
   double kinetic_energy(const Eigen::Ref<const MatX3d>& v) const;
-  /// Potential of the conservative loads: -sum (f_ext + m g) . x, J.
+  /// Potential of the conservative loads: -sum (f_ext + m g) . x over the free
+  /// nodes, J; not finite if any entry of x (fixed nodes included) is not.
   double load_potential(const Eigen::Ref<const MatX3d>& x) const;
 
  private:

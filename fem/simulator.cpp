@@ -119,7 +119,10 @@ std::string Simulator::integrate(double h, ElementHealth* start_health) {
 
 Simulator::Check Simulator::evaluate(const Check& before, const State& s, const ElementHealth& h) const {
   Check c;
-  if (!s.x.allFinite() || !s.v.allFinite()) {
+  c.kinetic = m_model.kinetic_energy(s.v);
+  c.load = m_model.load_potential(s.x);
+  // Every entry of x and v enters these sums (0 * NaN = NaN): finite sums, finite state.
+  if (!std::isfinite(c.kinetic) || !std::isfinite(c.load)) {
     const int n = m_model.num_nodes();
     for (int i = 0; i < n; ++i)
       if (!s.x.row(i).allFinite() || !s.v.row(i).allFinite()) {
@@ -129,6 +132,9 @@ Simulator::Check Simulator::evaluate(const Check& before, const State& s, const 
         c.message = os.str();
         return c;
       }
+    c.ok = false;
+    c.message = "the kinetic energy or the load potential overflows";
+    return c;
   }
   const bool allow_inversion =
       m_options.inversion == InversionPolicy::Allow ||
@@ -143,9 +149,7 @@ Simulator::Check Simulator::evaluate(const Check& before, const State& s, const 
     c.message = os.str();
     return c;
   }
-  c.kinetic = m_model.kinetic_energy(s.v);
   c.elastic = h.energy;
-  c.load = m_model.load_potential(s.x);
   const double growth = (c.kinetic + c.elastic) - (before.kinetic + before.elastic) + (c.load - before.load);
   const double allowed = m_options.max_energy_growth *
                              (before.kinetic + before.elastic + std::abs(c.load - before.load)) +
