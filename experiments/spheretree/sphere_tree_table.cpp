@@ -1,6 +1,6 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
-//                   [--worst-share F] [--coverage-spacing UNITS]
+//                   [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
                  " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-                 " [--worst-share F] [--coverage-spacing UNITS]\n";
+                 " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -91,6 +91,16 @@ int main(int argc, char** argv) {
     else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
     else if (key == "--octree") with_octree = std::atoi(value) != 0;
     else if (key == "--coverage-spacing") evaluation.coverage_spacing = std::atof(value);
+    else if (key == "--reduction") {
+      const std::string v = value;
+      if (v == "split") options.reduction = icd::mesh::ReductionMethod::split_lloyd;
+      else if (v == "merge") options.reduction = icd::mesh::ReductionMethod::merge_burst;
+      else if (v == "both") options.reduction = icd::mesh::ReductionMethod::best_of_both;
+      else {
+        std::cerr << "unknown reduction " << v << "\n";
+        return 2;
+      }
+    }
     else {
       std::cerr << "unknown option " << key << "\n";
       return 2;

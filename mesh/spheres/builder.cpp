@@ -1,6 +1,7 @@
 #include "mesh/spheres/builder.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -27,6 +28,8 @@ void check_options(const SphereTreeOptions& o) {
   if (o.refinement_iterations < 0) fail("refinement_iterations must be >= 0");
   if (!(o.refinement_tolerance > 0)) fail("refinement_tolerance must be > 0");
   if (o.lloyd_iterations < 0) fail("lloyd_iterations must be >= 0");
+  if (o.merge_burst_lloyd_iterations < 0) fail("merge_burst_lloyd_iterations must be >= 0");
+  if (o.exchange_rounds < 0) fail("exchange_rounds must be >= 0");
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
 }
@@ -46,6 +49,15 @@ struct ParentChoices {
     return sum;
   }
 };
+
+/// Worst error, then summed error: the order in which best_of_both compares configurations.
+bool better_config(const std::vector<FittedSphere>& a, const std::vector<FittedSphere>& b) {
+  double wa = 0, wb = 0;
+  for (const auto& s : a) wa = std::max(wa, s.error);
+  for (const auto& s : b) wb = std::max(wb, s.error);
+  if (wa != wb) return wa < wb;
+  return ParentChoices::total_error(a) < ParentChoices::total_error(b);
+}
 
 /// How many children each parent gets under a total cap: start with one
 /// each; give the first (1 - worst_share) of the extra spheres, one at a time,
@@ -167,6 +179,50 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
   }
 }
 
+/// Boundary exchange across the whole leaf level: a sample may move to a leaf
+/// whose ancestors all cover it with margin; then every inner node's samples
+/// become the union of its children's and its radius is refitted (it can only
+/// shrink: its samples were all covered by it).
+void exchange_across_leaves(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
+                            const std::vector<std::vector<int>>& parent_of, int rounds) {
+  const size_t last = levels.size() - 1;
+  std::vector<FittedSphere> leaves;
+  for (const Node& n : levels[last]) leaves.push_back(n.sphere);
+  auto covers = [&](const FittedSphere& sp, int s) {
+    return (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s] <= sp.radius;
+  };
+  auto accepts = [&](int leaf, int s) {
+    int node = leaf;
+    for (size_t l = last; l >= 1; --l) {
+      node = parent_of[l][static_cast<size_t>(node)];
+      if (!covers(levels[l - 1][static_cast<size_t>(node)].sphere, s)) return false;
+    }
+    return true;
+  };
+  ExchangeOptions exchange;
+  exchange.rounds = rounds;
+  shrink_by_exchange(dense, leaves, exchange, accepts);
+  for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
+  for (size_t l = last; l >= 1; --l) {
+    std::vector<std::vector<int>> unions(levels[l - 1].size());
+    for (size_t i = 0; i < levels[l].size(); ++i) {
+      const auto& m = levels[l][i].sphere.members;
+      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
+      u.insert(u.end(), m.begin(), m.end());
+    }
+    for (size_t p = 0; p < unions.size(); ++p) {
+      FittedSphere& sp = levels[l - 1][p].sphere;
+      std::sort(unions[p].begin(), unions[p].end());
+      sp.members = std::move(unions[p]);
+      double r = 0;
+      for (int s : sp.members) r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
+      assert(r <= sp.radius);
+      sp.radius = r;
+      sp.error = r - sp.depth;
+    }
+  }
+}
+
 }  // namespace
 
 SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOptions& options) {
@@ -199,6 +255,27 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   ReductionOptions reduction;
   reduction.lloyd_iterations = options.lloyd_iterations;
   reduction.deadline = deadline;
+  MergeBurstOptions merge_burst;
+  merge_burst.neighbour_radius = 1.5 * options.medial_spacing * scale;
+  merge_burst.lloyd_iterations = options.merge_burst_lloyd_iterations;
+  std::vector<int> owners;
+  if (options.reduction != ReductionMethod::split_lloyd) {
+    owners = medial_owners(coarse, options.medial_spacing * scale);
+  }
+  auto reduce = [&](const std::vector<int>& members) {
+    if (options.reduction == ReductionMethod::split_lloyd) {
+      return reduce_to_spheres(coarse, members, options.branching, reduction);
+    }
+    std::vector<std::vector<FittedSphere>> mb =
+        merge_burst_reduce(coarse, owners, members, options.branching, reduction, merge_burst);
+    if (options.reduction == ReductionMethod::best_of_both) {
+      const auto split = reduce_to_spheres(coarse, members, options.branching, reduction);
+      for (size_t k = 0; k < mb.size(); ++k) {
+        if (better_config(split[k], mb[k])) mb[k] = split[k];
+      }
+    }
+    return mb;
+  };
 
   // Root.
   Node root;
@@ -221,7 +298,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     const std::vector<Node>& parents = levels.back();
     std::vector<ParentChoices> choices(parents.size());
     for (size_t p = 0; p < parents.size(); ++p) {
-      choices[p].configs = reduce_to_spheres(coarse, parents[p].medial, options.branching, reduction);
+      choices[p].configs = reduce(parents[p].medial);
     }
     long long cap = 1;
     for (int i = 0; i < l; ++i) cap *= options.branching;
@@ -246,6 +323,13 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       assign_and_refit(dense, parents[p].sphere.members, fitted);
       for (auto& f : fitted) polish_sphere(dense, oracle, f);
       assign_and_refit(dense, parents[p].sphere.members, fitted);
+      ExchangeOptions exchange;
+      exchange.rounds = 2;
+      for (int round = 0; round < options.exchange_rounds; ++round) {
+        shrink_by_exchange(dense, fitted, exchange);
+        for (auto& f : fitted) polish_sphere(dense, oracle, f);
+      }
+      if (options.exchange_rounds > 0) shrink_by_exchange(dense, fitted, exchange);
       for (auto& f : fitted) {
         Node n;
         n.sphere = std::move(f);
@@ -261,6 +345,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   if (options.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
   }
+  if (options.leaf_exchange && levels.size() > 1) exchange_across_leaves(dense, levels, parent_of, 3);
 
   // Flatten breadth-first: level by level, children of a node contiguous.
   collision::SphereTree& tree = out.tree;

@@ -5,10 +5,19 @@
 
 #include "collision/sphere_tree.hpp"
 #include "mesh/io/types.hpp"
+#include "mesh/spheres/exchange.hpp"
+#include "mesh/spheres/merge_burst.hpp"
 #include "mesh/spheres/reduction.hpp"
 #include "mesh/spheres/surface_sampling.hpp"
 
 namespace icd::mesh {
+
+/// How the medial spheres of a node are reduced to its children.
+enum class ReductionMethod {
+  split_lloyd,   ///< greedy splitting + Lloyd rounds (reduce_to_spheres)
+  merge_burst,   ///< merge/burst from the medial set + Lloyd rounds (merge_burst_reduce)
+  best_of_both,  ///< both; for each child count the configuration with the lower worst error
+};
 
 /// Options of build_sphere_tree(). Lengths are fractions of the longest side
 /// of the model's axis-aligned bounding box (so 0.001 is 2 units when that
@@ -38,6 +47,16 @@ struct SphereTreeOptions {
   int refinement_iterations = 2;          ///< adaptive medial-axis rounds (>= 0)
   double refinement_tolerance = 0.002;    ///< medial sphere error that triggers refinement (relative)
   int lloyd_iterations = 8;               ///< see ReductionOptions
+  ReductionMethod reduction = ReductionMethod::best_of_both;  ///< see ReductionMethod
+  int merge_burst_lloyd_iterations = 4;   ///< see MergeBurstOptions::lloyd_iterations
+  /// Rounds of boundary exchange among the children of each node, each
+  /// followed by a centre polish (see shrink_by_exchange, polish_sphere; >= 0).
+  int exchange_rounds = 2;
+  /// After the top-down pass, let the leaves exchange boundary samples across
+  /// parents too (a sample may move to a leaf of another parent when that
+  /// leaf and all its ancestors already cover it); inner nodes then shrink to
+  /// the union of their children's samples. No radius grows.
+  bool leaf_exchange = true;
   /// After the top-down pass, optimise the leaves jointly (a leaf may take
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.

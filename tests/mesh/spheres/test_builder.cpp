@@ -32,22 +32,30 @@ std::vector<Case> cases() {
           {"torus", icd::make_torus(1.0, 0.3, 24, 12)}};
 }
 
-SphereTreeOptions small_options();
+SphereTreeOptions small_options(ReductionMethod method = SphereTreeOptions{}.reduction);
+
+/// The reduction methods every tree-level guarantee is checked for.
+const std::vector<std::pair<std::string, ReductionMethod>> kMethods = {
+    {"split_lloyd", ReductionMethod::split_lloyd},
+    {"merge_burst", ReductionMethod::merge_burst},
+    {"best_of_both", ReductionMethod::best_of_both}};
 
 /// The builds of cases(), made once per test program (each takes seconds).
-const SphereTreeBuild& cached_build(const Case& c) {
-  static std::map<std::string, SphereTreeBuild> builds;
-  auto it = builds.find(c.name);
-  if (it == builds.end()) it = builds.emplace(c.name, build_sphere_tree(c.mesh, small_options())).first;
+const SphereTreeBuild& cached_build(const Case& c, ReductionMethod method = SphereTreeOptions{}.reduction) {
+  static std::map<std::pair<std::string, ReductionMethod>, SphereTreeBuild> builds;
+  const auto key = std::make_pair(c.name, method);
+  auto it = builds.find(key);
+  if (it == builds.end()) it = builds.emplace(key, build_sphere_tree(c.mesh, small_options(method))).first;
   return it->second;
 }
 
-SphereTreeOptions small_options() {
+SphereTreeOptions small_options(ReductionMethod method) {
   SphereTreeOptions o;
   o.branching = 4;
   o.depth = 2;
   o.cover_spacing = 1.0 / 80;
   o.medial_spacing = 1.0 / 20;
+  o.reduction = method;
   return o;
 }
 
@@ -104,9 +112,10 @@ TEST(SphereTreeBuilder, LayoutIsBreadthFirstWithContiguousChildren) {
 }
 
 TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem) {
+  for (const auto& [method_name, method] : kMethods)
   for (const auto& c : cases()) {
-    SCOPED_TRACE(c.name);
-    const SphereTreeBuild& build = cached_build(c);
+    SCOPED_TRACE(c.name + " " + method_name);
+    const SphereTreeBuild& build = cached_build(c, method);
     const auto& tree = build.tree;
     const auto& P = build.samples.points;
     ASSERT_EQ(static_cast<int>(build.node_samples.size()), tree.num_nodes());
@@ -130,9 +139,10 @@ TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem
 }
 
 TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
+  for (const auto& [method_name, method] : kMethods)
   for (const auto& c : cases()) {
-    SCOPED_TRACE(c.name);
-    const SphereTreeBuild& build = cached_build(c);
+    SCOPED_TRACE(c.name + " " + method_name);
+    const SphereTreeBuild& build = cached_build(c, method);
     const auto& tree = build.tree;
     const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
     for (int l = 0; l < tree.num_levels(); ++l) {
@@ -152,9 +162,10 @@ TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
 TEST(SphereTreeBuilder, ErrorDecreasesFromLevelToLevel) {
   EvaluationOptions eval;
   eval.coverage_spacing = 10.0;
+  for (const auto& [method_name, method] : kMethods)
   for (const auto& c : cases()) {
-    SCOPED_TRACE(c.name);
-    const SphereTreeBuild& build = cached_build(c);
+    SCOPED_TRACE(c.name + " " + method_name);
+    const SphereTreeBuild& build = cached_build(c, method);
     const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
     ASSERT_EQ(metrics.size(), 3u);
     for (size_t l = 1; l < metrics.size(); ++l) {

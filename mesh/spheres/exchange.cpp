@@ -1,0 +1,82 @@
+#include "mesh/spheres/exchange.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+
+#include "mesh/io/error.hpp"
+
+namespace icd::mesh {
+
+int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere>& spheres,
+                       const ExchangeOptions& options, const std::function<bool(int, int)>& accepts) {
+  if (options.rounds < 0 || options.max_moves_per_sphere < 1) {
+    throw ParameterError("ExchangeOptions: rounds must be >= 0 and max_moves_per_sphere >= 1");
+  }
+  const int n = static_cast<int>(spheres.size());
+  auto reach = [&](int s, const FittedSphere& sp) {
+    return (problem.points.row(s).transpose() - sp.center).norm() + problem.gap[s];
+  };
+  int moved_total = 0;
+  for (int round = 0; round < options.rounds; ++round) {
+    // Spheres that overlap (only they can hold a sample of each other).
+    std::vector<std::vector<int>> overlapping(static_cast<size_t>(n));
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) {
+        const auto& A = spheres[static_cast<size_t>(a)];
+        const auto& B = spheres[static_cast<size_t>(b)];
+        if (a != b && (A.center - B.center).norm() <= A.radius + B.radius) overlapping[static_cast<size_t>(a)].push_back(b);
+      }
+    }
+    std::vector<int> order(static_cast<size_t>(n));
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return spheres[static_cast<size_t>(a)].error > spheres[static_cast<size_t>(b)].error;
+    });
+    int moved_round = 0;
+    for (int j : order) {
+      FittedSphere& sp = spheres[static_cast<size_t>(j)];
+      // Samples received earlier in this pass were appended: restore the order.
+      std::sort(sp.members.begin(), sp.members.end());
+      if (sp.members.size() <= 1) continue;
+      // Members farthest first.
+      std::vector<std::pair<double, int>> by_reach;
+      by_reach.reserve(sp.members.size());
+      for (int s : sp.members) by_reach.emplace_back(reach(s, sp), s);
+      std::sort(by_reach.begin(), by_reach.end(), [](const auto& x, const auto& y) {
+        return x.first != y.first ? x.first > y.first : x.second < y.second;
+      });
+      std::vector<int> leaving;
+      size_t i = 0;
+      for (; i + 1 < by_reach.size() && static_cast<int>(i) < options.max_moves_per_sphere; ++i) {
+        const int s = by_reach[i].second;
+        int receiver = -1;
+        for (int k : overlapping[static_cast<size_t>(j)]) {
+          const FittedSphere& other = spheres[static_cast<size_t>(k)];
+          if (reach(s, other) <= other.radius && (!accepts || accepts(k, s))) {
+            receiver = k;
+            break;
+          }
+        }
+        if (receiver < 0) break;
+        leaving.push_back(s);
+        spheres[static_cast<size_t>(receiver)].members.push_back(s);  // covered: its radius stands
+      }
+      if (leaving.empty()) continue;
+      std::sort(leaving.begin(), leaving.end());
+      std::vector<int> kept;
+      std::set_difference(sp.members.begin(), sp.members.end(), leaving.begin(), leaving.end(),
+                          std::back_inserter(kept));
+      sp.members = std::move(kept);
+      sp.radius = by_reach[i].first;  // the farthest member that stays
+      sp.error = sp.radius - sp.depth;
+      moved_round += static_cast<int>(leaving.size());
+    }
+    for (auto& other : spheres) std::sort(other.members.begin(), other.members.end());
+    moved_total += moved_round;
+    if (moved_round == 0) break;
+  }
+  return moved_total;
+}
+
+}  // namespace icd::mesh
