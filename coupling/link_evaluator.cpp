@@ -48,8 +48,10 @@ LinkEvaluator::LinkEvaluator(const RigidLinks& links, const LinkEvaluatorOptions
   for (int k = 0; k < N; ++k) {
     const int32_t* nodes = &links.nodes(k, 0);  // row-major: three consecutive ints
     uint64_t h = 0;
-    for (int i = 0; i < 3; ++i)  // splitmix64-style mixing of the three indices
-      h = (h ^ static_cast<uint32_t>(nodes[i])) * 0x9E3779B97F4A7C15ull, h ^= h >> 29;
+    for (int i = 0; i < 3; ++i) {  // multiply-xorshift mixing of the three indices
+      h = (h ^ static_cast<uint32_t>(nodes[i])) * 0x9E3779B97F4A7C15ull;
+      h ^= h >> 29;
+    }
     size_t at = h & (capacity - 1);
     for (;; at = (at + 1) & (capacity - 1)) {
       const int32_t t = slot[at];
@@ -173,7 +175,7 @@ void LinkEvaluator::fallback_frame(int t) {
   Vec e0, e1, e2;
   const Vec d = sub(q0, q1);
   const double dd = dot(d, d);
-  if (dd > 0.0) {
+  if (dd > 0.0 && dd < std::numeric_limits<double>::infinity()) {
     const double len = std::sqrt(dd);
     e1 = {d.x / len, d.y / len, d.z / len};
     Vec cand;

@@ -27,8 +27,8 @@
 ///     evaluator), or, before any, the frame of the first non-degenerate
 ///     apply; a triple never seen non-degenerate uses the coordinate axis
 ///     least aligned with e1.
-///   - if q0 == q1: the previous frame is kept unchanged (the identity frame
-///     if there is none).
+///   - if q0 == q1 (or |q0 - q1|^2 overflows): the previous frame is kept
+///     unchanged (the identity frame if there is none).
 /// The number of degenerate triples and of links they carry is returned, so a
 /// caller's health check can react.
 #include <cstdint>

@@ -277,6 +277,18 @@ TEST(LinkEvaluator, NearDegenerateSweepStaysFinite) {
   }
 }
 
+// Coordinates so large that |n|^2 and |u|^2 overflow: not an error (the nodes
+// are finite), every frame degenerate, the output finite.
+TEST(LinkEvaluator, OverflowingFramesStayFinite) {
+  const Object o = make_object(1);
+  LinkEvaluator ev(o.links);
+  MatX3d out(o.dense.V.rows(), 3);
+  const MatX3d X = 1e160 * o.coarse.V;
+  const LinkApplyResult r = ev.apply(X, out);
+  EXPECT_EQ(r.degenerate_triples, ev.num_triples());
+  EXPECT_TRUE(out.allFinite());
+}
+
 TEST(LinkEvaluator, RejectsBadInput) {
   const Object o = make_object(1);
   LinkEvaluator ev(o.links);
