@@ -1,18 +1,26 @@
 // Google Benchmark of the FEM kernels: internal-force evaluation per material
-// and one step per integrator, on ~1k, ~4k and ~30k-tet structured bars.
+// and one step per integrator, on ~1k, ~4k and ~30k-tet structured bars and
+// on the coarse tet meshes of the pipeline's asset bundles (bunny, dragon;
+// nodes reordered by reverse Cuthill-McKee), plus the force evaluation with
+// the fused health check, the separate health pass and the force differential
+// (the Lanczos product) on the ~4k-tet bar.
 // Reported as time per tet (counter "per_tet", seconds; shown with an SI
 // prefix, e.g. 30n = 30 ns/tet). Single thread unless the name says threads:2.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <numeric>
 #include <random>
+#include <string>
 
 #include "fem/backward_euler.hpp"
 #include "fem/reorder.hpp"
 #include "fem/simulator.hpp"
 #include "fem/stable_step.hpp"
+#include "icd/config.hpp"
 #include "mesh/io/primitives.hpp"
+#include "mesh/io/vtu_reader.hpp"
 
 namespace {
 
@@ -134,6 +142,70 @@ void BM_ForcesOrdering(benchmark::State& state) {
   state.counters["bandwidth"] = node_bandwidth(m.T);
 }
 BENCHMARK(BM_ForcesOrdering)->DenseRange(0, 2)->ArgName("order")->MinTime(0.2);
+
+// The coarse tet mesh of the asset bundle whose folder name starts with
+// `prefix` under <source>/assets (written by icd-preprocess); empty if none.
+TetMesh asset_coarse_mesh(const std::string& prefix) {
+  const std::filesystem::path dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const auto file = entry.path() / "coarse_tets.vtu";
+    if (name.rfind(prefix, 0) == 0 && std::filesystem::exists(file)) return read_vtu_tet_mesh(file);
+  }
+  return {};
+}
+
+// Args: model, asset (0 bunny, 1 dragon). A mildly deformed state as BM_Forces.
+void BM_ForcesAsset(benchmark::State& state) {
+  const char* prefix = state.range(1) == 0 ? "bunny00-" : "ChineseDragon-10kv-";
+  const TetMesh raw = asset_coarse_mesh(prefix);
+  if (raw.T.rows() == 0) {
+    state.SkipWithError("no coarse_tets.vtu under assets/ (run icd-preprocess)");
+    return;
+  }
+  const ReorderedMesh m = reorder_for_locality(raw.V, raw.T);
+  ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(state.range(0))));
+  const double size = (m.V.colwise().maxCoeff() - m.V.colwise().minCoeff()).maxCoeff();
+  MatX3d x = m.V;
+  for (int i = 0; i < x.rows(); ++i)
+    x(i, 2) += 0.05 * x(i, 0) * x(i, 0) / size + 0.001 * size * std::sin(37.0 * i);
+  MatX3d f(x.rows(), 3);
+  for (auto _ : state) {
+    forces.compute(x, f);
+    benchmark::DoNotOptimize(f.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel(std::string(prefix) + " " + to_string(forces.material().model));
+  set_per_tet(state, m.T.rows());
+  state.counters["bandwidth"] = node_bandwidth(m.T);
+}
+BENCHMARK(BM_ForcesAsset)->ArgsProduct({{0, 1, 2, 3}, {0, 1}})->ArgNames({"model", "asset"})->MinTime(0.2);
+
+// Args: kind (0 compute, 1 compute_with_health, 2 health, 3 differential), model; the ~4k-tet bar.
+void BM_Kernels(benchmark::State& state) {
+  const int kind = static_cast<int>(state.range(0));
+  const TetMesh m = bar(1);
+  ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(state.range(1))));
+  MatX3d x = m.V;
+  for (int i = 0; i < x.rows(); ++i) x(i, 2) += 0.05 * x(i, 0) * x(i, 0) + 0.001 * std::sin(37.0 * i);
+  const MatX3d dx = MatX3d::Constant(x.rows(), 3, 1e-3);
+  MatX3d f(x.rows(), 3);
+  for (auto _ : state) {
+    switch (kind) {
+      case 0: forces.compute(x, f); break;
+      case 1: benchmark::DoNotOptimize(forces.compute_with_health(x, f)); break;
+      case 2: benchmark::DoNotOptimize(forces.health(x)); break;
+      case 3: forces.differential(x, dx, f); break;
+    }
+    benchmark::DoNotOptimize(f.data());
+    benchmark::ClobberMemory();
+  }
+  const char* names[4] = {"forces", "forces + health", "health", "differential"};
+  state.SetLabel(std::string(names[kind]) + " " + to_string(forces.material().model));
+  set_per_tet(state, m.T.rows());
+}
+BENCHMARK(BM_Kernels)->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2, 3}})->ArgNames({"kind", "model"})->MinTime(0.2);
 
 // Single thread: rates from CPU time (robust on a shared machine).
 BENCHMARK(BM_Forces)
