@@ -36,14 +36,16 @@ def main(path):
           f"load average {', '.join(f'{x:.1f}' for x in ctx.get('load_avg', []))}; "
           f"{reps} repetitions, medians (ns per dense vertex, CPU time).\n")
     print("| object | dense vertices | distinct triples | " +
-          " | ".join(MAPPINGS) + " | reference / evaluator | evaluator / barycentric |")
-    print("|---" * (5 + len(MAPPINGS)) + "|")
+          " | ".join(MAPPINGS) + " | reference / evaluator | evaluator / barycentric | evaluator min-max |")
+    print("|---" * (6 + len(MAPPINGS)) + "|")
     for o in objects:
         row = [o, str(info[o]["dense_vertices"]), str(info[o].get("triples", "?"))]
         row += [f"{median[(m, o)]:.2f}" if (m, o) in median else "-" for m in MAPPINGS]
         ev = median.get(("evaluator", o))
         row.append(f"{median[('reference', o)] / ev:.2f}" if ev else "-")
         row.append(f"{ev / median[('barycentric', o)]:.2f}" if ev else "-")
+        ev_samples = samples.get(("evaluator", o), [])
+        row.append(f"{min(ev_samples):.2f}-{max(ev_samples):.2f}" if ev_samples else "-")
         print("| " + " | ".join(row) + " |")
 
 
