@@ -10,7 +10,11 @@
 // first window.
 // usage: soak [--frames N=100000] [--every K=1000] [--budget-tests B=2000]
 //             [--scene FILE] [--speed V=1] [--energy-factor F=1.5]
-//             [--max-growth-mb M=16] [--csv FILE]
+//             [--max-growth-mb M=16] [--relaunch K=0] [--csv FILE]
+// --relaunch K: every K frames, give each deformable object its initial
+// speed again (keeping its deformation), aimed at the centroid of the other
+// objects: objects that bounced apart come back, so a two-object scene such
+// as bunny-dragon collides again and again.
 #include <unistd.h>
 
 #include <algorithm>
@@ -45,6 +49,7 @@ struct Args {
   double speed = 1.0;
   double energy_factor = 1.5;
   double max_growth_mb = 16;
+  int relaunch = 0;
   std::string csv;
 };
 
@@ -65,12 +70,32 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--energy-factor") a.energy_factor = std::atof(v);
     else if (k == "--max-growth-mb") a.max_growth_mb = std::atof(v);
     else if (k == "--csv") a.csv = v;
+    else if (k == "--relaunch") a.relaunch = std::max(0, std::atoi(v));
     else {
       std::fprintf(stderr, "soak: unknown argument %s\n", k.c_str());
       std::exit(2);
     }
   }
   return a;
+}
+
+// Each deformable object gets its initial speed towards the centroid of the others.
+void relaunch(icd::runner::World& world) {
+  auto& objects = world.objects();
+  if (objects.size() < 2) return;
+  for (size_t i = 0; i < objects.size(); ++i) {
+    icd::runner::RuntimeObject& o = objects[i];
+    if (!o.sim) continue;
+    Eigen::Vector3d target = Eigen::Vector3d::Zero();
+    for (size_t j = 0; j < objects.size(); ++j)
+      if (j != i) target += objects[j].positions.colwise().mean().transpose();
+    target /= static_cast<double>(objects.size() - 1);
+    const Eigen::Vector3d d = target - o.positions.colwise().mean().transpose();
+    if (d.norm() <= 0) continue;
+    icd::MatX3d v(o.positions.rows(), 3);
+    v.rowwise() = (o.spec.velocity.norm() / d.norm() * d).transpose();
+    o.sim->set_velocities(v);  // zero at fixed nodes
+  }
 }
 
 }  // namespace
@@ -101,6 +126,7 @@ int main(int argc, char** argv) {
     auto t_window = std::chrono::steady_clock::now();
     const auto t_start = t_window;
     for (int f = 0; f < a.frames; ++f) {
+      if (a.relaunch > 0 && f > 0 && f % a.relaunch == 0) relaunch(world);
       const runner::FrameMetrics m = world.step();
       if (e0 < 0) e0 = m.energy;
       bool finite = std::isfinite(m.energy);
