@@ -22,11 +22,11 @@
 /// (e2 = e0 x e1), so every link keeps its length |c| (no NaN, no collapse):
 ///   - if q0 != q1: e1 = (q0 - q1) / |q0 - q1| as usual; e0 is the previous
 ///     frame's e0 (or, if that is nearly parallel to e1, its e2) made
-///     orthogonal to e1 and normalised; e2 = e0 x e1. The "previous frame" is
-///     the frame this triple had at the last apply() (the state kept by the
-///     evaluator), or, before any, the frame of the first non-degenerate
-///     apply; a triple never seen non-degenerate uses the coordinate axis
-///     least aligned with e1.
+///     orthogonal to e1 and normalised; e2 = e0 x e1. The previous frame is
+///     the one this triple got at its last apply(), regular or fallback (the
+///     state kept by the evaluator); a triple without one (degenerate at its
+///     first apply(), or after reset_frames()) starts from the coordinate
+///     axis least aligned with e1.
 ///   - if q0 == q1 (or |q0 - q1|^2 overflows): the previous frame is kept
 ///     unchanged (the identity frame if there is none).
 /// The number of degenerate triples and of links they carry is returned, so a
@@ -73,7 +73,7 @@ class LinkEvaluator {
 
   /// Evaluates every link (Eqs. 1, 9, 10) for the current coarse positions
   /// (#M x 3, M == num_coarse_nodes()) into dense_out (#N x 3, N ==
-  /// num_links(), resized by nobody: must already have N rows). Equal to
+  /// num_links(); not resized, must already have N rows). Equal to
   /// apply_reference() to rounding wherever no frame is degenerate; see the file
   /// comment for degenerate frames. Throws ParameterError on a size mismatch,
   /// NumericalError naming the node when a linked coarse node is not finite

@@ -72,7 +72,7 @@ RigidLinks build_rigid_links(const Eigen::Ref<const MatX3d>& P,
 /// with the frame of the current coarse positions (#M x 3, M ==
 /// links.num_coarse_nodes). dense_out must already have links.num_links() rows.
 /// Convenience wrapper: builds a LinkEvaluator on the fly (hashes the node
-/// triples and allocates ~60 bytes per link; measured 25-40 ns per dense vertex
+/// triples and allocates ~70 bytes per link; measured 25-40 ns per dense vertex
 /// in all, about the cost of apply_reference(), where a kept evaluator costs
 /// 8-17 ns), so code that evaluates the same links every frame should keep a
 /// LinkEvaluator (coupling/link_evaluator.hpp) instead. Degenerate frames use
@@ -84,8 +84,9 @@ void apply(const RigidLinks& links, const Eigen::Ref<const MatX3d>& coarse_posit
 
 /// The original one-link-at-a-time evaluation (Eigen 3-vectors, the frame
 /// recomputed for every link), kept as the reference that LinkEvaluator is
-/// tested and benchmarked against. Same contract as apply() except for
-/// degenerate frames: an axis whose defining vector is exactly zero stays zero
+/// tested and benchmarked against. Same contract as apply() except that the
+/// links are not validated and for degenerate frames: an axis whose defining
+/// vector is exactly zero stays zero
 /// (Eigen's normalized()), so exactly collinear nodes drop the e0 and e2 terms
 /// and coincident q0 == q1 collapse the vertex onto O; non-finite coarse
 /// positions give non-finite output without an exception. No allocation.
