@@ -47,7 +47,7 @@ struct SphereTreeOptions {
   int refinement_iterations = 2;          ///< adaptive medial-axis rounds (>= 0)
   double refinement_tolerance = 0.002;    ///< medial sphere error that triggers refinement (relative)
   int lloyd_iterations = 8;               ///< see ReductionOptions
-  ReductionMethod reduction = ReductionMethod::best_of_both;  ///< see ReductionMethod
+  ReductionMethod reduction = ReductionMethod::split_lloyd;  ///< see ReductionMethod (split_lloyd measured best)
   int merge_burst_lloyd_iterations = 4;   ///< see MergeBurstOptions::lloyd_iterations
   /// Rounds of boundary exchange among the children of each node, each
   /// followed by a centre polish (see shrink_by_exchange, polish_sphere; >= 0).

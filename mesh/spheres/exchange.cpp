@@ -37,19 +37,16 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
     for (int j : order) {
       FittedSphere& sp = spheres[static_cast<size_t>(j)];
       // Samples received earlier in this pass were appended: restore the order.
-      std::sort(sp.members.begin(), sp.members.end());
+      if (!std::is_sorted(sp.members.begin(), sp.members.end())) std::sort(sp.members.begin(), sp.members.end());
       if (sp.members.size() <= 1) continue;
-      // Members farthest first.
-      std::vector<std::pair<double, int>> by_reach;
-      by_reach.reserve(sp.members.size());
-      for (int s : sp.members) by_reach.emplace_back(reach(s, sp), s);
-      std::sort(by_reach.begin(), by_reach.end(), [](const auto& x, const auto& y) {
-        return x.first != y.first ? x.first > y.first : x.second < y.second;
-      });
+      // Members farthest first, popped lazily from a heap (most never leave).
+      std::vector<std::pair<double, int>> heap;
+      heap.reserve(sp.members.size());
+      for (int s : sp.members) heap.emplace_back(reach(s, sp), -s);  // ties: smaller index first
+      std::make_heap(heap.begin(), heap.end());
       std::vector<int> leaving;
-      size_t i = 0;
-      for (; i + 1 < by_reach.size() && static_cast<int>(i) < options.max_moves_per_sphere; ++i) {
-        const int s = by_reach[i].second;
+      while (heap.size() > 1 && static_cast<int>(leaving.size()) < options.max_moves_per_sphere) {
+        const int s = -heap.front().second;
         int receiver = -1;
         for (int k : overlapping[static_cast<size_t>(j)]) {
           const FittedSphere& other = spheres[static_cast<size_t>(k)];
@@ -61,18 +58,23 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
         if (receiver < 0) break;
         leaving.push_back(s);
         spheres[static_cast<size_t>(receiver)].members.push_back(s);  // covered: its radius stands
+        std::pop_heap(heap.begin(), heap.end());
+        heap.pop_back();
       }
+      const double farthest_kept = heap.front().first;
       if (leaving.empty()) continue;
       std::sort(leaving.begin(), leaving.end());
       std::vector<int> kept;
       std::set_difference(sp.members.begin(), sp.members.end(), leaving.begin(), leaving.end(),
                           std::back_inserter(kept));
       sp.members = std::move(kept);
-      sp.radius = by_reach[i].first;  // the farthest member that stays
+      sp.radius = farthest_kept;
       sp.error = sp.radius - sp.depth;
       moved_round += static_cast<int>(leaving.size());
     }
-    for (auto& other : spheres) std::sort(other.members.begin(), other.members.end());
+    for (auto& other : spheres) {
+      if (!std::is_sorted(other.members.begin(), other.members.end())) std::sort(other.members.begin(), other.members.end());
+    }
     moved_total += moved_round;
     if (moved_round == 0) break;
   }

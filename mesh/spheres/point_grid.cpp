@@ -14,9 +14,11 @@ PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_ce
     throw ParameterError("PointGrid: cell_size must be positive and finite, got " + std::to_string(cell_size));
   }
   m_points.resize(static_cast<size_t>(P.rows()));
+  m_point_cells.resize(static_cast<size_t>(P.rows()));
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     m_points[static_cast<size_t>(i)] = P.row(i);
     const Eigen::Vector3i c = cell_of(m_points[static_cast<size_t>(i)]);
+    m_point_cells[static_cast<size_t>(i)] = c;
     if (i == 0) {
       m_min_cell = m_max_cell = c;
     } else {
@@ -48,7 +50,7 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
         auto it = m_cells.find(key(i, j, k));
         if (it == m_cells.end()) continue;
         for (int idx : it->second) {
-          const Eigen::Vector3i c = cell_of(m_points[static_cast<size_t>(idx)]);
+          const Eigen::Vector3i& c = m_point_cells[static_cast<size_t>(idx)];
           if (c.x() != i || c.y() != j || c.z() != k) continue;  // hash collision
           if ((m_points[static_cast<size_t>(idx)] - center).squaredNorm() <= r2) out.push_back(idx);
         }

@@ -31,6 +31,7 @@ class PointGrid {
 
   double m_cell;
   std::vector<Eigen::Vector3d> m_points;
+  std::vector<Eigen::Vector3i> m_point_cells;  // cell of each point (hash-collision check)
   std::unordered_map<long long, std::vector<int>> m_cells;
   Eigen::Vector3i m_min_cell{0, 0, 0}, m_max_cell{0, 0, 0};
 };

@@ -6,10 +6,13 @@
 #include <limits>
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/convex_hull_3.h>
 
 #include "mesh/io/error.hpp"
+#include "mesh/io/primitives.hpp"
 
 namespace icd::mesh {
 namespace {
@@ -19,13 +22,77 @@ using Point = Kernel::Point_3;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+/// Drops the members strictly inside the convex hull of their extreme
+/// points along 42 directions (Akl-Toussaint prefilter): those are no hull
+/// vertices. The small hull's facets are found by brute force over triples.
+std::vector<int> prefilter(const MatX3d& points, const std::vector<int>& members) {
+  static const MatX3d dirs = make_icosphere(1, 1.0).V;
+  std::vector<int> support;
+  for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
+    int best = members.front();
+    double best_v = -kInf;
+    for (int s : members) {
+      const double v = dirs.row(d).dot(points.row(s));
+      if (v > best_v) best_v = v, best = s;
+    }
+    support.push_back(best);
+  }
+  std::sort(support.begin(), support.end());
+  support.erase(std::unique(support.begin(), support.end()), support.end());
+  const auto n = support.size();
+  std::vector<Eigen::Vector3d> S;
+  for (int s : support) S.emplace_back(points.row(s).transpose());
+  double extent = 0;
+  for (const auto& a : S) extent = std::max(extent, (a - S.front()).norm());
+  const double tol = 1e-9 * extent;
+  std::vector<std::pair<Eigen::Vector3d, double>> facets;  // outward normal, offset
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      for (size_t k = j + 1; k < n; ++k) {
+        Eigen::Vector3d normal = (S[j] - S[i]).cross(S[k] - S[i]);
+        const double len = normal.norm();
+        if (!(len > 1e-12 * extent * extent)) continue;
+        normal /= len;
+        const double offset = normal.dot(S[i]);
+        int above = 0, below = 0;
+        for (const auto& q : S) {
+          const double v = normal.dot(q) - offset;
+          above += v > tol ? 1 : 0;
+          below += v < -tol ? 1 : 0;
+        }
+        if (above > 0 && below > 0) continue;
+        if (above == 0 && below == 0) continue;  // flat support set: no volume
+        if (above > 0) facets.emplace_back(-normal, -offset);
+        else facets.emplace_back(normal, offset);
+      }
+    }
+  }
+  if (facets.size() < 4) return members;
+  std::vector<int> out = support;
+  for (int s : members) {
+    const Eigen::Vector3d p = points.row(s).transpose();
+    bool inside = true;
+    for (const auto& [normal, offset] : facets) {
+      if (normal.dot(p) >= offset - 1e3 * tol) {
+        inside = false;
+        break;
+      }
+    }
+    if (!inside) out.push_back(s);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 /// Extreme points (convex hull vertices) of the member samples, as rows.
-std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points, const std::vector<int>& members) {
+std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points, const std::vector<int>& all_members) {
   std::vector<Eigen::Vector3d> out;
-  if (members.size() <= 64) {
-    for (int s : members) out.emplace_back(points.row(s));
+  if (all_members.size() <= 64) {
+    for (int s : all_members) out.emplace_back(points.row(s));
     return out;
   }
+  const std::vector<int> members = all_members.size() > 1000 ? prefilter(points, all_members) : all_members;
   std::vector<Point> in;
   in.reserve(members.size());
   for (int s : members) in.emplace_back(points(s, 0), points(s, 1), points(s, 2));
