@@ -99,36 +99,38 @@ void LinkEvaluator::check_finite(const Eigen::Ref<const MatX3d>& coarse_position
   }
 }
 
-// Gathers the triples' nodes into the table (x, y, z, pad columns, for the
-// link loop); then Eqs. 4-6 for kLanes triples at a time with Eigen's packet
-// arithmetic (sqrt included), reading the nodes back from the table, and the
-// frames stored into the table; degenerate triples get fallback_frame().
-// Throws when a node is not finite (before any fallback frame of its chunk).
+// Eqs. 4-6 for kLanes triples at a time with Eigen's packet arithmetic
+// (sqrt included): the lanes are filled straight from the coarse rows, which
+// are also copied into the table for the link loop; the frames go into the
+// table, except for degenerate triples, which get fallback_frame(). Throws
+// when a node is not finite (before any fallback frame of its chunk).
 LinkApplyResult LinkEvaluator::update_triples(const Eigen::Ref<const MatX3d>& coarse_positions) {
   constexpr int kLanes = 2;  // one SSE2 packet: wider lanes spill more than they gain
+  static_assert(kLanes == 2, "the gather below fills two lanes");
   using Lane = Eigen::Array<double, kLanes, 1>;
   const int T = num_triples();
   const double* X = coarse_positions.data();
   const Eigen::Index stride = coarse_positions.outerStride();
   double* table = m_table.data();
-  for (int t = 0; t < T; ++t)
-    for (int i = 0; i < 3; ++i) {
-      const double* row = X + m_triple_nodes[3 * t + i] * stride;
-      double* col = table + 24 * static_cast<Eigen::Index>(t) + 4 * i;
-      col[0] = row[0];
-      col[1] = row[1];
-      col[2] = row[2];
-    }
-
   const double tol2 = m_options.degenerate_tolerance * m_options.degenerate_tolerance;
   LinkApplyResult result;
   for (int t0 = 0; t0 < T; t0 += kLanes) {
-    // Lane l holds triple t0 + l (the last one repeated past the end).
-    const double* col0 = table + 24 * static_cast<Eigen::Index>(t0);
-    const double* col1 = t0 + 1 < T ? col0 + 24 : col0;
-    const auto q = [&](int c) {
-      return Lane(col0[4 * (c / 3) + c % 3], col1[4 * (c / 3) + c % 3]);
-    };
+    // Lane l holds triple t0 + l (the last one repeated past the end); the
+    // nodes also go into the table for the link loop.
+    const int t1 = std::min(t0 + 1, T - 1);
+    const double* rows[2][3];
+    for (int i = 0; i < 3; ++i) {
+      rows[0][i] = X + m_triple_nodes[3 * t0 + i] * stride;
+      rows[1][i] = X + m_triple_nodes[3 * t1 + i] * stride;
+    }
+    double* col0 = table + 24 * static_cast<Eigen::Index>(t0);
+    double* col1 = table + 24 * static_cast<Eigen::Index>(t1);
+    for (int i = 0; i < 3; ++i)
+      for (int d = 0; d < 3; ++d) {
+        col0[4 * i + d] = rows[0][i][d];
+        col1[4 * i + d] = rows[1][i][d];
+      }
+    const auto q = [&](int c) { return Lane(rows[0][c / 3][c % 3], rows[1][c / 3][c % 3]); };
     const Lane ux = q(3) - q(0), uy = q(4) - q(1), uz = q(5) - q(2);
     const Lane vx = q(6) - q(0), vy = q(7) - q(1), vz = q(8) - q(2);
     const Lane nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;  // Eq. 4

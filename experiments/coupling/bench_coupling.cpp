@@ -3,13 +3,15 @@
 // LinkEvaluator (one frame per node triple), by the free apply() (which builds
 // an evaluator each call), the origin map of Eq. 1 alone as a sparse product,
 // and the barycentric embedding (sparse W * x) as the baseline. Objects: dense
-// icospheres over a structured coarse ball (generated), and the bunny and
-// dragon asset bundles in <repo>/assets when present. Also the contact
+// icospheres over a structured coarse ball (generated), and every bunny and
+// dragon asset bundle in <repo>/assets (named by folder). Also the contact
 // response per pair. Summarise repetitions with summarise_bench.py.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -142,15 +144,18 @@ void BM_ContactResponse(benchmark::State& state, const Fixture* f) {
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
-// The asset bundle folder in <repo>/assets whose name starts with `prefix`.
-std::filesystem::path find_bundle(const std::string& prefix) {
+// The asset bundle folders in <repo>/assets whose names start with `prefix`,
+// sorted by name (the folder name ends with a hash of the preprocessing input).
+std::vector<std::filesystem::path> find_bundles(const std::string& prefix) {
   const std::filesystem::path dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
+  std::vector<std::filesystem::path> found;
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec))
     if (e.is_directory() && e.path().filename().string().rfind(prefix, 0) == 0 &&
         std::filesystem::exists(e.path() / coupling::kBundleDataFile))
-      return e.path();
-  return {};
+      found.push_back(e.path());
+  std::sort(found.begin(), found.end());
+  return found;
 }
 
 }  // namespace
@@ -159,14 +164,11 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   fixtures()["sphere3"] = std::make_unique<Fixture>(sphere_asset(3));
   fixtures()["sphere5"] = std::make_unique<Fixture>(sphere_asset(5));
-  for (const auto& [name, prefix] :
-       {std::pair{"bunny", "bunny00"}, std::pair{"dragon", "ChineseDragon"}}) {
-    const std::filesystem::path p = find_bundle(prefix);
-    if (p.empty()) {
-      std::fprintf(stderr, "bench_coupling: no %s* bundle in assets/, skipped\n", prefix);
-      continue;
-    }
-    fixtures()[name] = std::make_unique<Fixture>(coupling::read_asset_bundle(p));
+  for (const char* prefix : {"bunny00", "ChineseDragon"}) {
+    const std::vector<std::filesystem::path> found = find_bundles(prefix);
+    if (found.empty()) std::fprintf(stderr, "bench_coupling: no %s* bundle in assets/\n", prefix);
+    for (const std::filesystem::path& p : found)
+      fixtures()[p.filename().string()] = std::make_unique<Fixture>(coupling::read_asset_bundle(p));
   }
   for (const auto& [name, f] : fixtures()) {
     const Fixture* fp = f.get();

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "coupling/asset_bundle.hpp"
 #include "coupling/link_evaluator.hpp"
@@ -122,31 +124,37 @@ TEST(LinkEvaluator, EqualsReferenceUnderRandomDeformations) {
 // The real dragon bundle (made by scripts/fetch_meshes.sh + icd-preprocess
 // into <repo>/assets): at rest and under random deformations, against the
 // reference and against the dense rest vertices.
-TEST(LinkEvaluator, EqualsReferenceOnDragonBundle) {
-  std::filesystem::path bundle;
+TEST(LinkEvaluator, EqualsReferenceOnDragonBundles) {
+  std::vector<std::filesystem::path> bundles;
   std::error_code ec;
   for (const auto& e :
        std::filesystem::directory_iterator(std::filesystem::path(ICD_SOURCE_DIR) / "assets", ec))
     if (e.path().filename().string().rfind("ChineseDragon", 0) == 0 &&
         std::filesystem::exists(e.path() / kBundleDataFile))
-      bundle = e.path();
-  if (bundle.empty()) GTEST_SKIP() << "no ChineseDragon* bundle in " << ICD_SOURCE_DIR << "/assets";
-  const AssetBundle b = read_asset_bundle(bundle);
-  LinkEvaluator ev(b.links);
-  MatX3d fast(b.dense.V.rows(), 3), ref(b.dense.V.rows(), 3);
-  ASSERT_EQ(ev.apply(b.coarse.V, fast).degenerate_triples, 0);
-  const double size = b.dense.V.cwiseAbs().maxCoeff();
-  EXPECT_LT((fast - b.dense.V).cwiseAbs().maxCoeff(), 1e-12 * size);
-  std::mt19937 rng(9);
-  const double diag = (b.coarse.V.colwise().maxCoeff() - b.coarse.V.colwise().minCoeff()).norm();
-  for (int trial = 0; trial < 3; ++trial) {
-    const MatX3d X = random_deformation(b.coarse.V, rng, 0.01 * diag);
-    EXPECT_EQ(ev.apply(X, fast).degenerate_triples, 0);
-    apply_reference(b.links, X, ref);
-    EXPECT_LT((fast - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff())
-        << "trial " << trial;
+      bundles.push_back(e.path());
+  if (bundles.empty())
+    GTEST_SKIP() << "no ChineseDragon* bundle in " << ICD_SOURCE_DIR << "/assets";
+  std::sort(bundles.begin(), bundles.end());
+  for (const std::filesystem::path& path : bundles) {
+    SCOPED_TRACE(path.string());
+    const AssetBundle b = read_asset_bundle(path);
+    LinkEvaluator ev(b.links);
+    MatX3d fast(b.dense.V.rows(), 3), ref(b.dense.V.rows(), 3);
+    ASSERT_EQ(ev.apply(b.coarse.V, fast).degenerate_triples, 0);
+    const double size = b.dense.V.cwiseAbs().maxCoeff();
+    EXPECT_LT((fast - b.dense.V).cwiseAbs().maxCoeff(), 1e-12 * size);
+    std::mt19937 rng(9);
+    const double diag = (b.coarse.V.colwise().maxCoeff() - b.coarse.V.colwise().minCoeff()).norm();
+    for (int trial = 0; trial < 3; ++trial) {
+      const MatX3d X = random_deformation(b.coarse.V, rng, 0.01 * diag);
+      EXPECT_EQ(ev.apply(X, fast).degenerate_triples, 0);
+      apply_reference(b.links, X, ref);
+      EXPECT_LT((fast - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff())
+          << "trial " << trial;
+    }
+    std::printf("%s: %d links, %d distinct triples\n", path.filename().c_str(), ev.num_links(),
+                ev.num_triples());
   }
-  std::printf("dragon bundle: %d links, %d distinct triples\n", ev.num_links(), ev.num_triples());
 }
 
 TEST(LinkEvaluator, OriginMatrixIsEquationOne) {
