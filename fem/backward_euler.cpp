@@ -47,6 +47,8 @@ NewtonReport BackwardEulerStepper::step(Model& model, State& s, double h, const 
         ck * Eigen::Map<const Eigen::VectorXd>(K.valuePtr(), K.nonZeros());
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < 3; ++c) m_A.coeffRef(3 * i + c, 3 * i + c) += m[i] * (1.0 + h * damp.alpha);
+    add_strain_rate_damping_matrix(model.mesh(), model.elastic().pattern(), model.strain_rate_damping(), x1, h,
+                                   m_A);
     apply_dirichlet(m_A, fixed);
     const Eigen::VectorXd rhs = -flat(r);
     rep.max_shift = std::max(rep.max_shift, solve_with_shift(m_solver, m_A, m_shifted, rhs, dv));

@@ -23,8 +23,9 @@ struct NewtonReport {
 };
 
 /// Backward Euler: find v1 with M (v1 - v0) = h f(x0 + h v1, v1), x1 = x0 + h v1.
-/// Newton matrix M (1 + h alpha) + (h^2 + h beta) K(x1) (the dK/dx v1 term of
-/// stiffness damping is neglected). The CHOLMOD symbolic analysis is done once.
+/// Newton matrix M (1 + h alpha) + (h^2 + h beta) K(x1) + h D(x1) with D the
+/// strain-rate damping matrix (the dK/dx v1 term of stiffness damping and the
+/// dD/dx v1 term are neglected). The CHOLMOD symbolic analysis is done once.
 class BackwardEulerStepper {
  public:
   /// One step of size h (s). The reference scale of the residual is

@@ -32,6 +32,28 @@ inline void strain_rate(const double* F, const double* Fdot, double* Edot) {
                                Fdot[3 + r] * F[3 + c] + Fdot[6 + r] * F[6 + c]);
 }
 
+// Nodal damping forces out[12] (nodes 0..3) of one element with F, Fdot,
+// Dm^-1 (column-major) and rest volume.
+inline void element_forces(const StrainRateDamping& damping, const double* F, const double* Fdot,
+                           const double* dinv, double volume, double* out) {
+  double Edot[9], S[9], P[9], H[9];
+  strain_rate(F, Fdot, Edot);
+  const double t = damping.phi * (Edot[0] + Edot[4] + Edot[8]);
+  for (int k = 0; k < 9; ++k) S[k] = 2.0 * damping.psi * Edot[k];
+  S[0] += t;
+  S[4] += t;
+  S[8] += t;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) P[3 * r + c] = F[3 * r] * S[c] + F[3 * r + 1] * S[3 + c] + F[3 * r + 2] * S[6 + c];
+  kernels::nodal_forces(P, dinv, volume, H);
+  for (int r = 0; r < 3; ++r) {
+    out[3 + r] = H[3 * r];
+    out[6 + r] = H[3 * r + 1];
+    out[9 + r] = H[3 * r + 2];
+    out[r] = -(H[3 * r] + H[3 * r + 1] + H[3 * r + 2]);
+  }
+}
+
 }  // namespace
 
 void validate(const StrainRateDamping& damping) {
@@ -51,29 +73,50 @@ void add_strain_rate_damping_forces(const TetMeshData& mesh, const StrainRateDam
                          std::to_string(mesh.num_nodes) + " rows");
   if (!damping.enabled()) return;
   for (int e = 0; e < mesh.num_tets(); ++e) {
-    double F[9], Fdot[9], Edot[9], S[9], P[9], H[9];
+    double F[9], Fdot[9], out[12];
     rates(mesh, x, v, e, F, Fdot);
-    strain_rate(F, Fdot, Edot);
-    const double t = damping.phi * (Edot[0] + Edot[4] + Edot[8]);
-    for (int k = 0; k < 9; ++k) S[k] = 2.0 * damping.psi * Edot[k];
-    S[0] += t;
-    S[4] += t;
-    S[8] += t;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) P[3 * r + c] = F[3 * r] * S[c] + F[3 * r + 1] * S[3 + c] + F[3 * r + 2] * S[6 + c];
-    kernels::nodal_forces(P, mesh.dm_inv[e].data(), mesh.rest_volume[e], H);
-    const int* tt = mesh.tets.data() + 4 * e;
-    for (int r = 0; r < 3; ++r) {
-      f(tt[1], r) += H[3 * r];
-      f(tt[2], r) += H[3 * r + 1];
-      f(tt[3], r) += H[3 * r + 2];
-      f(tt[0], r) -= H[3 * r] + H[3 * r + 1] + H[3 * r + 2];
-    }
+    element_forces(damping, F, Fdot, mesh.dm_inv[e].data(), mesh.rest_volume[e], out);
+    const int* t = mesh.tets.data() + 4 * e;
+    for (int a = 0; a < 4; ++a)
+      for (int r = 0; r < 3; ++r) f(t[a], r) += out[3 * a + r];
+  }
+}
+
+void add_strain_rate_damping_matrix(const TetMeshData& mesh, const StiffnessPattern& pattern,
+                                    const StrainRateDamping& damping, const Eigen::Ref<const MatX3d>& x,
+                                    double scale, Eigen::SparseMatrix<double>& A) {
+  if (x.rows() != mesh.num_nodes || A.rows() != 3 * mesh.num_nodes || A.cols() != A.rows())
+    throw ParameterError("fem::add_strain_rate_damping_matrix: expected x with #V = " +
+                         std::to_string(mesh.num_nodes) + " rows and a 3#V x 3#V matrix");
+  if (!damping.enabled()) return;
+  double* val = A.valuePtr();
+  const MatX3d zero = MatX3d::Zero(mesh.num_nodes, 3);
+  for (int e = 0; e < mesh.num_tets(); ++e) {
+    const int* t = mesh.tets.data() + 4 * e;
+    double F[9], unused[9];
+    rates(mesh, x, zero, e, F, unused);
+    const Eigen::Matrix<double, 4, 3> G = mesh.shape_gradients(e);
+    for (int b = 0; b < 4; ++b)
+      for (int c = 0; c < 3; ++c) {
+        double Fdot[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};  // unit velocity of dof (b, c): row c of Fdot is grad N_b
+        for (int k = 0; k < 3; ++k) Fdot[3 * c + k] = G(b, k);
+        double col[12];
+        element_forces(damping, F, Fdot, mesh.dm_inv[e].data(), mesh.rest_volume[e], col);
+        for (int a = 0; a < 4; ++a) {
+          double* block = val + pattern.block_offset(e, a, b) + c * pattern.column_length(t[b]);
+          block[0] -= scale * col[3 * a];  // D = -df_d/dv
+          block[1] -= scale * col[3 * a + 1];
+          block[2] -= scale * col[3 * a + 2];
+        }
+      }
   }
 }
 
 double strain_rate_dissipation(const TetMeshData& mesh, const StrainRateDamping& damping,
                                const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v) {
+  if (x.rows() != mesh.num_nodes || v.rows() != mesh.num_nodes)
+    throw ParameterError("fem::strain_rate_dissipation: x and v must have #V = " + std::to_string(mesh.num_nodes) +
+                         " rows");
   double R = 0;
   for (int e = 0; e < mesh.num_tets(); ++e) {
     double F[9], Fdot[9], Edot[9];

@@ -3,7 +3,9 @@
 /// damping of the paper's deformation model): a damping stress that depends
 /// only on how fast the element deforms, so rigid motions are not damped.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
+#include "fem/stiffness_pattern.hpp"
 #include "fem/tet_mesh_data.hpp"
 
 namespace icd::fem {
@@ -30,6 +32,14 @@ void validate(const StrainRateDamping& damping);
 void add_strain_rate_damping_forces(const TetMeshData& mesh, const StrainRateDamping& damping,
                                     const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
                                     Eigen::Ref<MatX3d> f);
+
+/// Adds scale x D(x) to A, D = -df_d/dv (3#V x 3#V, symmetric positive
+/// semi-definite, N s/m) the damping matrix at positions x, written in place
+/// into A's values; A must have the layout of `pattern` (e.g. a copy of
+/// ElasticForces::stiffness()). Backward Euler's Newton matrix uses it.
+void add_strain_rate_damping_matrix(const TetMeshData& mesh, const StiffnessPattern& pattern,
+                                    const StrainRateDamping& damping, const Eigen::Ref<const MatX3d>& x,
+                                    double scale, Eigen::SparseMatrix<double>& A);
 
 /// The Rayleigh dissipation function R(v) above, W (J/s): half the power the
 /// damping forces dissipate.
