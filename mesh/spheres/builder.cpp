@@ -30,6 +30,7 @@ void check_options(const SphereTreeOptions& o) {
   if (o.lloyd_iterations < 0) fail("lloyd_iterations must be >= 0");
   if (o.merge_burst_lloyd_iterations < 0) fail("merge_burst_lloyd_iterations must be >= 0");
   if (o.exchange_rounds < 0) fail("exchange_rounds must be >= 0");
+  if (o.relieve_moves < 0) fail("relieve_moves must be >= 0");
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
 }
@@ -183,8 +184,9 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
 /// whose ancestors all cover it with margin; then every inner node's samples
 /// become the union of its children's and its radius is refitted (it can only
 /// shrink: its samples were all covered by it).
-void exchange_across_leaves(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
-                            const std::vector<std::vector<int>>& parent_of, int rounds) {
+void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& oracle,
+                            std::vector<std::vector<Node>>& levels, const std::vector<std::vector<int>>& parent_of,
+                            int rounds, int relieve_moves) {
   const size_t last = levels.size() - 1;
   std::vector<FittedSphere> leaves;
   for (const Node& n : levels[last]) leaves.push_back(n.sphere);
@@ -202,6 +204,13 @@ void exchange_across_leaves(const ReductionProblem& dense, std::vector<std::vect
   ExchangeOptions exchange;
   exchange.rounds = rounds;
   shrink_by_exchange(dense, leaves, exchange, accepts);
+  if (relieve_moves > 0) {
+    relieve_worst(dense, leaves, relieve_moves, accepts);
+    for (auto& leaf : leaves) polish_sphere(dense, oracle, leaf);
+    shrink_by_exchange(dense, leaves, exchange, accepts);
+    relieve_worst(dense, leaves, relieve_moves, accepts);
+    shrink_by_exchange(dense, leaves, exchange, accepts);
+  }
   for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
   for (size_t l = last; l >= 1; --l) {
     std::vector<std::vector<int>> unions(levels[l - 1].size());
@@ -345,7 +354,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   if (options.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
   }
-  if (options.leaf_exchange && levels.size() > 1) exchange_across_leaves(dense, levels, parent_of, 3);
+  if (options.leaf_exchange && levels.size() > 1) exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
 
   // Flatten breadth-first: level by level, children of a node contiguous.
   collision::SphereTree& tree = out.tree;

@@ -57,6 +57,9 @@ struct SphereTreeOptions {
   /// leaf and all its ancestors already cover it); inner nodes then shrink to
   /// the union of their children's samples. No radius grows.
   bool leaf_exchange = true;
+  /// With leaf_exchange: at most this many single-sample moves that lower the
+  /// worst leaf error bound (see relieve_worst; 0 disables, >= 0).
+  int relieve_moves = 200000;
   /// After the top-down pass, optimise the leaves jointly (a leaf may take
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.

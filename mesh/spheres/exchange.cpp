@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <set>
 #include <string>
 
 #include "mesh/io/error.hpp"
@@ -79,6 +80,74 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
     if (moved_round == 0) break;
   }
   return moved_total;
+}
+
+int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& spheres, int max_moves,
+                  const std::function<bool(int, int)>& accepts) {
+  if (max_moves < 0) throw ParameterError("relieve_worst: max_moves must be >= 0");
+  const int n = static_cast<int>(spheres.size());
+  if (n < 2) return 0;
+  auto reach = [&](int s, const FittedSphere& sp) {
+    return (problem.points.row(s).transpose() - sp.center).norm() + problem.gap[s];
+  };
+  // Per sphere: a max-heap of (reach, -sample) over its current members.
+  std::vector<std::vector<std::pair<double, int>>> heaps(static_cast<size_t>(n));
+  std::vector<int> size(static_cast<size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    auto& h = heaps[static_cast<size_t>(j)];
+    for (int s : spheres[static_cast<size_t>(j)].members) h.emplace_back(reach(s, spheres[static_cast<size_t>(j)]), -s);
+    std::make_heap(h.begin(), h.end());
+    size[static_cast<size_t>(j)] = static_cast<int>(h.size());
+  }
+  // Worst sphere first (ties: lower index).
+  std::set<std::pair<double, int>> by_error;
+  for (int j = 0; j < n; ++j) by_error.emplace(-spheres[static_cast<size_t>(j)].error, j);
+  int moves = 0;
+  while (moves < max_moves) {
+    const int j = by_error.begin()->second;
+    FittedSphere& worst = spheres[static_cast<size_t>(j)];
+    auto& hj = heaps[static_cast<size_t>(j)];
+    if (size[static_cast<size_t>(j)] <= 1) break;
+    const int s = -hj.front().second;
+    int receiver = -1;
+    double receiver_error = worst.error;
+    for (int k = 0; k < n; ++k) {
+      if (k == j) continue;
+      const FittedSphere& other = spheres[static_cast<size_t>(k)];
+      const double r = std::max(other.radius, reach(s, other));
+      const double e = r - other.depth;
+      if (e < receiver_error && (!accepts || accepts(k, s))) receiver_error = e, receiver = k;
+    }
+    if (receiver < 0) break;
+    // Move s from j to the receiver.
+    std::pop_heap(hj.begin(), hj.end());
+    hj.pop_back();
+    size[static_cast<size_t>(j)] -= 1;
+    FittedSphere& other = spheres[static_cast<size_t>(receiver)];
+    const double rs = reach(s, other);
+    auto& hk = heaps[static_cast<size_t>(receiver)];
+    hk.emplace_back(rs, -s);
+    std::push_heap(hk.begin(), hk.end());
+    size[static_cast<size_t>(receiver)] += 1;
+    by_error.erase({-worst.error, j});
+    by_error.erase({-other.error, receiver});
+    worst.radius = hj.front().first;
+    worst.error = worst.radius - worst.depth;
+    other.radius = std::max(other.radius, rs);
+    other.error = other.radius - other.depth;
+    by_error.emplace(-worst.error, j);
+    by_error.emplace(-other.error, receiver);
+    ++moves;
+  }
+  if (moves > 0) {
+    for (int j = 0; j < n; ++j) {
+      auto& members = spheres[static_cast<size_t>(j)].members;
+      members.clear();
+      for (const auto& [r, neg] : heaps[static_cast<size_t>(j)]) members.push_back(-neg);
+      std::sort(members.begin(), members.end());
+    }
+  }
+  return moves;
 }
 
 }  // namespace icd::mesh

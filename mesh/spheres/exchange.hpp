@@ -30,4 +30,17 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
                        const ExchangeOptions& options = {},
                        const std::function<bool(int receiver, int sample)>& accepts = {});
 
+/// Lowers the worst error bound of a sphere set: repeatedly, the sphere with
+/// the largest error bound hands its farthest member s to the sphere k that
+/// would then have the smallest error bound max(r_k, |s - c_k| + gap[s]) -
+/// depth_k, provided that is below the worst sphere's current error bound and
+/// accepts(k, s) holds (empty: always); k grows to cover s. Stops when the
+/// worst sphere cannot give its farthest member away, or after
+/// `max_moves` moves. Only the worst error is guaranteed not to rise (others
+/// may grow, below it); every sample stays covered with margin and in
+/// exactly one sphere. A sphere keeps at least one member. Returns the number
+/// of moves. Deterministic. Throws ParameterError for max_moves < 0.
+int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& spheres, int max_moves,
+                  const std::function<bool(int receiver, int sample)>& accepts = {});
+
 }  // namespace icd::mesh
