@@ -34,6 +34,7 @@ struct Case {
   double left_x = -0.13, right_x = 0.13, speed = 0.6;
   std::string collision = R"("budget_tests": 2000)";
   bool fix_all_left = false;
+  std::string model = "stvk";  // material of both balls
   double kick_at_half = 0;  // m/s added to every left-ball node at the middle frame
 };
 
@@ -44,7 +45,7 @@ runner::Scene make_scene(const Case& c) {
     s << R"({"name": ")" << name
       << R"(", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 4},)"
       << R"( "position": [)" << x << R"(, 0, 0], "velocity": [)" << v
-      << R"(, 0, 0], "material": {"model": "stvk", "young": 5e5, "poisson": 0.3,)"
+      << R"(, 0, 0], "material": {"model": ")" << c.model << R"(", "young": 5e5, "poisson": 0.3,)"
       << R"( "density": 1000}, "integrator": "rk4", "preprocess": {"tree_depth": 3}})";
   };
   s << R"({"name": ")" << c.name << R"(", "frames": 1, "objects": [)";
@@ -120,7 +121,7 @@ int main(int argc, char** argv) {
   int frames = 120;
   if (argc == 3 && std::string(argv[1]) == "--frames") frames = std::atoi(argv[2]);
   std::vector<Case> cases;
-  cases.push_back({"zero_budget", "budget of 0 sphere tests"});
+  cases.push_back({"zero_budget", "budget of 0 sphere tests: refused at scene validation"});
   cases.back().collision = R"("budget_tests": 0)";
   cases.push_back({"huge_budget", "budget of 10^12 sphere tests"});
   cases.back().collision = R"("budget_tests": 1000000000000)";
@@ -134,6 +135,12 @@ int main(int argc, char** argv) {
   cases.back().left_x = -0.075;
   cases.back().right_x = 0.075;
   cases.back().speed = 0;
+  cases.push_back({"start_interpenetrated_snh",
+                   "as above, inversion-safe stable Neo-Hookean: pushed apart"});
+  cases.back().left_x = -0.075;
+  cases.back().right_x = 0.075;
+  cases.back().speed = 0;
+  cases.back().model = "stable_neo_hookean";
   cases.push_back({"sudden_huge_force", "impulse: +100 m/s on the left ball mid-run"});
   cases.back().kick_at_half = 100;
 

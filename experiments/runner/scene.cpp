@@ -210,7 +210,11 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   if (f.boolean("unlimited", false)) c.budget_seconds = kInf;
   const double tests = f.number("budget_tests", -1, -1, 1e15);
   if (tests != -1 && (tests < 0 || tests != std::floor(tests)))
-    f.fail("collision.budget_tests", "must be a non-negative integer or -1");
+    f.fail("collision.budget_tests", "must be a positive integer or -1");
+  if (tests == 0)
+    f.fail("collision.budget_tests",
+           "0 allows no sphere test, so every query would answer with the root pair (whole "
+           "objects assumed colliding); give a positive count, or -1 for no limit");
   c.budget_tests = static_cast<int64_t>(tests);
   if (c.budget_tests >= 0 && f.get("budget_seconds") == nullptr) c.budget_seconds = kInf;
   const std::string mode =
