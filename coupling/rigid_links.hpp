@@ -72,9 +72,9 @@ RigidLinks build_rigid_links(const Eigen::Ref<const MatX3d>& P,
 /// with the frame of the current coarse positions (#M x 3, M ==
 /// links.num_coarse_nodes). dense_out must already have links.num_links() rows.
 /// Convenience wrapper: builds a LinkEvaluator on the fly (hashes the node
-/// triples and allocates ~70 bytes per link; measured 25-40 ns per dense vertex
-/// in all, about the cost of apply_reference(), where a kept evaluator costs
-/// 8-17 ns), so code that evaluates the same links every frame should keep a
+/// triples and allocates ~70 bytes per link; measured 23-35 ns per dense vertex
+/// in all, 0.6-0.9x the cost of apply_reference(), where a kept evaluator
+/// costs 7-15 ns), so code that evaluates the same links every frame should keep a
 /// LinkEvaluator (coupling/link_evaluator.hpp) instead. Degenerate frames use
 /// the evaluator's fallback frame (no previous frame: see link_evaluator.hpp).
 /// Throws ParameterError on a size mismatch, InputError on inconsistent links,
