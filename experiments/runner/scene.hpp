@@ -4,6 +4,7 @@
 /// field by field: every error names the file and the field.
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -70,8 +71,9 @@ enum class InterruptedResponse {
   /// process lost the processor for longer than the budget) then pushes with
   /// the penetration of large inner spheres: an energy kick.
   Untested,
-  /// The last complete answer of the pair, if it is at most one frame old,
-  /// re-evaluated at the current sphere positions; otherwise as Untested.
+  /// The last complete answer of the pair, if it is at most
+  /// CollisionSpec::previous_max_age old, re-evaluated at the current sphere
+  /// positions; otherwise (no complete answer yet) as Untested.
   /// The query's own lists (PAIRLIST, COLLISIONLIST) are still reported.
   Previous,
 };
@@ -105,6 +107,11 @@ struct CollisionSpec {
   collision::SphereUpdateOptions update;
   coupling::ContactOptions contact;
   InterruptedResponse on_interrupt = InterruptedResponse::Previous;
+  /// Oldest complete answer on_interrupt = "previous" reuses, simulated s
+  /// (inf: any). A deep contact can keep queries interrupted for many frames;
+  /// an old leaf-level answer then still pushes far less wrongly than the
+  /// untested inner spheres (whose overlap can be a large part of the objects).
+  double previous_max_age = std::numeric_limits<double>::infinity();
 };
 
 /// What the run writes.

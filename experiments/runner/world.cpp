@@ -229,7 +229,8 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       // evaluated at the current sphere positions.
       const bool reuse = m_results[p].interrupted &&
                          cs.on_interrupt == InterruptedResponse::Previous &&
-                         t_end - m_complete_time[p] <= 1.0 / m_scene.frame_rate + 1e-12;
+                         std::isfinite(m_complete_time[p]) &&
+                         t_end - m_complete_time[p] <= cs.previous_max_age;
       if (reuse) ++m.reused;
       const coupling::ContactStats st = coupling::apply_contact_forces(
           a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : m_results[p], co,
