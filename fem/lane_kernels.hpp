@@ -3,6 +3,7 @@
 /// structure-of-arrays lane loops (a[k][lane]) that the compiler vectorises.
 /// Per element, the arithmetic is the same sequence of operations as the
 /// scalar kernels (element_kernels.hpp), so results are bitwise identical.
+#include "fem/element_kernels.hpp"
 #include "fem/material.hpp"
 
 namespace icd::fem::lanes {
@@ -226,21 +227,9 @@ inline void block_differential(const double* x, const double* dx, const int* tet
         f[k] = F[k][l];
         g[k] = dF[k][l];
       }
-      // cofactor_bilinear(A, B) as in element_kernels.hpp.
-      auto cof = [](const double* A, const double* B, double* o) {
-        o[0] = A[4] * B[8] - A[7] * B[5];
-        o[1] = A[5] * B[6] - A[8] * B[3];
-        o[2] = A[3] * B[7] - A[6] * B[4];
-        o[3] = A[7] * B[2] - A[1] * B[8];
-        o[4] = A[8] * B[0] - A[2] * B[6];
-        o[5] = A[6] * B[1] - A[0] * B[7];
-        o[6] = A[1] * B[5] - A[4] * B[2];
-        o[7] = A[2] * B[3] - A[5] * B[0];
-        o[8] = A[0] * B[4] - A[3] * B[1];
-      };
-      cof(f, f, C);
-      cof(g, f, dC);
-      cof(f, g, dC2);
+      kernels::cofactor_bilinear(f, f, C);
+      kernels::cofactor_bilinear(g, f, dC);
+      kernels::cofactor_bilinear(f, g, dC2);
       const double J = f[0] * C[0] + f[3] * C[3] + f[6] * C[6];
       double cdf = 0;
       for (int k = 0; k < 9; ++k) cdf += C[k] * g[k];

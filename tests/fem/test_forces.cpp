@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "fem/constitutive.hpp"
+#include "fem/element_kernels.hpp"
+#include "fem/lane_kernels.hpp"
 #include "fem_test_utils.hpp"
 #include "mesh/io/error.hpp"
 
@@ -200,6 +202,64 @@ TEST_P(ForcesPerModel, FusedHealthMatchesTheSeparatePassForAnyThreadCount) {
 
 INSTANTIATE_TEST_SUITE_P(AllModels, ForcesPerModel, ::testing::ValuesIn(test::all_models()),
                          test::model_name);
+
+TEST(Forces, LaneKernelsMatchTheScalarKernelsPerElement) {
+  // The 8-lane kernels (forces, fused health, force differential) against the
+  // scalar per-element kernels of element_kernels.hpp: forces, det F and
+  // energy density bitwise (same operation sequence), the differential to
+  // round-off. 5 elements in the block (3 padding lanes).
+  const TetMeshData d = test::box_data(1, 1, 1, {0.1, 0.1, 0.1});  // 5 or 6 tets
+  const int count = std::min(d.num_tets(), 8);
+  lanes::Block block{};
+  for (int e = 0; e < count; ++e) {
+    for (int k = 0; k < 9; ++k) block.dinv[k][e] = d.dm_inv[e].data()[k];
+    block.volume[e] = d.rest_volume[e];
+  }
+  const MatX3d x = deformed(d, 31, 0.03), dx = test::random_field(d.num_nodes, 32);
+  const double mu = 3.1e5, lambda = 7.7e5;
+  auto check = [&](auto tag, auto stress, auto energy, auto dstress) {
+    constexpr MaterialModel kModel = decltype(tag)::value;
+    double out[8][12], psi[8], det[8], dout[8][12];
+    lanes::block_forces<kModel, true>(x.data(), d.tets.data(), count, block, mu, lambda, out, psi, det);
+    lanes::block_differential<kModel>(x.data(), dx.data(), d.tets.data(), count, block, mu, lambda, dout);
+    for (int e = 0; e < count; ++e) {
+      const int* t = d.tets.data() + 4 * e;
+      const double* D = d.dm_inv[e].data();
+      double F[9], dF[9], P[9], dP[9], H[9], dH[9];
+      kernels::deformation_gradient(&x(t[0], 0), &x(t[1], 0), &x(t[2], 0), &x(t[3], 0), D, F);
+      kernels::deformation_gradient(&dx(t[0], 0), &dx(t[1], 0), &dx(t[2], 0), &dx(t[3], 0), D, dF);
+      stress(F, P);
+      dstress(F, dF, dP);
+      kernels::nodal_forces(P, D, d.rest_volume[e], H);
+      kernels::nodal_forces(dP, D, d.rest_volume[e], dH);
+      const double J = kernels::determinant(F);
+      EXPECT_EQ(det[e], J) << to_string(kModel) << " element " << e;
+      EXPECT_EQ(psi[e], energy(F, J)) << to_string(kModel) << " element " << e;
+      double scale = 0;
+      for (double h : dH) scale = std::max(scale, std::abs(h));
+      for (int r = 0; r < 3; ++r)
+        for (int a = 1; a < 4; ++a) {
+          EXPECT_EQ(out[e][3 * a + r], H[3 * r + a - 1]) << to_string(kModel) << " element " << e;
+          EXPECT_NEAR(dout[e][3 * a + r], dH[3 * r + a - 1], 1e-13 * scale) << to_string(kModel) << " element " << e;
+        }
+    }
+  };
+  using kernels::determinant;
+  check(std::integral_constant<MaterialModel, MaterialModel::Linear>{},
+        [&](const double* F, double* P) { kernels::linear_stress(F, mu, lambda, P); },
+        [&](const double* F, double) { return kernels::linear_energy(F, mu, lambda); },
+        [&](const double*, const double* dF, double* dP) { kernels::linear_stress_differential(dF, mu, lambda, dP); });
+  check(std::integral_constant<MaterialModel, MaterialModel::StVK>{},
+        [&](const double* F, double* P) { kernels::stvk_stress(F, mu, lambda, P); },
+        [&](const double* F, double) { return kernels::stvk_energy(F, mu, lambda); },
+        [&](const double* F, const double* dF, double* dP) { kernels::stvk_stress_differential(F, dF, mu, lambda, dP); });
+  check(std::integral_constant<MaterialModel, MaterialModel::StableNeoHookean>{},
+        [&](const double* F, double* P) { kernels::stable_neo_hookean_stress(F, mu, lambda, P); },
+        [&](const double* F, double J) { return kernels::stable_neo_hookean_energy(F, J, mu, lambda); },
+        [&](const double* F, const double* dF, double* dP) {
+          kernels::stable_neo_hookean_stress_differential(F, dF, mu, lambda, dP);
+        });
+}
 
 TEST(Forces, RejectsShapeMismatch) {
   const TetMeshData d = test::box_data(1, 1, 1);
