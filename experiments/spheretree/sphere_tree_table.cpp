@@ -1,6 +1,7 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
 //                   [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]
+//                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -26,6 +27,7 @@
 #include "mesh/io/vtk_writer.hpp"
 #include "mesh/spheres/builder.hpp"
 #include "mesh/spheres/evaluation.hpp"
+#include "mesh/spheres/mesh_oracle.hpp"
 
 namespace {
 
@@ -62,13 +64,46 @@ void print_table(const std::string& model, const std::string& method, double sec
   }
 }
 
+/// The `count` leaves with the largest 162-probe error: what limits the worst error.
+void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTreeBuild& build, double to_2000,
+                        int count) {
+  const icd::mesh::MeshOracle oracle(icd::mesh::close_holes(mesh));
+  const icd::MatX3d dirs = icd::mesh::probe_directions(2);
+  const auto& tree = build.tree;
+  const int leaf_level = tree.num_levels() - 1;
+  std::vector<int> parent(static_cast<size_t>(tree.num_nodes()), -1);
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    for (int k = 0; k < tree.child_count[static_cast<size_t>(i)]; ++k) parent[static_cast<size_t>(tree.first_child[static_cast<size_t>(i)] + k)] = i;
+  }
+  std::vector<std::pair<double, int>> errors;
+  for (int i = tree.level_offset[static_cast<size_t>(leaf_level)]; i < tree.num_nodes(); ++i) {
+    const auto& s = tree.spheres[static_cast<size_t>(i)];
+    double e = 0;
+    for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
+      const Eigen::Vector3d p = s.center() + s.r * dirs.row(d).transpose();
+      if (!oracle.inside(p)) e = std::max(e, oracle.distance(p));
+    }
+    errors.emplace_back(e * to_2000, i);
+  }
+  std::sort(errors.rbegin(), errors.rend());
+  for (int k = 0; k < count && k < static_cast<int>(errors.size()); ++k) {
+    const int i = errors[static_cast<size_t>(k)].second;
+    const auto& s = tree.spheres[static_cast<size_t>(i)];
+    const int p = parent[static_cast<size_t>(i)];
+    std::printf("# worst leaf %d: node %d error162 %.1f bound %.1f radius %.1f depth %.1f samples %zu, parent %d with %d children\n",
+                k, i, errors[static_cast<size_t>(k)].first, to_2000 * (s.r - build.node_depth[static_cast<size_t>(i)]),
+                to_2000 * s.r, to_2000 * build.node_depth[static_cast<size_t>(i)], build.node_samples[static_cast<size_t>(i)].size(),
+                p, p >= 0 ? tree.child_count[static_cast<size_t>(p)] : 0);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
                  " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-                 " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]\n";
+                 " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] [--diagnose N]\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -78,6 +113,7 @@ int main(int argc, char** argv) {
   options.depth = 3;
   options.max_spheres_per_level = {1, 8, 64, 445};
   bool with_octree = true;
+  int diagnose = 0;
   icd::mesh::EvaluationOptions evaluation;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
@@ -90,6 +126,7 @@ int main(int argc, char** argv) {
     else if (key == "--worst-share") options.worst_share = std::atof(value);
     else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
     else if (key == "--octree") with_octree = std::atoi(value) != 0;
+    else if (key == "--diagnose") diagnose = std::atoi(value);
     else if (key == "--coverage-spacing") evaluation.coverage_spacing = std::atof(value);
     else if (key == "--reduction") {
       const std::string v = value;
@@ -158,6 +195,7 @@ int main(int argc, char** argv) {
       std::printf("# %s level %d: error bound r - depth: worst %.1f mean %.2f\n", model.name.c_str(), l, worst,
                   sum / (end - begin));
     }
+    if (diagnose > 0) print_worst_leaves(mesh, ours, to_2000, diagnose);
     std::fflush(stdout);
     write_tree(results, model.name + "_medial", ours.tree);
     write_tree(results, model.name + "_octree", octree);

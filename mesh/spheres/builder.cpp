@@ -181,23 +181,40 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
 }
 
 /// Boundary exchange across the whole leaf level: a sample may move to a leaf
-/// whose ancestors all cover it with margin; then every inner node's samples
-/// become the union of its children's and its radius is refitted (it can only
-/// shrink: its samples were all covered by it).
+/// whose ancestors all cover it with margin (shrink_by_exchange), or, to lower
+/// the worst leaf error (relieve_worst), whose ancestors would stay within
+/// their level's worst error bound when grown to cover it. Then every inner
+/// node's samples become the union of its children's and its radius is
+/// refitted exactly.
 void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& oracle,
                             std::vector<std::vector<Node>>& levels, const std::vector<std::vector<int>>& parent_of,
                             int rounds, int relieve_moves) {
   const size_t last = levels.size() - 1;
   std::vector<FittedSphere> leaves;
   for (const Node& n : levels[last]) leaves.push_back(n.sphere);
-  auto covers = [&](const FittedSphere& sp, int s) {
-    return (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s] <= sp.radius;
+  std::vector<double> level_worst(levels.size(), 0.0);
+  for (size_t l = 0; l < levels.size(); ++l) {
+    for (const Node& n : levels[l]) level_worst[l] = std::max(level_worst[l], n.sphere.error);
+  }
+  auto reach = [&](const FittedSphere& sp, int s) {
+    return (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s];
   };
   auto accepts = [&](int leaf, int s) {
     int node = leaf;
     for (size_t l = last; l >= 1; --l) {
       node = parent_of[l][static_cast<size_t>(node)];
-      if (!covers(levels[l - 1][static_cast<size_t>(node)].sphere, s)) return false;
+      const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
+      if (reach(a, s) > a.radius) return false;
+    }
+    return true;
+  };
+  auto accepts_growing = [&](int leaf, int s) {
+    int node = leaf;
+    for (size_t l = last; l >= 1; --l) {
+      node = parent_of[l][static_cast<size_t>(node)];
+      const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
+      const double r = reach(a, s);
+      if (r > a.radius && r - a.depth > level_worst[l - 1]) return false;
     }
     return true;
   };
@@ -205,10 +222,10 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
   exchange.rounds = rounds;
   shrink_by_exchange(dense, leaves, exchange, accepts);
   if (relieve_moves > 0) {
-    relieve_worst(dense, leaves, relieve_moves, accepts);
+    relieve_worst(dense, leaves, relieve_moves, accepts_growing);
     for (auto& leaf : leaves) polish_sphere(dense, oracle, leaf);
     shrink_by_exchange(dense, leaves, exchange, accepts);
-    relieve_worst(dense, leaves, relieve_moves, accepts);
+    relieve_worst(dense, leaves, relieve_moves, accepts_growing);
     shrink_by_exchange(dense, leaves, exchange, accepts);
   }
   for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
@@ -225,8 +242,7 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
       sp.members = std::move(unions[p]);
       double r = 0;
       for (int s : sp.members) r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
-      assert(r <= sp.radius);
-      sp.radius = r;
+      sp.radius = r;  // grows only within the level's worst error (accepts_growing)
       sp.error = r - sp.depth;
     }
   }

@@ -37,7 +37,7 @@ struct SphereTreeOptions {
   /// one per parent go where the summed child error drops most (favours the
   /// mean error), the rest to the parents with the worst child (favours the
   /// worst error). In [0, 1].
-  double worst_share = 0.1;
+  double worst_share = 0.3;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;

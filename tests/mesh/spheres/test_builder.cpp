@@ -37,8 +37,7 @@ SphereTreeOptions small_options(ReductionMethod method = SphereTreeOptions{}.red
 /// The reduction methods every tree-level guarantee is checked for.
 const std::vector<std::pair<std::string, ReductionMethod>> kMethods = {
     {"split_lloyd", ReductionMethod::split_lloyd},
-    {"merge_burst", ReductionMethod::merge_burst},
-    {"best_of_both", ReductionMethod::best_of_both}};
+    {"merge_burst", ReductionMethod::merge_burst}};
 
 /// The builds of cases(), made once per test program (each takes seconds).
 const SphereTreeBuild& cached_build(const Case& c, ReductionMethod method = SphereTreeOptions{}.reduction) {

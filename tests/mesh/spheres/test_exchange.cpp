@@ -1,7 +1,8 @@
-// Boundary exchange between spheres: checked by brute force on the samples of
-// a torus (coverage with margin kept, no radius grows, members partitioned,
-// the receiver predicate respected) and against a two-sphere configuration
-// whose shrunken radius is known in closed form.
+// Boundary exchange between spheres (shrink_by_exchange, relieve_worst):
+// checked by brute force on the samples of a torus (coverage with margin
+// kept, no radius grows / the worst error drops, members partitioned, the
+// receiver predicate respected) and on samples along a line, where the
+// result is known in closed form or by enumerating every split.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -104,6 +105,77 @@ TEST(Exchange, HandsTheFarthestSampleToTheNeighbourThatCoversIt) {
   EXPECT_EQ(spheres[1].members, (std::vector<int>{6, 7, 8, 9, 10}));
 }
 
+TEST(Exchange, RelieveWorstReachesTheMinimaxSplitOnALine) {
+  // Samples at x = 0..10 (gap 0), centres fixed at 0 and 8 (depth 0). The
+  // best split for the worst radius is A = {0..4} (4), B = {5..10} (3), or
+  // A = {0..3} (3), B = {4..10} (4): worst 4 (brute force over the 12 splits).
+  icd::MatX3d P(11, 3);
+  for (int i = 0; i <= 10; ++i) P.row(i) << i, 0, 0;
+  const Eigen::VectorXd gap = Eigen::VectorXd::Zero(11);
+  const MedialSpheres medial;
+  const PointGrid grid(P, 1.0);
+  const ReductionProblem problem{P, gap, medial, grid};
+  double minimax = 1e9;
+  for (int split = 0; split <= 11; ++split) {  // A = {0 .. split - 1}
+    const double ra = split > 0 ? split - 1.0 : 0.0;
+    const double rb = split <= 10 ? std::max(8.0 - split, 2.0) : 0.0;
+    minimax = std::min(minimax, std::max(ra, rb));
+  }
+  FittedSphere a, b;  // A starts with 0..9, B with sample 10 only
+  a.center = Eigen::Vector3d::Zero(), a.radius = 9, a.error = 9, a.members = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+  b.center = Eigen::Vector3d(8, 0, 0), b.radius = 2, b.error = 2, b.members = {10};
+  std::vector<FittedSphere> spheres{a, b};
+  EXPECT_GT(relieve_worst(problem, spheres, 1000), 0);
+  EXPECT_DOUBLE_EQ(std::max(spheres[0].error, spheres[1].error), minimax);
+  std::vector<int> joined = spheres[0].members;
+  joined.insert(joined.end(), spheres[1].members.begin(), spheres[1].members.end());
+  std::sort(joined.begin(), joined.end());
+  EXPECT_EQ(joined, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  for (const auto& s : spheres) {
+    for (int m : s.members) EXPECT_LE(std::abs(P(m, 0) - s.center.x()), s.radius);
+  }
+}
+
+TEST(Exchange, RelieveWorstNeverRaisesTheWorstAndKeepsCoverage) {
+  const auto torus = icd::make_torus(1.0, 0.3, 24, 12);
+  const auto samples = sample_surface(torus.V, torus.F, SamplingOptions{0.05});
+  const MedialSpheres medial;
+  const PointGrid grid(samples.points, 0.5);
+  const ReductionProblem problem{samples.points, samples.gap, medial, grid};
+  std::vector<FittedSphere> spheres = nearest_centre_spheres(samples.points, samples.gap, 10, 5);
+  // Make sphere 1 the worst: it takes every sample of sphere 2 but one.
+  auto& taker = spheres[1];
+  auto& giver = spheres[2];
+  taker.members.insert(taker.members.end(), giver.members.begin() + 1, giver.members.end());
+  std::sort(taker.members.begin(), taker.members.end());
+  giver.members.resize(1);
+  for (auto* sp : {&taker, &giver}) {
+    sp->radius = 0;
+    for (int m : sp->members) {
+      sp->radius = std::max(sp->radius, (samples.points.row(m).transpose() - sp->center).norm() + samples.gap[m]);
+    }
+    sp->error = sp->radius - sp->depth;
+  }
+  double worst_before = 0;
+  for (const auto& s : spheres) worst_before = std::max(worst_before, s.error);
+  // Sphere 0 may receive nothing.
+  relieve_worst(problem, spheres, 100000, [](int k, int) { return k != 0; });
+  double worst_after = 0;
+  std::vector<int> joined;
+  for (const auto& s : spheres) {
+    worst_after = std::max(worst_after, s.error);
+    EXPECT_FALSE(s.members.empty());
+    for (int m : s.members) {
+      EXPECT_LE((samples.points.row(m).transpose() - s.center).norm() + samples.gap[m], s.radius * (1 + 1e-12));
+    }
+    joined.insert(joined.end(), s.members.begin(), s.members.end());
+  }
+  EXPECT_LT(worst_after, worst_before);
+  std::sort(joined.begin(), joined.end());
+  EXPECT_EQ(static_cast<Eigen::Index>(joined.size()), samples.points.rows());
+  EXPECT_TRUE(std::adjacent_find(joined.begin(), joined.end()) == joined.end());
+}
+
 TEST(Exchange, RejectsBadOptions) {
   icd::MatX3d P(1, 3);
   P << 0, 0, 0;
@@ -115,6 +187,7 @@ TEST(Exchange, RejectsBadOptions) {
   ExchangeOptions o;
   o.rounds = -1;
   EXPECT_THROW(shrink_by_exchange(problem, spheres, o), icd::ParameterError);
+  EXPECT_THROW(relieve_worst(problem, spheres, -1), icd::ParameterError);
 }
 
 }  // namespace
