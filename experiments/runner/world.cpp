@@ -83,7 +83,10 @@ World::World(const Scene& scene, const std::filesystem::path& cache_dir,
       for (int n : o.spec.fixed_nodes) v.row(n).setZero();
       o.sim->set_velocities(v);
     }
-    if (o.plan.dense_update) o.dense = o.asset.dense.V;
+    if (o.plan.dense_update) {
+      o.dense = o.asset.dense.V;
+      o.links = coupling::LinkEvaluator(o.asset.links);  // after place_object (it scales the links)
+    }
     m_objects.push_back(std::move(o));
   }
   // Node masses for the mass-weighted response; objects without FEM never
@@ -113,7 +116,7 @@ int World::contact_cycles(double dt) const {
 
 void World::update_dense(RuntimeObject& o) {
   if (o.dense.rows() != o.asset.dense.V.rows()) o.dense.resize(o.asset.dense.V.rows(), 3);
-  coupling::apply(o.asset.links, o.positions, o.dense);
+  o.links.apply(o.positions, o.dense);
 }
 
 void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics& m) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "collision/traversal.hpp"
+#include "coupling/link_evaluator.hpp"
 #include "experiments/runner/object_asset.hpp"
 #include "experiments/runner/plan.hpp"
 #include "fem/simulator.hpp"
@@ -62,6 +63,7 @@ struct RuntimeObject {
   MatX3d rest;            ///< rest coarse positions, placed in the scene
   MatX3d contact_forces;  ///< forces from the last collision response (#V x 3)
   MatX3d dense;           ///< current dense positions (when the plan updates them)
+  coupling::LinkEvaluator links;  ///< the rigid links, grouped by node triple (when dense_update)
   MatX3d predicted;       ///< coarse positions half a cycle ahead (collision.midpoint)
   Eigen::VectorXd node_mass;  ///< lumped coarse node masses (kg); huge for objects without FEM
 };
