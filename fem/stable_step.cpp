@@ -98,6 +98,7 @@ FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free, const 
   Eigen::VectorXd w, ritz;
   double theta = 0;
   Eigen::VectorXd s_top;
+  Eigen::MatrixXd S;  // eigenvectors of the last tridiagonal matrix
   for (int j = 0; j < kmax; ++j) {
     apply(Q[j], w);
     alpha.push_back(Q[j].dot(w));
@@ -112,7 +113,8 @@ FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free, const 
     }
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T);
     theta = es.eigenvalues()[k - 1];
-    s_top = es.eigenvectors().col(k - 1);
+    S = es.eigenvectors();
+    s_top = S.col(k - 1);
     est.iterations = k;
     est.residual = std::abs(beta[j] * s_top[k - 1]) / std::max(std::abs(theta), 1e-300);
     if (est.residual <= options.tolerance || beta[j] <= 1e-14 * std::abs(theta)) {
@@ -121,9 +123,11 @@ FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free, const 
     }
     Q.push_back(w / beta[j]);
   }
-  if (warm) {
+  if (warm) {  // the sum of the top warm_modes Ritz vectors (orthonormal)
+    const int k = static_cast<int>(S.cols());
     ritz = Eigen::VectorXd::Zero(ndof);
-    for (int i = 0; i < static_cast<int>(s_top.size()); ++i) ritz += s_top[i] * Q[i];
+    for (int m = 0; m < std::min(options.warm_modes, k); ++m)
+      for (int i = 0; i < k; ++i) ritz += S(i, k - 1 - m) * Q[i];
     *warm = ritz;
   }
   *theta_out = theta;
@@ -131,9 +135,10 @@ FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free, const 
 }
 
 void check_options(const FrequencyOptions& options) {
-  if (options.max_iterations < 1 || !(options.contact_stiffness >= 0) || !(options.tolerance > 0))
-    throw ParameterError("fem::FrequencyOptions: expected max_iterations >= 1, tolerance > 0 and "
-                         "contact_stiffness >= 0");
+  if (options.max_iterations < 1 || !(options.contact_stiffness >= 0) || !(options.tolerance > 0) ||
+      options.warm_modes < 1)
+    throw ParameterError("fem::FrequencyOptions: expected max_iterations >= 1, tolerance > 0, "
+                         "contact_stiffness >= 0 and warm_modes >= 1");
 }
 
 // Free-dof mask and M^-1/2 per dof.

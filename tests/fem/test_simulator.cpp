@@ -30,7 +30,10 @@ TEST(Simulator, FixedStepAboveTheLimitIsRefusedNamingTheLimit) {
       EXPECT_NE(msg.find(std::to_string(limit).substr(0, 5)), std::string::npos) << msg << " vs " << limit;
     }
     EXPECT_THROW(over.step(1.05 * limit), ParameterError);
-    o.fixed_step = 0.99 * limit;
+    // Later frames re-estimate with a few warm Lanczos products and take the
+    // residual upper bound (and the sagging beam's omega_max moves), so their
+    // limit can be ~1% below the converged first one: 0.97 x stays under it.
+    o.fixed_step = 0.97 * limit;
     Simulator under(test::cantilever(1, mat), o);
     for (int f = 0; f < 30; ++f) under.advance(1.0 / 60);
     EXPECT_TRUE(under.positions().allFinite());

@@ -44,10 +44,12 @@ TEST(StableStep, LanczosMatchesDenseEigenvaluesAtRestCompressedAndWithContact) {
         EXPECT_TRUE(est.converged) << to_string(mm);
         EXPECT_NEAR(est.omega_max, dense_omega_max(model, *x, kc), 1e-4 * est.omega_max) << to_string(mm);
       }
-    // A warm start from the last Ritz vector converges in a few products.
+    // A warm start from the last top Ritz vector converges in a few products.
+    FrequencyOptions one;
+    one.warm_modes = 1;
     Eigen::VectorXd warm;
-    estimate_max_frequency(model, rest, {}, &warm);
-    EXPECT_LE(estimate_max_frequency(model, rest, {}, &warm).iterations, 3);
+    estimate_max_frequency(model, rest, one, &warm);
+    EXPECT_LE(estimate_max_frequency(model, rest, one, &warm).iterations, 3);
   }
 }
 
