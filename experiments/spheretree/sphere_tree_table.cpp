@@ -2,6 +2,7 @@
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
 //                   [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
+//                   [--exchange-rounds N] [--relieve-moves N]
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -103,7 +104,8 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
                  " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-                 " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] [--diagnose N]\n";
+                 " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] [--diagnose N]"
+                 " [--exchange-rounds N] [--relieve-moves N]\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -127,6 +129,8 @@ int main(int argc, char** argv) {
     else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
     else if (key == "--octree") with_octree = std::atoi(value) != 0;
     else if (key == "--diagnose") diagnose = std::atoi(value);
+    else if (key == "--exchange-rounds") options.exchange_rounds = std::atoi(value);
+    else if (key == "--relieve-moves") options.relieve_moves = std::atoi(value);
     else if (key == "--coverage-spacing") evaluation.coverage_spacing = std::atof(value);
     else if (key == "--reduction") {
       const std::string v = value;

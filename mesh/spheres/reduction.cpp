@@ -106,6 +106,26 @@ std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points, const std::vec
   return out;
 }
 
+/// The member farthest along each of 162 directions (vertices of a twice
+/// subdivided icosahedron), without duplicates.
+std::vector<Eigen::Vector3d> support_points(const MatX3d& points, const std::vector<int>& members) {
+  static const MatX3d dirs = make_icosphere(2, 1.0).V;
+  std::vector<double> best(static_cast<size_t>(dirs.rows()), -kInf);
+  std::vector<int> arg(static_cast<size_t>(dirs.rows()), members.front());
+  for (int s : members) {
+    const Eigen::Vector3d p = points.row(s).transpose();
+    for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
+      const double v = dirs(d, 0) * p.x() + dirs(d, 1) * p.y() + dirs(d, 2) * p.z();
+      if (v > best[static_cast<size_t>(d)]) best[static_cast<size_t>(d)] = v, arg[static_cast<size_t>(d)] = s;
+    }
+  }
+  std::sort(arg.begin(), arg.end());
+  arg.erase(std::unique(arg.begin(), arg.end()), arg.end());
+  std::vector<Eigen::Vector3d> out;
+  for (int s : arg) out.emplace_back(points.row(s).transpose());
+  return out;
+}
+
 double max_distance(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& c) {
   double best = 0;
   for (const auto& p : pts) best = std::max(best, (p - c).squaredNorm());
@@ -207,7 +227,14 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
 void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, FittedSphere& sphere,
                    int max_evaluations) {
   if (sphere.members.empty()) return;
-  const std::vector<Eigen::Vector3d> hull = extreme_points(problem.points, sphere.members);
+  // Large member sets: the search runs on their extreme points along 162
+  // directions (a slight underestimate of the farthest distance); the result
+  // is refitted exactly and kept only when it beats the exact starting point.
+  const std::vector<Eigen::Vector3d> hull = sphere.members.size() > 20000
+                                                ? support_points(problem.points, sphere.members)
+                                                : extreme_points(problem.points, sphere.members);
+  FittedSphere start = sphere;
+  refit_radius(problem, start);
   double gmax = 0;
   for (int s : sphere.members) gmax = std::max(gmax, problem.gap[s]);
   auto cost = [&](const Eigen::Vector3d& c, double depth) { return max_distance(hull, c) + gmax - depth; };
@@ -237,6 +264,7 @@ void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, Fi
   sphere.center = center;
   sphere.depth = depth;
   refit_radius(problem, sphere);
+  if (sphere.error > start.error) sphere = std::move(start);
 }
 
 void assign_and_refit(const ReductionProblem& problem, const std::vector<int>& members,
