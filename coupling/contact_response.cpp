@@ -129,12 +129,12 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
       acc_b(forces_b, b, options.distribution, options.mass_b);
   ContactStats stats;
   const double k = options.stiffness;
-  auto respond = [&](const NodePair& p) {
+  auto respond = [&](const NodePair& p, double cap) {
     const collision::Sphere& sa = a.spheres[p.a];
     const collision::Sphere& sb = b.spheres[p.b];
     const Eigen::Vector3d d = sb.center() - sa.center();
     const double dist = d.norm();
-    const double delta = sa.r + sb.r - dist;
+    const double delta = std::min(sa.r + sb.r - dist, cap);
     if (!(delta > 0.0)) return;
     const Eigen::Vector3d n = dist > 1e-12 * (sa.r + sb.r) ? Eigen::Vector3d(d / dist) : fallback;
     const Eigen::Vector3d f = k * delta * n;  // on b; -f on a (Eq. 11)
@@ -148,9 +148,12 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     stats.max_penetration = std::max(stats.max_penetration, delta);
     stats.penalty_energy += 0.5 * k * delta * delta;
   };
-  for (const NodePair& p : result.colliding) respond(p);
+  if (!(options.max_untested_penetration > 0.0))
+    throw ParameterError("contact response: max_untested_penetration must be positive (got " +
+                         std::to_string(options.max_untested_penetration) + ")");
+  for (const NodePair& p : result.colliding) respond(p, std::numeric_limits<double>::infinity());
   if (options.use_untested)
-    for (const NodePair& p : result.untested) respond(p);
+    for (const NodePair& p : result.untested) respond(p, options.max_untested_penetration);
   if (options.distribution == ContactDistribution::PaperAverage) {
     stats.total_force_a = acc_a.finish();
     stats.total_force_b = acc_b.finish();

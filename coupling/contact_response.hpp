@@ -8,6 +8,8 @@
 /// sphere a receives -k delta n, so the two objects always receive exactly
 /// opposite total forces. A sphere's force is passed to its associated coarse
 /// nodes V_i (the same nodes that steer its update).
+#include <limits>
+
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -40,6 +42,11 @@ struct ContactOptions {
   /// Apply forces for the untested pairs (PAIRLIST of an interrupted query, or
   /// pairs held back by a depth or list cap), assumed colliding (paper 4.2).
   bool use_untested = true;
+  /// Largest penetration credited to an untested pair (model units, > 0;
+  /// inf = none, the paper). Untested pairs are coarse spheres assumed
+  /// colliding; their overlap can be far deeper than the surfaces' (see
+  /// runner's on_interrupt). Colliding leaf pairs are never capped.
+  double max_untested_penetration = std::numeric_limits<double>::infinity();
   /// Direction used when two centres coincide (|O_b - O_a| < 1e-12 * (r_a + r_b)):
   /// normally the direction from object a's centroid to object b's. Normalised
   /// internally; a zero vector falls back to +z.

@@ -245,7 +245,7 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.on_interrupt = f.string("on_interrupt", "previous", {"untested", "previous"}) == "untested"
                        ? InterruptedResponse::Untested
                        : InterruptedResponse::Previous;
-  c.previous_max_age = f.number("previous_max_age", kInf, 0, kInf);
+  c.previous_max_age = f.number("previous_max_age", c.previous_max_age, 0, kInf);
   f.finish();
   return c;
 }

@@ -73,8 +73,9 @@ enum class InterruptedResponse {
   Untested,
   /// The last complete answer of the pair, if it is at most
   /// CollisionSpec::previous_max_age old, re-evaluated at the current sphere
-  /// positions; otherwise (no complete answer yet) as Untested.
-  /// The query's own lists (PAIRLIST, COLLISIONLIST) are still reported.
+  /// positions. If it is older, the untested pairs respond (as Untested) but
+  /// none deeper than that answer's deepest pair (when it had a contact).
+  /// With no complete answer yet: as Untested.
   Previous,
 };
 
@@ -107,11 +108,10 @@ struct CollisionSpec {
   collision::SphereUpdateOptions update;
   coupling::ContactOptions contact;
   InterruptedResponse on_interrupt = InterruptedResponse::Previous;
-  /// Oldest complete answer on_interrupt = "previous" reuses, simulated s
-  /// (inf: any). A deep contact can keep queries interrupted for many frames;
-  /// an old leaf-level answer then still pushes far less wrongly than the
-  /// untested inner spheres (whose overlap can be a large part of the objects).
-  double previous_max_age = std::numeric_limits<double>::infinity();
+  /// Oldest complete answer on_interrupt = "previous" reuses as is,
+  /// simulated s. Reusing an old answer misses contacts that began since
+  /// (a pair that was apart stays apart), so by default one 60 Hz frame.
+  double previous_max_age = 1.0 / 60;
 };
 
 /// What the run writes.

@@ -101,6 +101,7 @@ World::World(const Scene& scene, const std::filesystem::path& cache_dir,
   m_fronts.resize(m_plan.pairs.size());
   m_complete.resize(m_plan.pairs.size());
   m_complete_time.assign(m_plan.pairs.size(), -std::numeric_limits<double>::infinity());
+  m_complete_depth.assign(m_plan.pairs.size(), 0.0);
 }
 
 int World::contact_cycles(double dt) const {
@@ -228,16 +229,23 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       co.mass_a = &a.node_mass;
       co.mass_b = &b.node_mass;
       // An interrupted query answers with coarse spheres; with on_interrupt =
-      // "previous" the last complete answer (at most a frame old) stands in,
-      // evaluated at the current sphere positions.
-      const bool reuse = m_results[p].interrupted &&
-                         cs.on_interrupt == InterruptedResponse::Previous &&
-                         std::isfinite(m_complete_time[p]) &&
-                         t_end - m_complete_time[p] <= cs.previous_max_age;
+      // "previous" the last complete answer (if recent) stands in, evaluated
+      // at the current sphere positions; if it is older, the untested pairs
+      // respond (the paper) but with at most the penetration that answer had.
+      const collision::CollisionResult& r = m_results[p];
+      const bool previous = r.interrupted && cs.on_interrupt == InterruptedResponse::Previous &&
+                            std::isfinite(m_complete_time[p]);
+      // (relative slack: cycle end times are sums of h, the age of a
+      // one-frame-old answer can exceed 1 / frame_rate by rounding)
+      const bool reuse =
+          previous && t_end - m_complete_time[p] <= cs.previous_max_age * (1 + 1e-9);
+      if (previous && !reuse && m_complete_depth[p] > 0)
+        co.max_untested_penetration = m_complete_depth[p];
       if (reuse) ++m.reused;
       const coupling::ContactStats st = coupling::apply_contact_forces(
-          a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : m_results[p], co,
-          a.contact_forces, b.contact_forces);
+          a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : r, co, a.contact_forces,
+          b.contact_forces);
+      if (!r.interrupted) m_complete_depth[p] = st.max_penetration;
       m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
       m_penalty_energy += st.penalty_energy;
       m.max_penetration = std::max(m.max_penetration, st.max_penetration);
@@ -269,6 +277,7 @@ void World::save(Snapshot& s) const {
   s.fronts = m_fronts;
   s.complete = m_complete;
   s.complete_time = m_complete_time;
+  s.complete_depth = m_complete_depth;
   s.node_stiffness = m_node_stiffness;
 }
 
@@ -285,6 +294,7 @@ void World::restore(const Snapshot& s) {
   m_fronts = s.fronts;
   m_complete = s.complete;
   m_complete_time = s.complete_time;
+  m_complete_depth = s.complete_depth;
   m_node_stiffness = s.node_stiffness;
   m_penalty_energy = 0;  // the trial started contact-free
 }

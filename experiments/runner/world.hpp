@@ -103,7 +103,7 @@ class World {
     std::vector<MatX3d> positions, velocities;
     std::vector<std::vector<collision::NodePair>> fronts;
     std::vector<collision::CollisionResult> complete;
-    std::vector<double> complete_time;
+    std::vector<double> complete_time, complete_depth;
     double node_stiffness = 0;
   };
   void save(Snapshot& s) const;
@@ -127,6 +127,9 @@ class World {
   /// Last complete (not interrupted) answer of each pair and its simulated time.
   std::vector<collision::CollisionResult> m_complete;
   std::vector<double> m_complete_time;
+  /// Deepest penetration of the response to each pair's last complete answer
+  /// (0: it had no contact), m: caps untested pairs once that answer is too old.
+  std::vector<double> m_complete_depth;
   double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
   double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
   double m_penalty_energy = 0;  ///< penalty spring energy of the last response, J

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <Eigen/Dense>
@@ -52,6 +53,41 @@ TEST(ContactResponse, SinglePairFollowsEquation11) {
   EXPECT_NEAR(s.max_penetration, 0.5, 1e-15);
   EXPECT_LT((fb.row(0).transpose() - 100.0 * dir).norm(), 1e-12);
   EXPECT_LT((fa.row(0).transpose() + 100.0 * dir).norm(), 1e-12);
+}
+
+// The untested-pair cap: an untested pair (the roots, radii 10 and 10 at
+// distance 1.5: penetration 18.5) pushes with k * cap; a colliding leaf pair is never
+// capped; the penalty energy follows k delta^2 / 2 with the capped delta.
+TEST(ContactResponse, UntestedPenetrationCapAppliesToUntestedPairsOnly) {
+  const Eigen::Vector3d dir = Eigen::Vector3d(1, 2, 2) / 3.0;
+  const Eigen::Vector3d cb = 1.5 * dir;
+  const SphereTree a = make_tree({{0, 0, 0, 1}}, {{0}, {0}});
+  const SphereTree b = make_tree({{cb.x(), cb.y(), cb.z(), 1}}, {{0}, {0}}, {cb.x(), cb.y(), cb.z(), 10});
+  ContactOptions o;
+  o.stiffness = 200.0;
+  o.max_untested_penetration = 0.25;
+  MatX3d fa = MatX3d::Zero(1, 3), fb = MatX3d::Zero(1, 3);
+  CollisionResult untested;
+  untested.untested.push_back({0, 0});
+  ContactStats s = apply_contact_forces(a, b, untested, o, fa, fb);
+  EXPECT_NEAR(s.max_penetration, 0.25, 1e-15);
+  EXPECT_LT((fb.row(0).transpose() - 200.0 * 0.25 * dir).norm(), 1e-12);
+  EXPECT_NEAR(s.penalty_energy, 0.5 * 200.0 * 0.25 * 0.25, 1e-12);
+  o.max_untested_penetration = std::numeric_limits<double>::infinity();
+  fa.setZero();
+  fb.setZero();
+  s = apply_contact_forces(a, b, untested, o, fa, fb);
+  EXPECT_NEAR(s.max_penetration, 18.5, 1e-12);
+  // A colliding leaf pair is not capped.
+  o.max_untested_penetration = 0.25;
+  CollisionResult colliding;
+  colliding.colliding.push_back({1, 1});
+  fa.setZero();
+  fb.setZero();
+  s = apply_contact_forces(a, b, colliding, o, fa, fb);
+  EXPECT_NEAR(s.max_penetration, 0.5, 1e-15);
+  o.max_untested_penetration = 0;
+  EXPECT_THROW(apply_contact_forces(a, b, colliding, o, fa, fb), ParameterError);
 }
 
 // Random overlapping pairs, random associations: the total force on a is
