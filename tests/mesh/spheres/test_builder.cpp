@@ -181,6 +181,43 @@ TEST(SphereTreeBuilder, ErrorDecreasesFromLevelToLevel) {
   }
 }
 
+TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
+  // The joint option moves leaves across parents and refits the inner nodes
+  // bottom-up: every node must still cover its samples with margin, children
+  // divide their parent's samples, and every level covers a dense sampling.
+  const Case torus = cases()[2];
+  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  o.joint_leaf_refinement = true;
+  const SphereTreeBuild build = build_sphere_tree(torus.mesh, o);
+  const auto& tree = build.tree;
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  const auto& P = build.samples.points;
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    for (int m : build.node_samples[i]) {
+      ASSERT_LE((P.row(m).transpose() - tree.spheres[i].center()).norm() + build.samples.gap[m],
+                tree.spheres[i].r * (1 + 1e-12) + 1e-12);
+    }
+    if (tree.child_count[i] == 0) continue;
+    std::vector<int> joined;
+    for (int k = 0; k < tree.child_count[i]; ++k) {
+      const auto& cs = build.node_samples[tree.first_child[i] + k];
+      joined.insert(joined.end(), cs.begin(), cs.end());
+    }
+    std::sort(joined.begin(), joined.end());
+    EXPECT_EQ(joined, build.node_samples[i]) << "node " << i;
+  }
+  const icd::MatX3d D = dense_random_points(torus.mesh, 5000, 11);
+  for (int l = 0; l < tree.num_levels(); ++l) {
+    for (Eigen::Index p = 0; p < D.rows(); ++p) {
+      bool covered = false;
+      for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
+        covered = (D.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
+      }
+      ASSERT_TRUE(covered) << "level " << l << " point " << p;
+    }
+  }
+}
+
 TEST(SphereTreeBuilder, IsDeterministic) {
   const Case torus = cases()[2];
   const auto& a = cached_build(torus).tree;
