@@ -255,6 +255,17 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       }
     }
   }
+  // Past the staggered scheme's stability margin (explicit limit: omega h = 2)
+  // soften this response rather than let it pump energy.
+  if (m_plan.response && m_node_stiffness > 0) {
+    const double omega_h = std::sqrt(m_node_stiffness / m_min_node_mass) * h;
+    if (omega_h > kContactOmegaLimit) {
+      const double scale = (kContactOmegaLimit / omega_h) * (kContactOmegaLimit / omega_h);
+      for (RuntimeObject& o : m_objects) o.contact_forces *= scale;
+      m_penalty_energy *= scale;
+      ++m.softened;
+    }
+  }
   m.times.response += seconds_since(t0);
   if (last) m.energy += m_penalty_energy;
 

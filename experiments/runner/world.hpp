@@ -44,6 +44,9 @@ struct FrameMetrics {
   /// Interrupted queries whose response used the pair's previous complete
   /// answer (collision.on_interrupt = "previous").
   int reused = 0;
+  /// Cycles whose penalty forces were scaled down because the stiffness on
+  /// the lightest node exceeded what the cycle length allows (see kContactOmegaLimit).
+  int softened = 0;
   int substeps = 0;            ///< FEM sub-steps summed over objects
   double min_step = 0;         ///< smallest FEM step used, s
   /// Mechanical energy of the deformable objects, J: kinetic + elastic +
@@ -118,6 +121,10 @@ class World {
   /// Largest omega h of the staggered penalty (explicit limit 2; smaller
   /// values inject less energy per contact).
   static constexpr double kContactOmegaStep = 0.25;
+  /// Largest omega h a response may reach; beyond it (more cycles needed
+  /// than kMaxContactCycles, or stiffness jumping within a frame) its forces
+  /// are scaled by (kContactOmegaLimit / omega h)^2: a softer but stable penalty.
+  static constexpr double kContactOmegaLimit = 1.0;
 
   Scene m_scene;
   StagePlan m_plan;
