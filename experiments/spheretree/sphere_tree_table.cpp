@@ -11,9 +11,9 @@
 // and writes each tree as .sph and one VTU sphere set per level into RESULTS_DIR.
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -39,10 +39,12 @@ struct Model {
   std::string file;
 };
 
-void write_tree(const fs::path& dir, const std::string& stem, const icd::collision::SphereTree& tree) {
+void write_tree(const fs::path& dir, const std::string& stem,
+                const icd::collision::SphereTree& tree) {
   icd::collision::write_sph((dir / (stem + ".sph")).string(), tree, 8);
   for (int l = 0; l < tree.num_levels(); ++l) {
-    const int begin = tree.level_offset[static_cast<size_t>(l)], end = tree.level_offset[static_cast<size_t>(l) + 1];
+    const int begin = tree.level_offset[static_cast<size_t>(l)],
+              end = tree.level_offset[static_cast<size_t>(l) + 1];
     icd::SphereSet set;
     set.centers.resize(end - begin, 3);
     set.radii.resize(end - begin);
@@ -58,23 +60,25 @@ void write_tree(const fs::path& dir, const std::string& stem, const icd::collisi
 void print_table(const std::string& model, const std::string& method, double seconds,
                  const std::vector<icd::mesh::LevelMetrics>& levels) {
   for (const auto& m : levels) {
-    std::printf("%-7s %-7s %5d %7d %9.1f %8.2f %9.1f %8.2f %10.5f%% %8lld %7.2f %6d %9.1f %8.2f\n", model.c_str(),
-                method.c_str(), m.level, m.num_spheres, m.worst_error_42, m.mean_error_42, m.worst_error_162,
-                m.mean_error_162, 100.0 * m.uncovered_area_fraction, m.num_uncovered_samples, m.max_uncovered_gap,
+    std::printf("%-7s %-7s %5d %7d %9.1f %8.2f %9.1f %8.2f %10.5f%% %8lld %7.2f %6d %9.1f %8.2f\n",
+                model.c_str(), method.c_str(), m.level, m.num_spheres, m.worst_error_42,
+                m.mean_error_42, m.worst_error_162, m.mean_error_162,
+                100.0 * m.uncovered_area_fraction, m.num_uncovered_samples, m.max_uncovered_gap,
                 m.num_uncovered_vertices, m.max_child_protrusion, seconds);
   }
 }
 
 /// The `count` leaves with the largest 162-probe error: what limits the worst error.
-void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTreeBuild& build, double to_2000,
-                        int count) {
+void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTreeBuild& build,
+                        double to_2000, int count) {
   const icd::mesh::MeshOracle oracle(icd::mesh::close_holes(mesh));
   const icd::MatX3d dirs = icd::mesh::probe_directions(2);
   const auto& tree = build.tree;
   const int leaf_level = tree.num_levels() - 1;
   std::vector<int> parent(static_cast<size_t>(tree.num_nodes()), -1);
   for (int i = 0; i < tree.num_nodes(); ++i) {
-    for (int k = 0; k < tree.child_count[static_cast<size_t>(i)]; ++k) parent[static_cast<size_t>(tree.first_child[static_cast<size_t>(i)] + k)] = i;
+    for (int k = 0; k < tree.child_count[static_cast<size_t>(i)]; ++k)
+      parent[static_cast<size_t>(tree.first_child[static_cast<size_t>(i)] + k)] = i;
   }
   std::vector<std::pair<double, int>> errors;
   for (int i = tree.level_offset[static_cast<size_t>(leaf_level)]; i < tree.num_nodes(); ++i) {
@@ -91,10 +95,14 @@ void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTre
     const int i = errors[static_cast<size_t>(k)].second;
     const auto& s = tree.spheres[static_cast<size_t>(i)];
     const int p = parent[static_cast<size_t>(i)];
-    std::printf("# worst leaf %d: node %d error162 %.1f bound %.1f radius %.1f depth %.1f samples %zu, parent %d with %d children\n",
-                k, i, errors[static_cast<size_t>(k)].first, to_2000 * (s.r - build.node_depth[static_cast<size_t>(i)]),
-                to_2000 * s.r, to_2000 * build.node_depth[static_cast<size_t>(i)], build.node_samples[static_cast<size_t>(i)].size(),
-                p, p >= 0 ? tree.child_count[static_cast<size_t>(p)] : 0);
+    std::printf(
+        "# worst leaf %d: node %d error162 %.1f bound %.1f radius %.1f depth %.1f samples %zu, "
+        "parent %d with %d children\n",
+        k, i, errors[static_cast<size_t>(k)].first,
+        to_2000 * (s.r - build.node_depth[static_cast<size_t>(i)]), to_2000 * s.r,
+        to_2000 * build.node_depth[static_cast<size_t>(i)],
+        build.node_samples[static_cast<size_t>(i)].size(), p,
+        p >= 0 ? tree.child_count[static_cast<size_t>(p)] : 0);
   }
 }
 
@@ -102,10 +110,12 @@ void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTre
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::cerr << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
-                 " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-                 " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] [--diagnose N]"
-                 " [--exchange-rounds N] [--relieve-moves N]\n";
+    std::cerr
+        << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
+           " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
+           " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] "
+           "[--diagnose N]"
+           " [--exchange-rounds N] [--relieve-moves N]\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -120,29 +130,43 @@ int main(int argc, char** argv) {
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const char* value = argv[i + 1];
-    if (key == "--models") models_arg = value;
-    else if (key == "--time-limit") options.time_limit = std::atof(value);
-    else if (key == "--medial-spacing") options.medial_spacing = std::atof(value);
-    else if (key == "--cover-spacing") options.cover_spacing = std::atof(value);
-    else if (key == "--joint") options.joint_leaf_refinement = std::atoi(value) != 0;
-    else if (key == "--worst-share") options.worst_share = std::atof(value);
-    else if (key == "--lloyd") options.lloyd_iterations = std::atoi(value);
-    else if (key == "--octree") with_octree = std::atoi(value) != 0;
-    else if (key == "--diagnose") diagnose = std::atoi(value);
-    else if (key == "--exchange-rounds") options.exchange_rounds = std::atoi(value);
-    else if (key == "--relieve-moves") options.relieve_moves = std::atoi(value);
-    else if (key == "--coverage-spacing") evaluation.coverage_spacing = std::atof(value);
+    if (key == "--models")
+      models_arg = value;
+    else if (key == "--time-limit")
+      options.time_limit = std::atof(value);
+    else if (key == "--medial-spacing")
+      options.medial_spacing = std::atof(value);
+    else if (key == "--cover-spacing")
+      options.cover_spacing = std::atof(value);
+    else if (key == "--joint")
+      options.joint_leaf_refinement = std::atoi(value) != 0;
+    else if (key == "--worst-share")
+      options.worst_share = std::atof(value);
+    else if (key == "--lloyd")
+      options.lloyd_iterations = std::atoi(value);
+    else if (key == "--octree")
+      with_octree = std::atoi(value) != 0;
+    else if (key == "--diagnose")
+      diagnose = std::atoi(value);
+    else if (key == "--exchange-rounds")
+      options.exchange_rounds = std::atoi(value);
+    else if (key == "--relieve-moves")
+      options.relieve_moves = std::atoi(value);
+    else if (key == "--coverage-spacing")
+      evaluation.coverage_spacing = std::atof(value);
     else if (key == "--reduction") {
       const std::string v = value;
-      if (v == "split") options.reduction = icd::mesh::ReductionMethod::split_lloyd;
-      else if (v == "merge") options.reduction = icd::mesh::ReductionMethod::merge_burst;
-      else if (v == "both") options.reduction = icd::mesh::ReductionMethod::best_of_both;
+      if (v == "split")
+        options.reduction = icd::mesh::ReductionMethod::split_lloyd;
+      else if (v == "merge")
+        options.reduction = icd::mesh::ReductionMethod::merge_burst;
+      else if (v == "both")
+        options.reduction = icd::mesh::ReductionMethod::best_of_both;
       else {
         std::cerr << "unknown reduction " << v << "\n";
         return 2;
       }
-    }
-    else {
+    } else {
       std::cerr << "unknown option " << key << "\n";
       return 2;
     }
@@ -157,16 +181,18 @@ int main(int argc, char** argv) {
     if (name == "dragon") models.push_back({"dragon", "ChineseDragon-10kv.off"});
   }
 
-  std::printf("# errors in units where the longest bounding-box side is 2000; error = largest distance\n"
-              "# from a probe outside the (hole-closed) mesh to the surface; coverage on a dense\n"
-              "# sampling (spacing 1 unit), gap = largest distance of an uncovered sample to a sphere.\n");
-  std::printf("%-7s %-7s %5s %7s %9s %8s %9s %8s %11s %8s %7s %6s %9s %8s\n", "model", "method", "level", "spheres",
-              "worst42", "mean42", "worst162", "mean162", "uncovered", "unc.pts", "gap", "unc.v", "protrude",
-              "build_s");
+  std::printf(
+      "# errors in units where the longest bounding-box side is 2000; error = largest distance\n"
+      "# from a probe outside the (hole-closed) mesh to the surface; coverage on a dense\n"
+      "# sampling (spacing 1 unit), gap = largest distance of an uncovered sample to a sphere.\n");
+  std::printf("%-7s %-7s %5s %7s %9s %8s %9s %8s %11s %8s %7s %6s %9s %8s\n", "model", "method",
+              "level", "spheres", "worst42", "mean42", "worst162", "mean162", "uncovered",
+              "unc.pts", "gap", "unc.v", "protrude", "build_s");
   for (const auto& model : models) {
     const fs::path path = data / model.file;
     if (!fs::exists(path)) {
-      std::fprintf(stderr, "missing %s (run scripts/fetch_meshes.sh); skipped\n", path.string().c_str());
+      std::fprintf(stderr, "missing %s (run scripts/fetch_meshes.sh); skipped\n",
+                   path.string().c_str());
       continue;
     }
     const icd::SurfaceMesh mesh = icd::read_surface_mesh(path);
@@ -179,25 +205,36 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     icd::collision::OctreeTreeOptions octree_options;
     octree_options.levels = 4;
-    const icd::collision::SphereTree octree = icd::collision::build_octree_tree(mesh.V, mesh.F, octree_options);
-    const double octree_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const icd::collision::SphereTree octree =
+        icd::collision::build_octree_tree(mesh.V, mesh.F, octree_options);
+    const double octree_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    print_table(model.name, "medial", ours.seconds, icd::mesh::evaluate_sphere_tree(mesh, ours.tree, evaluation));
-    if (with_octree) print_table(model.name, "octree", octree_s, icd::mesh::evaluate_sphere_tree(mesh, octree, evaluation));
-    std::printf("# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f s, build CPU time %.1f s%s\n",
-                model.name.c_str(), static_cast<long long>(ours.samples.points.rows()), ours.num_medial_spheres,
-                ours.num_refinement_points, ours.medial_seconds, build_cpu_s, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+    print_table(model.name, "medial", ours.seconds,
+                icd::mesh::evaluate_sphere_tree(mesh, ours.tree, evaluation));
+    if (with_octree)
+      print_table(model.name, "octree", octree_s,
+                  icd::mesh::evaluate_sphere_tree(mesh, octree, evaluation));
+    std::printf(
+        "# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f "
+        "s, build CPU time %.1f s%s\n",
+        model.name.c_str(), static_cast<long long>(ours.samples.points.rows()),
+        ours.num_medial_spheres, ours.num_refinement_points, ours.medial_seconds, build_cpu_s,
+        ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // The builder's own error bound (radius - centre depth), normalized, per level.
-    const double to_2000 = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    const double to_2000 =
+        2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
     for (int l = 0; l < ours.tree.num_levels(); ++l) {
       double worst = 0, sum = 0;
-      const int begin = ours.tree.level_offset[static_cast<size_t>(l)], end = ours.tree.level_offset[static_cast<size_t>(l) + 1];
+      const int begin = ours.tree.level_offset[static_cast<size_t>(l)],
+                end = ours.tree.level_offset[static_cast<size_t>(l) + 1];
       for (int i = begin; i < end; ++i) {
-        const double bound = to_2000 * (ours.tree.spheres[static_cast<size_t>(i)].r - ours.node_depth[static_cast<size_t>(i)]);
+        const double bound = to_2000 * (ours.tree.spheres[static_cast<size_t>(i)].r -
+                                        ours.node_depth[static_cast<size_t>(i)]);
         worst = std::max(worst, bound), sum += bound;
       }
-      std::printf("# %s level %d: error bound r - depth: worst %.1f mean %.2f\n", model.name.c_str(), l, worst,
-                  sum / (end - begin));
+      std::printf("# %s level %d: error bound r - depth: worst %.1f mean %.2f\n",
+                  model.name.c_str(), l, worst, sum / (end - begin));
     }
     if (diagnose > 0) print_worst_leaves(mesh, ours, to_2000, diagnose);
     std::fflush(stdout);

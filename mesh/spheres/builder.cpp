@@ -37,8 +37,8 @@ void check_options(const SphereTreeOptions& o) {
 
 /// A node under construction: its sphere and its samples (coverage and medial).
 struct Node {
-  FittedSphere sphere;        // members = coverage samples
-  std::vector<int> medial;    // medial (coarse) samples
+  FittedSphere sphere;      // members = coverage samples
+  std::vector<int> medial;  // medial (coarse) samples
 };
 
 /// The children a parent gets for each child count k (configs[k - 1]).
@@ -64,10 +64,12 @@ bool better_config(const std::vector<FittedSphere>& a, const std::vector<FittedS
 /// each; give the first (1 - worst_share) of the extra spheres, one at a time,
 /// to the parent whose summed child error drops most, then the rest to the
 /// parent whose worst child error is largest.
-std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, int cap, double worst_share) {
+std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, int cap,
+                                   double worst_share) {
   std::vector<int> count(choices.size(), 1);
   const long long extra = std::max<long long>(0, cap - static_cast<long long>(choices.size()));
-  const auto by_worst = static_cast<long long>(std::llround(worst_share * static_cast<double>(extra)));
+  const auto by_worst =
+      static_cast<long long>(std::llround(worst_share * static_cast<double>(extra)));
   auto run = [&](long long n, bool worst_rule) {
     auto gain = [&](size_t p) {
       const int k = count[p];
@@ -101,9 +103,10 @@ std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, in
 /// samples from a neighbour of its parent), then restores the wrapped-tree
 /// invariant bottom-up: each inner node's samples become the union of its
 /// children's, and its sphere is re-centred and refitted to cover them.
-void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense, const MeshOracle& oracle,
-                   const SurfaceSamples& dense_samples, const MatX3i& F, const ReductionOptions& reduction,
-                   std::vector<std::vector<Node>>& levels, const std::vector<std::vector<int>>& parent_of) {
+void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense,
+                   const MeshOracle& oracle, const SurfaceSamples& dense_samples, const MatX3i& F,
+                   const ReductionOptions& reduction, std::vector<std::vector<Node>>& levels,
+                   const std::vector<std::vector<int>>& parent_of) {
   std::vector<Node>& leaves = levels.back();
   std::vector<FittedSphere> spheres;
   for (size_t i = 0; i < leaves.size(); ++i) {
@@ -122,7 +125,8 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
   }
   std::vector<int> dense_owner(static_cast<size_t>(dense.points.rows()), -1);
   for (size_t i = 0; i < leaves.size(); ++i) {
-    for (int s : leaves[i].sphere.members) dense_owner[static_cast<size_t>(s)] = static_cast<int>(i);
+    for (int s : leaves[i].sphere.members)
+      dense_owner[static_cast<size_t>(s)] = static_cast<int>(i);
   }
   auto reassign = [&]() {
     for (auto& sp : spheres) sp.members.clear();
@@ -131,13 +135,15 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
       if (best < 0) continue;
       const Eigen::Vector3d p = dense.points.row(static_cast<Eigen::Index>(s));
       auto cost = [&](int j) {
-        return (p - spheres[static_cast<size_t>(j)].center).norm() - spheres[static_cast<size_t>(j)].depth;
+        return (p - spheres[static_cast<size_t>(j)].center).norm() -
+               spheres[static_cast<size_t>(j)].depth;
       };
       double best_cost = cost(best);
       const int tri = dense_samples.face[static_cast<Eigen::Index>(s)];
       for (int k = 0; k < 3 && tri >= 0; ++k) {
         const int v = F(tri, k);
-        const int j = v < static_cast<int>(coarse_owner.size()) ? coarse_owner[static_cast<size_t>(v)] : -1;
+        const int j =
+            v < static_cast<int>(coarse_owner.size()) ? coarse_owner[static_cast<size_t>(v)] : -1;
         if (j < 0) continue;
         const double c = cost(j);
         if (c < best_cost) best_cost = c, best = j;
@@ -153,11 +159,13 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
   reassign();
   for (size_t i = 0; i < leaves.size(); ++i) {
     FittedSphere& sp = spheres[i];
-    if (sp.members.empty()) {  // lost everything: keep the old leaf (still valid, covers its old share)
+    if (sp.members
+            .empty()) {  // lost everything: keep the old leaf (still valid, covers its old share)
       continue;
     }
     double r = 0;
-    for (int m : sp.members) r = std::max(r, (dense.points.row(m).transpose() - sp.center).norm() + dense.gap[m]);
+    for (int m : sp.members)
+      r = std::max(r, (dense.points.row(m).transpose() - sp.center).norm() + dense.gap[m]);
     sp.radius = r;
     sp.error = r - sp.depth;
     leaves[i].sphere = sp;
@@ -187,8 +195,9 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
 /// node's samples become the union of its children's and its radius is
 /// refitted exactly.
 void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& oracle,
-                            std::vector<std::vector<Node>>& levels, const std::vector<std::vector<int>>& parent_of,
-                            int rounds, int relieve_moves) {
+                            std::vector<std::vector<Node>>& levels,
+                            const std::vector<std::vector<int>>& parent_of, int rounds,
+                            int relieve_moves) {
   const size_t last = levels.size() - 1;
   std::vector<FittedSphere> leaves;
   for (const Node& n : levels[last]) leaves.push_back(n.sphere);
@@ -241,7 +250,8 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
       std::sort(unions[p].begin(), unions[p].end());
       sp.members = std::move(unions[p]);
       double r = 0;
-      for (int s : sp.members) r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
+      for (int s : sp.members)
+        r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
       sp.radius = r;  // grows only within the level's worst error (accepts_growing)
       sp.error = r - sp.depth;
     }
@@ -263,7 +273,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
 
   // Samples: coverage (dense) on the input surface, medial (coarse) on the closed one.
   out.samples = sample_surface(input.V, input.F, SamplingOptions{options.cover_spacing * scale});
-  const SurfaceSamples medial_samples = sample_surface(closed.V, closed.F, SamplingOptions{options.medial_spacing * scale});
+  const SurfaceSamples medial_samples =
+      sample_surface(closed.V, closed.F, SamplingOptions{options.medial_spacing * scale});
   MedialAxisOptions medial_options;
   medial_options.refinement_iterations = options.refinement_iterations;
   medial_options.error_tolerance = options.refinement_tolerance * scale;
@@ -274,7 +285,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   out.medial_seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
   // The medial samples drive the placement; their margin is that of the coverage samples.
-  const Eigen::VectorXd medial_gap = Eigen::VectorXd::Constant(medial_samples.points.rows(), out.samples.gap.maxCoeff());
+  const Eigen::VectorXd medial_gap =
+      Eigen::VectorXd::Constant(medial_samples.points.rows(), out.samples.gap.maxCoeff());
   const ReductionProblem coarse{medial_samples.points, medial_gap, medial, grid};
   const ReductionProblem dense{out.samples.points, out.samples.gap, medial, grid};
   ReductionOptions reduction;
@@ -327,11 +339,13 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     }
     long long cap = 1;
     for (int i = 0; i < l; ++i) cap *= options.branching;
-    if (static_cast<int>(options.max_spheres_per_level.size()) > l && options.max_spheres_per_level[static_cast<size_t>(l)] > 0) {
+    if (static_cast<int>(options.max_spheres_per_level.size()) > l &&
+        options.max_spheres_per_level[static_cast<size_t>(l)] > 0) {
       cap = std::min<long long>(cap, options.max_spheres_per_level[static_cast<size_t>(l)]);
     }
     cap = std::max<long long>(cap, static_cast<long long>(parents.size()));
-    const std::vector<int> count = allocate_children(choices, static_cast<int>(std::min<long long>(cap, 1LL << 30)), options.worst_share);
+    const std::vector<int> count = allocate_children(
+        choices, static_cast<int>(std::min<long long>(cap, 1LL << 30)), options.worst_share);
 
     std::vector<Node> children;
     std::vector<int> parent_index;
@@ -370,7 +384,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   if (options.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
   }
-  if (options.leaf_exchange && levels.size() > 1) exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
+  if (options.leaf_exchange && levels.size() > 1)
+    exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
 
   // Flatten breadth-first: level by level, children of a node contiguous.
   collision::SphereTree& tree = out.tree;
@@ -399,7 +414,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     for (size_t i = 0; i < levels[l].size(); ++i) {
       const int parent = level_start[l - 1] + parent_of[l][i];
       const int node = level_start[l] + static_cast<int>(i);
-      if (tree.first_child[static_cast<size_t>(parent)] < 0) tree.first_child[static_cast<size_t>(parent)] = node;
+      if (tree.first_child[static_cast<size_t>(parent)] < 0)
+        tree.first_child[static_cast<size_t>(parent)] = node;
       tree.child_count[static_cast<size_t>(parent)] += 1;
     }
   }

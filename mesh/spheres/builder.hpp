@@ -44,11 +44,12 @@ struct SphereTreeOptions {
   /// Spacing of the samples whose Voronoi diagram gives the medial axis and
   /// on which the spheres are placed (relative, >= cover_spacing).
   double medial_spacing = 1.0 / 25.0;
-  int refinement_iterations = 2;          ///< adaptive medial-axis rounds (>= 0)
-  double refinement_tolerance = 0.002;    ///< medial sphere error that triggers refinement (relative)
-  int lloyd_iterations = 8;               ///< see ReductionOptions
-  ReductionMethod reduction = ReductionMethod::split_lloyd;  ///< see ReductionMethod (split_lloyd measured best)
-  int merge_burst_lloyd_iterations = 4;   ///< see MergeBurstOptions::lloyd_iterations
+  int refinement_iterations = 2;        ///< adaptive medial-axis rounds (>= 0)
+  double refinement_tolerance = 0.002;  ///< medial sphere error that triggers refinement (relative)
+  int lloyd_iterations = 8;             ///< see ReductionOptions
+  ReductionMethod reduction =
+      ReductionMethod::split_lloyd;      ///< see ReductionMethod (split_lloyd measured best)
+  int merge_burst_lloyd_iterations = 4;  ///< see MergeBurstOptions::lloyd_iterations
   /// Rounds of boundary exchange among the children of each node, each
   /// followed by a centre polish (see shrink_by_exchange, polish_sphere; >= 0).
   int exchange_rounds = 2;
@@ -71,17 +72,17 @@ struct SphereTreeOptions {
 
 /// Result of build_sphere_tree().
 struct SphereTreeBuild {
-  collision::SphereTree tree;          ///< spheres in model units; assoc_* left empty
-  SurfaceSamples samples;              ///< the coverage samples
+  collision::SphereTree tree;  ///< spheres in model units; assoc_* left empty
+  SurfaceSamples samples;      ///< the coverage samples
   /// Coverage samples of each node: node i covers samples node_samples[i]
   /// with margin (|s - c| + gap[s] <= r); its children divide them.
   std::vector<std::vector<int>> node_samples;
-  std::vector<double> node_depth;      ///< distance from each centre to the surface
-  int num_medial_spheres = 0;          ///< medial spheres (Voronoi + cover) after refinement
-  int num_refinement_points = 0;       ///< points added by the adaptive refinement
-  double seconds = 0;                  ///< wall-clock build time
-  double medial_seconds = 0;           ///< of which sampling + medial axis
-  bool hit_time_limit = false;         ///< true when the optimisation was cut short
+  std::vector<double> node_depth;  ///< distance from each centre to the surface
+  int num_medial_spheres = 0;      ///< medial spheres (Voronoi + cover) after refinement
+  int num_refinement_points = 0;   ///< points added by the adaptive refinement
+  double seconds = 0;              ///< wall-clock build time
+  double medial_seconds = 0;       ///< of which sampling + medial axis
+  bool hit_time_limit = false;     ///< true when the optimisation was cut short
 };
 
 /// Builds the wrapped sphere tree of the triangle mesh (V #V x 3, F #F x 3,

@@ -25,7 +25,8 @@ class SphereGrid {
   SphereGrid(std::vector<collision::Sphere> spheres) : m_spheres(std::move(spheres)) {
     std::vector<double> radii;
     for (const auto& s : m_spheres) radii.push_back(s.r);
-    std::nth_element(radii.begin(), radii.begin() + static_cast<long>(radii.size() / 2), radii.end());
+    std::nth_element(radii.begin(), radii.begin() + static_cast<long>(radii.size() / 2),
+                     radii.end());
     m_cell = std::max(radii[radii.size() / 2], 1e-9);
     for (int i = 0; i < static_cast<int>(m_spheres.size()); ++i) {
       const auto& s = m_spheres[static_cast<size_t>(i)];
@@ -66,11 +67,13 @@ class SphereGrid {
     return (p - s.center()).squaredNorm() <= s.r * s.r;
   }
   Eigen::Vector3i cell(const Eigen::Vector3d& p) const {
-    return {static_cast<int>(std::floor(p.x() / m_cell)), static_cast<int>(std::floor(p.y() / m_cell)),
+    return {static_cast<int>(std::floor(p.x() / m_cell)),
+            static_cast<int>(std::floor(p.y() / m_cell)),
             static_cast<int>(std::floor(p.z() / m_cell))};
   }
   static long long key(const Eigen::Vector3i& c) {
-    return (static_cast<long long>(c.x()) * 73856093LL) ^ (static_cast<long long>(c.y()) * 19349663LL) ^
+    return (static_cast<long long>(c.x()) * 73856093LL) ^
+           (static_cast<long long>(c.y()) * 19349663LL) ^
            (static_cast<long long>(c.z()) * 83492791LL);
   }
 
@@ -83,12 +86,14 @@ class SphereGrid {
 void check_tree(const collision::SphereTree& tree) {
   const int n = tree.num_nodes();
   if (n == 0 || tree.num_levels() < 1 || tree.level_offset.back() != n ||
-      static_cast<int>(tree.first_child.size()) != n || static_cast<int>(tree.child_count.size()) != n) {
+      static_cast<int>(tree.first_child.size()) != n ||
+      static_cast<int>(tree.child_count.size()) != n) {
     throw ParameterError("evaluate_sphere_tree: the tree is empty or its arrays are inconsistent");
   }
   for (const auto& s : tree.spheres) {
     if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || !(s.r >= 0)) {
-      throw ParameterError("evaluate_sphere_tree: a sphere has a non-finite centre or a negative radius");
+      throw ParameterError(
+          "evaluate_sphere_tree: a sphere has a non-finite centre or a negative radius");
     }
   }
 }
@@ -97,10 +102,12 @@ void check_tree(const collision::SphereTree& tree) {
 
 MatX3d probe_directions(int subdivisions) { return make_icosphere(subdivisions, 1.0).V; }
 
-std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh, const collision::SphereTree& tree,
+std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
+                                               const collision::SphereTree& tree,
                                                const EvaluationOptions& options) {
   if (!(options.normalized_size > 0) || !(options.coverage_spacing > 0)) {
-    throw ParameterError("EvaluationOptions: normalized_size and coverage_spacing must be positive");
+    throw ParameterError(
+        "EvaluationOptions: normalized_size and coverage_spacing must be positive");
   }
   check_tree(tree);
   const double side = longest_bounding_box_side(mesh.V);
@@ -134,7 +141,8 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh, const co
   for (int l = 0; l < num_levels; ++l) {
     LevelMetrics& m = out[static_cast<size_t>(l)];
     m.level = l;
-    const int begin = tree.level_offset[static_cast<size_t>(l)], end = tree.level_offset[static_cast<size_t>(l) + 1];
+    const int begin = tree.level_offset[static_cast<size_t>(l)],
+              end = tree.level_offset[static_cast<size_t>(l) + 1];
     m.num_spheres = end - begin;
     for (int i = begin; i < end; ++i) {
       const auto& s = spheres[static_cast<size_t>(i)];
@@ -146,10 +154,12 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh, const co
       const int p = parent[static_cast<size_t>(i)];
       if (p >= 0) {
         const auto& ps = spheres[static_cast<size_t>(p)];
-        m.max_child_protrusion = std::max(m.max_child_protrusion, (s.center() - ps.center()).norm() + s.r - ps.r);
+        m.max_child_protrusion =
+            std::max(m.max_child_protrusion, (s.center() - ps.center()).norm() + s.r - ps.r);
       }
     }
-    grids.emplace_back(std::vector<collision::Sphere>(spheres.begin() + begin, spheres.begin() + end));
+    grids.emplace_back(
+        std::vector<collision::Sphere>(spheres.begin() + begin, spheres.begin() + end));
     for (Eigen::Index v = 0; v < scaled.V.rows(); ++v) {
       if (!grids.back().covered(scaled.V.row(v))) ++m.num_uncovered_vertices;
     }

@@ -28,11 +28,12 @@ struct LevelMetrics {
   /// lie outside the closed mesh (0 when none does). Worst and mean over the level.
   double worst_error_42 = 0, mean_error_42 = 0;
   double worst_error_162 = 0, mean_error_162 = 0;
-  double uncovered_area_fraction = 0;  ///< area of dense samples outside every sphere / total area
-  long long num_dense_samples = 0;     ///< dense samples tested
-  long long num_uncovered_samples = 0; ///< dense samples outside every sphere of the level
-  double max_uncovered_gap = 0;        ///< largest distance from an uncovered sample to the nearest sphere
-  int num_uncovered_vertices = 0;      ///< mesh vertices outside every sphere of the level
+  double uncovered_area_fraction = 0;   ///< area of dense samples outside every sphere / total area
+  long long num_dense_samples = 0;      ///< dense samples tested
+  long long num_uncovered_samples = 0;  ///< dense samples outside every sphere of the level
+  double max_uncovered_gap =
+      0;  ///< largest distance from an uncovered sample to the nearest sphere
+  int num_uncovered_vertices = 0;  ///< mesh vertices outside every sphere of the level
   /// How far the level's spheres stick out of their parents (max over nodes
   /// of |c - c_parent| + r - r_parent, >= 0; 0 for the root).
   double max_child_protrusion = 0;
@@ -44,7 +45,8 @@ struct LevelMetrics {
 /// close_holes) before any inside test; coverage is measured on the input
 /// surface. Throws ParameterError for bad options or an invalid tree (see
 /// collision::validate), InputError for an empty or degenerate mesh.
-std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh, const collision::SphereTree& tree,
+std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
+                                               const collision::SphereTree& tree,
                                                const EvaluationOptions& options = {});
 
 /// The probe directions: vertices of the icosahedron subdivided `subdivisions`

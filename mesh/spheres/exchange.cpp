@@ -10,7 +10,8 @@
 namespace icd::mesh {
 
 int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere>& spheres,
-                       const ExchangeOptions& options, const std::function<bool(int, int)>& accepts) {
+                       const ExchangeOptions& options,
+                       const std::function<bool(int, int)>& accepts) {
   if (options.rounds < 0 || options.max_moves_per_sphere < 1) {
     throw ParameterError("ExchangeOptions: rounds must be >= 0 and max_moves_per_sphere >= 1");
   }
@@ -26,7 +27,8 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
       for (int b = 0; b < n; ++b) {
         const auto& A = spheres[static_cast<size_t>(a)];
         const auto& B = spheres[static_cast<size_t>(b)];
-        if (a != b && (A.center - B.center).norm() <= A.radius + B.radius) overlapping[static_cast<size_t>(a)].push_back(b);
+        if (a != b && (A.center - B.center).norm() <= A.radius + B.radius)
+          overlapping[static_cast<size_t>(a)].push_back(b);
       }
     }
     std::vector<int> order(static_cast<size_t>(n));
@@ -38,7 +40,8 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
     for (int j : order) {
       FittedSphere& sp = spheres[static_cast<size_t>(j)];
       // Samples received earlier in this pass were appended: restore the order.
-      if (!std::is_sorted(sp.members.begin(), sp.members.end())) std::sort(sp.members.begin(), sp.members.end());
+      if (!std::is_sorted(sp.members.begin(), sp.members.end()))
+        std::sort(sp.members.begin(), sp.members.end());
       if (sp.members.size() <= 1) continue;
       // Members farthest first, popped lazily from a heap (most never leave).
       std::vector<std::pair<double, int>> heap;
@@ -74,7 +77,8 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
       moved_round += static_cast<int>(leaving.size());
     }
     for (auto& other : spheres) {
-      if (!std::is_sorted(other.members.begin(), other.members.end())) std::sort(other.members.begin(), other.members.end());
+      if (!std::is_sorted(other.members.begin(), other.members.end()))
+        std::sort(other.members.begin(), other.members.end());
     }
     moved_total += moved_round;
     if (moved_round == 0) break;
@@ -82,8 +86,8 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
   return moved_total;
 }
 
-int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& spheres, int max_moves,
-                  const std::function<bool(int, int)>& accepts) {
+int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& spheres,
+                  int max_moves, const std::function<bool(int, int)>& accepts) {
   if (max_moves < 0) throw ParameterError("relieve_worst: max_moves must be >= 0");
   const int n = static_cast<int>(spheres.size());
   if (n < 2) return 0;
@@ -95,7 +99,8 @@ int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& sp
   std::vector<int> size(static_cast<size_t>(n));
   for (int j = 0; j < n; ++j) {
     auto& h = heaps[static_cast<size_t>(j)];
-    for (int s : spheres[static_cast<size_t>(j)].members) h.emplace_back(reach(s, spheres[static_cast<size_t>(j)]), -s);
+    for (int s : spheres[static_cast<size_t>(j)].members)
+      h.emplace_back(reach(s, spheres[static_cast<size_t>(j)]), -s);
     std::make_heap(h.begin(), h.end());
     size[static_cast<size_t>(j)] = static_cast<int>(h.size());
   }

@@ -40,7 +40,7 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
 /// may grow, below it); every sample stays covered with margin and in
 /// exactly one sphere. A sphere keeps at least one member. Returns the number
 /// of moves. Deterministic. Throws ParameterError for max_moves < 0.
-int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& spheres, int max_moves,
-                  const std::function<bool(int receiver, int sample)>& accepts = {});
+int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& spheres,
+                  int max_moves, const std::function<bool(int receiver, int sample)>& accepts = {});
 
 }  // namespace icd::mesh

@@ -29,7 +29,9 @@ struct CellInfo {
   double inscribed = 0;
 };
 using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
-using Cb = CGAL::Triangulation_cell_base_with_info_3<CellInfo, Kernel, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+using Cb =
+    CGAL::Triangulation_cell_base_with_info_3<CellInfo, Kernel,
+                                              CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
 
@@ -94,14 +96,16 @@ std::vector<InnerVertex> inner_vertices(Delaunay& dt, const MeshOracle& oracle) 
 MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSamples& samples,
                                       const MedialAxisOptions& options) {
   if (options.refinement_iterations < 0 || options.max_insertions_per_iteration < 0) {
-    throw ParameterError("MedialAxisOptions: refinement_iterations and max_insertions_per_iteration must be >= 0");
+    throw ParameterError(
+        "MedialAxisOptions: refinement_iterations and max_insertions_per_iteration must be >= 0");
   }
   if (!(options.error_tolerance > 0)) {
     throw ParameterError("MedialAxisOptions::error_tolerance must be positive, got " +
                          std::to_string(options.error_tolerance));
   }
   const auto ns = static_cast<int>(samples.points.rows());
-  if (ns < 4) throw InputError("approximate_medial_axis: need at least 4 samples, got " + std::to_string(ns));
+  if (ns < 4)
+    throw InputError("approximate_medial_axis: need at least 4 samples, got " + std::to_string(ns));
 
   std::vector<std::pair<Point, int>> input;
   input.reserve(static_cast<size_t>(ns));
@@ -118,7 +122,8 @@ MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSam
     // Worst spheres first, so that the insertion budget goes where the error is.
     std::vector<std::pair<double, int>> bad;
     for (int i = 0; i < static_cast<int>(inner.size()); ++i) {
-      const double err = inner[static_cast<size_t>(i)].circumradius - inner[static_cast<size_t>(i)].inscribed;
+      const double err =
+          inner[static_cast<size_t>(i)].circumradius - inner[static_cast<size_t>(i)].inscribed;
       if (err > options.error_tolerance) bad.emplace_back(-err, i);
     }
     if (bad.empty()) break;

@@ -26,11 +26,11 @@ struct MedialAxisOptions {
 /// centre to the surface, so every sphere lies inside the object), and for
 /// the Voronoi ones the Delaunay circumradius (distance to the nearest sample).
 struct MedialSpheres {
-  MatX3d centers;                ///< #M x 3 centres (inside the closed mesh)
-  Eigen::VectorXd radii;         ///< #M inscribed radii (distance to the surface, >= 0)
-  Eigen::VectorXd circumradii;   ///< #M distance to the nearest sample (>= radii up to sampling)
-  int num_voronoi = 0;           ///< the first num_voronoi are Voronoi vertices, the rest cover spheres
-  int num_inserted = 0;          ///< points added by the adaptive refinement
+  MatX3d centers;               ///< #M x 3 centres (inside the closed mesh)
+  Eigen::VectorXd radii;        ///< #M inscribed radii (distance to the surface, >= 0)
+  Eigen::VectorXd circumradii;  ///< #M distance to the nearest sample (>= radii up to sampling)
+  int num_voronoi = 0;   ///< the first num_voronoi are Voronoi vertices, the rest cover spheres
+  int num_inserted = 0;  ///< points added by the adaptive refinement
 };
 
 /// Builds the medial-sphere set of the closed mesh behind `oracle` from the

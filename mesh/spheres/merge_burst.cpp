@@ -33,7 +33,7 @@ struct Cluster {
   std::vector<int> members;
   std::vector<int> support;     // one sample per support direction
   std::vector<int> neighbours;  // sorted cluster ids
-  std::vector<int> pool;        // initial clusters absorbed (their centres are the merge candidates)
+  std::vector<int> pool;  // initial clusters absorbed (their centres are the merge candidates)
   long long version = 0;
   bool alive = true;
   double error() const { return radius - depth; }
@@ -56,8 +56,8 @@ class MergeBurst {
   MergeBurst(const ReductionProblem& problem, const MergeBurstOptions& options)
       : m_problem(problem), m_options(options) {}
 
-  std::vector<std::vector<FittedSphere>> run(const std::vector<int>& owners, const std::vector<int>& members,
-                                             int max_k) {
+  std::vector<std::vector<FittedSphere>> run(const std::vector<int>& owners,
+                                             const std::vector<int>& members, int max_k) {
     init(owners, members);
     std::vector<std::vector<FittedSphere>> snapshots(static_cast<size_t>(max_k));
     int alive = static_cast<int>(m_clusters.size());
@@ -120,11 +120,13 @@ class MergeBurst {
     }
     // Neighbours: clusters with samples closer than neighbour_radius.
     MatX3d P(static_cast<Eigen::Index>(members.size()), 3);
-    for (size_t m = 0; m < members.size(); ++m) P.row(static_cast<Eigen::Index>(m)) = m_problem.points.row(members[m]);
+    for (size_t m = 0; m < members.size(); ++m)
+      P.row(static_cast<Eigen::Index>(m)) = m_problem.points.row(members[m]);
     const PointGrid grid(P, m_options.neighbour_radius);
     for (size_t m = 0; m < members.size(); ++m) {
       const int a = cluster_of_member[m];
-      for (int n : grid.query_ball(P.row(static_cast<Eigen::Index>(m)).transpose(), m_options.neighbour_radius)) {
+      for (int n : grid.query_ball(P.row(static_cast<Eigen::Index>(m)).transpose(),
+                                   m_options.neighbour_radius)) {
         const int b = cluster_of_member[static_cast<size_t>(n)];
         if (a != b) m_clusters[static_cast<size_t>(a)].neighbours.push_back(b);
       }
@@ -153,13 +155,15 @@ class MergeBurst {
       c.gmax = std::max(c.gmax, m_problem.gap[s]);
       for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
         const double v = dirs.row(d).dot(p);
-        if (v > best[static_cast<size_t>(d)]) best[static_cast<size_t>(d)] = v, c.support[static_cast<size_t>(d)] = s;
+        if (v > best[static_cast<size_t>(d)])
+          best[static_cast<size_t>(d)] = v, c.support[static_cast<size_t>(d)] = s;
       }
     }
     c.version = ++m_clock;
   }
 
-  /// Best centre for the union of clusters a and b: (error bound, centre index or -1 for a, -2 for b).
+  /// Best centre for the union of clusters a and b: (error bound, centre index or -1 for a, -2 for
+  /// b).
   std::pair<double, int> evaluate_merge(int a, int b) const {
     const Cluster& A = m_clusters[static_cast<size_t>(a)];
     const Cluster& B = m_clusters[static_cast<size_t>(b)];
@@ -167,12 +171,15 @@ class MergeBurst {
     std::vector<Eigen::Vector3d> support;
     for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
       const int sa = A.support[static_cast<size_t>(d)], sb = B.support[static_cast<size_t>(d)];
-      support.push_back(dirs.row(d).dot(point(sa).transpose()) >= dirs.row(d).dot(point(sb).transpose()) ? point(sa)
-                                                                                                     : point(sb));
+      support.push_back(dirs.row(d).dot(point(sa).transpose()) >=
+                                dirs.row(d).dot(point(sb).transpose())
+                            ? point(sa)
+                            : point(sb));
     }
-    std::sort(support.begin(), support.end(), [](const Eigen::Vector3d& x, const Eigen::Vector3d& y) {
-      return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3);
-    });
+    std::sort(support.begin(), support.end(),
+              [](const Eigen::Vector3d& x, const Eigen::Vector3d& y) {
+                return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3);
+              });
     support.erase(std::unique(support.begin(), support.end()), support.end());
     const double gmax = std::max(A.gmax, B.gmax);
     auto cost = [&](const Eigen::Vector3d& c, double depth) {
@@ -221,20 +228,23 @@ class MergeBurst {
     }
     double worst = 0;
     for (size_t j = 0; j < A.neighbours.size(); ++j) {
-      if (receives[j]) worst = std::max(worst, radius[j] - m_clusters[static_cast<size_t>(A.neighbours[j])].depth);
+      if (receives[j])
+        worst = std::max(worst, radius[j] - m_clusters[static_cast<size_t>(A.neighbours[j])].depth);
     }
     return worst;
   }
 
   long long neighbourhood_version(int a) const {
     long long sum = 0;
-    for (int n : m_clusters[static_cast<size_t>(a)].neighbours) sum += m_clusters[static_cast<size_t>(n)].version;
+    for (int n : m_clusters[static_cast<size_t>(a)].neighbours)
+      sum += m_clusters[static_cast<size_t>(n)].version;
     return sum + static_cast<long long>(m_clusters[static_cast<size_t>(a)].neighbours.size());
   }
 
   bool current(const Op& op) const {
     const Cluster& A = m_clusters[static_cast<size_t>(op.a)];
-    if (op.b >= 0) return A.version == op.va && m_clusters[static_cast<size_t>(op.b)].version == op.vb;
+    if (op.b >= 0)
+      return A.version == op.va && m_clusters[static_cast<size_t>(op.b)].version == op.vb;
     return A.version == op.va && neighbourhood_version(op.a) == op.vb;
   }
 
@@ -245,7 +255,9 @@ class MergeBurst {
                      m_clusters[static_cast<size_t>(b)].version});
     } else if (m_options.allow_burst) {
       const double key = evaluate_burst(a);
-      if (key < kInf) m_heap.push(Op{key, a, -1, m_clusters[static_cast<size_t>(a)].version, neighbourhood_version(a)});
+      if (key < kInf)
+        m_heap.push(
+            Op{key, a, -1, m_clusters[static_cast<size_t>(a)].version, neighbourhood_version(a)});
     }
   }
 
@@ -299,7 +311,8 @@ class MergeBurst {
       A.center = m_centers.row(idx).transpose(), A.depth = m_depths[idx];
     }
     std::vector<int> joined;
-    std::merge(A.members.begin(), A.members.end(), B.members.begin(), B.members.end(), std::back_inserter(joined));
+    std::merge(A.members.begin(), A.members.end(), B.members.begin(), B.members.end(),
+               std::back_inserter(joined));
     A.members = std::move(joined);
     B.members.clear();
     A.pool.insert(A.pool.end(), B.pool.begin(), B.pool.end());
@@ -378,7 +391,8 @@ class MergeBurst {
 
 std::vector<int> medial_owners(const ReductionProblem& problem, double search_radius) {
   if (!(search_radius > 0)) {
-    throw ParameterError("medial_owners: search_radius must be positive, got " + std::to_string(search_radius));
+    throw ParameterError("medial_owners: search_radius must be positive, got " +
+                         std::to_string(search_radius));
   }
   const auto ns = static_cast<int>(problem.points.rows());
   std::vector<int> owners(static_cast<size_t>(ns), -1);
@@ -391,7 +405,8 @@ std::vector<int> medial_owners(const ReductionProblem& problem, double search_ra
     }
     double best = kInf;
     for (int m : cands) {
-      const double v = (p - problem.medial.centers.row(m).transpose()).norm() - problem.medial.radii[m];
+      const double v =
+          (p - problem.medial.centers.row(m).transpose()).norm() - problem.medial.radii[m];
       if (v < best) best = v, owners[static_cast<size_t>(s)] = m;
     }
   }
@@ -400,22 +415,29 @@ std::vector<int> medial_owners(const ReductionProblem& problem, double search_ra
 
 std::vector<std::vector<FittedSphere>> merge_burst_reduce(const ReductionProblem& problem,
                                                           const std::vector<int>& owners,
-                                                          const std::vector<int>& members, int max_k,
+                                                          const std::vector<int>& members,
+                                                          int max_k,
                                                           const ReductionOptions& reduction,
                                                           const MergeBurstOptions& options) {
-  if (max_k < 1) throw ParameterError("merge_burst_reduce: max_k must be >= 1, got " + std::to_string(max_k));
+  if (max_k < 1)
+    throw ParameterError("merge_burst_reduce: max_k must be >= 1, got " + std::to_string(max_k));
   if (members.empty()) throw ParameterError("merge_burst_reduce: no samples to cover");
-  if (!(options.neighbour_radius > 0) || options.merge_candidates < 1 || options.lloyd_iterations < 0) {
-    throw ParameterError("MergeBurstOptions: neighbour_radius must be > 0, merge_candidates >= 1, lloyd_iterations >= 0");
+  if (!(options.neighbour_radius > 0) || options.merge_candidates < 1 ||
+      options.lloyd_iterations < 0) {
+    throw ParameterError(
+        "MergeBurstOptions: neighbour_radius must be > 0, merge_candidates >= 1, lloyd_iterations "
+        ">= 0");
   }
   if (owners.size() != static_cast<size_t>(problem.points.rows())) {
-    throw ParameterError("merge_burst_reduce: need one owner per sample (" + std::to_string(problem.points.rows()) +
-                         "), got " + std::to_string(owners.size()));
+    throw ParameterError("merge_burst_reduce: need one owner per sample (" +
+                         std::to_string(problem.points.rows()) + "), got " +
+                         std::to_string(owners.size()));
   }
   for (int s : members) {
     const int o = owners[static_cast<size_t>(s)];
     if (o < 0 || o >= problem.medial.centers.rows()) {
-      throw ParameterError("merge_burst_reduce: sample " + std::to_string(s) + " has no medial owner");
+      throw ParameterError("merge_burst_reduce: sample " + std::to_string(s) +
+                           " has no medial owner");
     }
   }
   MergeBurst mb(problem, options);
@@ -428,12 +450,14 @@ std::vector<std::vector<FittedSphere>> merge_burst_reduce(const ReductionProblem
       continue;
     }
     refine_jointly(problem, config, lloyd);
-    config.erase(std::remove_if(config.begin(), config.end(), [](const FittedSphere& s) { return s.members.empty(); }),
+    config.erase(std::remove_if(config.begin(), config.end(),
+                                [](const FittedSphere& s) { return s.members.empty(); }),
                  config.end());
   }
   // Counts above the number of initial spheres were never met: repeat the largest configuration.
   for (int k = 2; k <= max_k; ++k) {
-    if (result[static_cast<size_t>(k - 1)].empty()) result[static_cast<size_t>(k - 1)] = result[static_cast<size_t>(k - 2)];
+    if (result[static_cast<size_t>(k - 1)].empty())
+      result[static_cast<size_t>(k - 1)] = result[static_cast<size_t>(k - 2)];
   }
   assert(!result.front().empty());
   return result;

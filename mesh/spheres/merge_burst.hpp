@@ -15,8 +15,9 @@ struct MergeBurstOptions {
   /// Two spheres are neighbours when one has a sample within this distance of
   /// a sample of the other (model units, > 0; about 1.5 sample spacings).
   double neighbour_radius = 1.0;
-  int merge_candidates = 192;  ///< candidate centres tried per merge evaluation (evenly thinned, >= 1)
-  bool allow_burst = true;     ///< consider bursts besides merges
+  int merge_candidates =
+      192;                  ///< candidate centres tried per merge evaluation (evenly thinned, >= 1)
+  bool allow_burst = true;  ///< consider bursts besides merges
   /// Lloyd rounds (see refine_jointly) run on each reduced configuration.
   int lloyd_iterations = 4;
 };
@@ -41,7 +42,8 @@ std::vector<int> medial_owners(const ReductionProblem& problem, double search_ra
 /// empty members or bad options.
 std::vector<std::vector<FittedSphere>> merge_burst_reduce(const ReductionProblem& problem,
                                                           const std::vector<int>& owners,
-                                                          const std::vector<int>& members, int max_k,
+                                                          const std::vector<int>& members,
+                                                          int max_k,
                                                           const ReductionOptions& reduction,
                                                           const MergeBurstOptions& options);
 

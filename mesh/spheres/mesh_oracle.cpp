@@ -34,8 +34,8 @@ void check_indices(const SurfaceMesh& mesh) {
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
     for (int k = 0; k < 3; ++k) {
       if (mesh.F(f, k) < 0 || mesh.F(f, k) >= mesh.V.rows()) {
-        throw InputError("close_holes: face " + std::to_string(f) + " has out-of-range vertex index " +
-                         std::to_string(mesh.F(f, k)));
+        throw InputError("close_holes: face " + std::to_string(f) +
+                         " has out-of-range vertex index " + std::to_string(mesh.F(f, k)));
       }
     }
   }
@@ -53,8 +53,9 @@ CgalMesh to_cgal(const SurfaceMesh& mesh) {
                                    vids[static_cast<size_t>(mesh.F(f, 1))],
                                    vids[static_cast<size_t>(mesh.F(f, 2))]);
     if (face == CgalMesh::null_face()) {
-      throw InputError("close_holes: face " + std::to_string(f) +
-                       " cannot be added (non-manifold edge, degenerate or inconsistent orientation)");
+      throw InputError(
+          "close_holes: face " + std::to_string(f) +
+          " cannot be added (non-manifold edge, degenerate or inconsistent orientation)");
     }
   }
   return out;
@@ -94,7 +95,8 @@ SurfaceMesh close_holes(const SurfaceMesh& mesh) {
   std::vector<int> index(cm.number_of_vertices(), -1);
   int nv = 0;
   for (auto v : cm.vertices()) index[v.idx()] = nv++;
-  if (nv != mesh.V.rows()) throw InputError("close_holes: hole filling added vertices unexpectedly");
+  if (nv != mesh.V.rows())
+    throw InputError("close_holes: hole filling added vertices unexpectedly");
   out.F.resize(static_cast<Eigen::Index>(cm.number_of_faces()), 3);
   Eigen::Index f = 0;
   for (auto face : cm.faces()) {
@@ -117,7 +119,8 @@ MeshOracle::MeshOracle(const SurfaceMesh& closed) : m_impl(std::make_unique<Impl
   m_impl->cgal = to_cgal(closed);
   for (auto h : m_impl->cgal.halfedges()) {
     if (m_impl->cgal.is_border(h)) {
-      throw InputError("MeshOracle: mesh has a boundary (holes must be closed first, see close_holes)");
+      throw InputError(
+          "MeshOracle: mesh has a boundary (holes must be closed first, see close_holes)");
     }
   }
   m_impl->tree.insert(faces(m_impl->cgal).first, faces(m_impl->cgal).second, m_impl->cgal);

@@ -11,7 +11,8 @@ namespace icd::mesh {
 
 PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_cell(cell_size) {
   if (!(cell_size > 0) || !std::isfinite(cell_size)) {
-    throw ParameterError("PointGrid: cell_size must be positive and finite, got " + std::to_string(cell_size));
+    throw ParameterError("PointGrid: cell_size must be positive and finite, got " +
+                         std::to_string(cell_size));
   }
   m_points.resize(static_cast<size_t>(P.rows()));
   m_point_cells.resize(static_cast<size_t>(P.rows()));
@@ -34,15 +35,18 @@ long long PointGrid::key(long long i, long long j, long long k) const {
 }
 
 Eigen::Vector3i PointGrid::cell_of(const Eigen::Vector3d& p) const {
-  return {static_cast<int>(std::floor(p.x() / m_cell)), static_cast<int>(std::floor(p.y() / m_cell)),
+  return {static_cast<int>(std::floor(p.x() / m_cell)),
+          static_cast<int>(std::floor(p.y() / m_cell)),
           static_cast<int>(std::floor(p.z() / m_cell))};
 }
 
 std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double radius) const {
   std::vector<int> out;
   if (m_points.empty() || radius < 0) return out;
-  const Eigen::Vector3i lo = cell_of(center - Eigen::Vector3d::Constant(radius)).cwiseMax(m_min_cell);
-  const Eigen::Vector3i hi = cell_of(center + Eigen::Vector3d::Constant(radius)).cwiseMin(m_max_cell);
+  const Eigen::Vector3i lo =
+      cell_of(center - Eigen::Vector3d::Constant(radius)).cwiseMax(m_min_cell);
+  const Eigen::Vector3i hi =
+      cell_of(center + Eigen::Vector3d::Constant(radius)).cwiseMin(m_max_cell);
   const double r2 = radius * radius;
   for (int i = lo.x(); i <= hi.x(); ++i) {
     for (int j = lo.y(); j <= hi.y(); ++j) {

@@ -62,8 +62,10 @@ std::vector<int> prefilter(const MatX3d& points, const std::vector<int>& members
         }
         if (above > 0 && below > 0) continue;
         if (above == 0 && below == 0) continue;  // flat support set: no volume
-        if (above > 0) facets.emplace_back(-normal, -offset);
-        else facets.emplace_back(normal, offset);
+        if (above > 0)
+          facets.emplace_back(-normal, -offset);
+        else
+          facets.emplace_back(normal, offset);
       }
     }
   }
@@ -86,13 +88,15 @@ std::vector<int> prefilter(const MatX3d& points, const std::vector<int>& members
 }
 
 /// Extreme points (convex hull vertices) of the member samples, as rows.
-std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points, const std::vector<int>& all_members) {
+std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points,
+                                            const std::vector<int>& all_members) {
   std::vector<Eigen::Vector3d> out;
   if (all_members.size() <= 64) {
     for (int s : all_members) out.emplace_back(points.row(s));
     return out;
   }
-  const std::vector<int> members = all_members.size() > 1000 ? prefilter(points, all_members) : all_members;
+  const std::vector<int> members =
+      all_members.size() > 1000 ? prefilter(points, all_members) : all_members;
   std::vector<Point> in;
   in.reserve(members.size());
   for (int s : members) in.emplace_back(points(s, 0), points(s, 1), points(s, 2));
@@ -116,7 +120,8 @@ std::vector<Eigen::Vector3d> support_points(const MatX3d& points, const std::vec
     const Eigen::Vector3d p = points.row(s).transpose();
     for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
       const double v = dirs(d, 0) * p.x() + dirs(d, 1) * p.y() + dirs(d, 2) * p.z();
-      if (v > best[static_cast<size_t>(d)]) best[static_cast<size_t>(d)] = v, arg[static_cast<size_t>(d)] = s;
+      if (v > best[static_cast<size_t>(d)])
+        best[static_cast<size_t>(d)] = v, arg[static_cast<size_t>(d)] = s;
     }
   }
   std::sort(arg.begin(), arg.end());
@@ -166,15 +171,17 @@ double objective(const std::vector<FittedSphere>& spheres) {
 void distribute(const std::vector<int>& members, const std::vector<int>& owner,
                 std::vector<FittedSphere>& spheres) {
   for (auto& s : spheres) s.members.clear();
-  for (size_t m = 0; m < members.size(); ++m) spheres[static_cast<size_t>(owner[m])].members.push_back(members[m]);
-  spheres.erase(std::remove_if(spheres.begin(), spheres.end(), [](const FittedSphere& s) { return s.members.empty(); }),
+  for (size_t m = 0; m < members.size(); ++m)
+    spheres[static_cast<size_t>(owner[m])].members.push_back(members[m]);
+  spheres.erase(std::remove_if(spheres.begin(), spheres.end(),
+                               [](const FittedSphere& s) { return s.members.empty(); }),
                 spheres.end());
 }
 
 }  // namespace
 
-FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>& members, const FittedSphere* hint,
-                        const ReductionOptions& options) {
+FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>& members,
+                        const FittedSphere* hint, const ReductionOptions& options) {
   assert(!members.empty());
   FittedSphere out;
   out.tag = hint != nullptr ? hint->tag : -1;
@@ -237,7 +244,9 @@ void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, Fi
   refit_radius(problem, start);
   double gmax = 0;
   for (int s : sphere.members) gmax = std::max(gmax, problem.gap[s]);
-  auto cost = [&](const Eigen::Vector3d& c, double depth) { return max_distance(hull, c) + gmax - depth; };
+  auto cost = [&](const Eigen::Vector3d& c, double depth) {
+    return max_distance(hull, c) + gmax - depth;
+  };
   Eigen::Vector3d center = sphere.center;
   double depth = oracle.inside(center) ? oracle.distance(center) : 0.0;
   double best = cost(center, depth);
@@ -296,7 +305,8 @@ void refine_jointly(const ReductionProblem& problem, std::vector<FittedSphere>& 
     if (std::chrono::steady_clock::now() > options.deadline) break;
     const std::vector<int> owner = assign(problem, members, spheres);
     for (auto& s : spheres) s.members.clear();
-    for (size_t m = 0; m < members.size(); ++m) spheres[static_cast<size_t>(owner[m])].members.push_back(members[m]);
+    for (size_t m = 0; m < members.size(); ++m)
+      spheres[static_cast<size_t>(owner[m])].members.push_back(members[m]);
     for (auto& s : spheres) {
       if (s.members.empty()) continue;
       const FittedSphere hint = s;
@@ -311,7 +321,8 @@ void refine_jointly(const ReductionProblem& problem, std::vector<FittedSphere>& 
 std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem& problem,
                                                          const std::vector<int>& members, int max_k,
                                                          const ReductionOptions& options) {
-  if (max_k < 1) throw ParameterError("reduce_to_spheres: max_k must be >= 1, got " + std::to_string(max_k));
+  if (max_k < 1)
+    throw ParameterError("reduce_to_spheres: max_k must be >= 1, got " + std::to_string(max_k));
   if (members.empty()) throw ParameterError("reduce_to_spheres: no samples to cover");
   std::vector<std::vector<FittedSphere>> result;
   std::vector<FittedSphere> spheres{fit_sphere(problem, members, nullptr, options)};
@@ -325,7 +336,8 @@ std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem&
     for (size_t m = 0; m < members.size(); ++m) {
       const auto& sp = spheres[static_cast<size_t>(owner[m])];
       const int s = members[m];
-      const double v = (problem.points.row(s).transpose() - sp.center).norm() - sp.depth + problem.gap[s];
+      const double v =
+          (problem.points.row(s).transpose() - sp.center).norm() - sp.depth + problem.gap[s];
       if (v > worst) worst = v, worst_m = m;
     }
     const Eigen::Vector3d seed = problem.points.row(members[worst_m]);
@@ -361,7 +373,8 @@ std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem&
       const double obj = objective(spheres);
       if (obj < best_obj) best_obj = obj, best_config = spheres;
       bool stable = spheres.size() == before.size();
-      for (size_t j = 0; stable && j < spheres.size(); ++j) stable = spheres[j].members == before[j];
+      for (size_t j = 0; stable && j < spheres.size(); ++j)
+        stable = spheres[j].members == before[j];
       if (stable) break;
     }
     spheres = best_config;

@@ -16,8 +16,8 @@ namespace icd::mesh {
 /// with margin gap[s], i.e. |s - center| + gap[s] <= radius.
 struct FittedSphere {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
-  double radius = 0;   ///< model units
-  double depth = 0;    ///< distance from the centre to the surface (centre inside; 0 if unknown)
+  double radius = 0;  ///< model units
+  double depth = 0;   ///< distance from the centre to the surface (centre inside; 0 if unknown)
   /// Error bound radius - depth: no point of the sphere is farther than this
   /// from the object (a point of the sphere at distance radius from the centre
   /// is at most radius - depth beyond the surface along the ray from the centre).
@@ -37,9 +37,9 @@ struct ReductionProblem {
 
 /// Options of reduce_to_spheres().
 struct ReductionOptions {
-  int lloyd_iterations = 8;      ///< assignment / refit rounds after each split (>= 0)
-  int max_candidates = 2500;     ///< candidate centres tried per refit (evenly thinned beyond)
-  double depth_bias = 0.05;      ///< preference for deep centres when seeding a new sphere
+  int lloyd_iterations = 8;   ///< assignment / refit rounds after each split (>= 0)
+  int max_candidates = 2500;  ///< candidate centres tried per refit (evenly thinned beyond)
+  double depth_bias = 0.05;   ///< preference for deep centres when seeding a new sphere
   /// Past this time only the greedy splits run (no Lloyd rounds): the result is still valid.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };

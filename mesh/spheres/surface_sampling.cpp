@@ -17,14 +17,15 @@ constexpr double kInvSqrt3 = 0.57735026918962576451;
 void check_input(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F) {
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     if (!V.row(i).allFinite()) {
-      throw InputError("sample_surface: vertex " + std::to_string(i) + " has a non-finite coordinate");
+      throw InputError("sample_surface: vertex " + std::to_string(i) +
+                       " has a non-finite coordinate");
     }
   }
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k) {
       if (F(f, k) < 0 || F(f, k) >= V.rows()) {
-        throw InputError("sample_surface: face " + std::to_string(f) + " has out-of-range vertex index " +
-                         std::to_string(F(f, k)));
+        throw InputError("sample_surface: face " + std::to_string(f) +
+                         " has out-of-range vertex index " + std::to_string(F(f, k)));
       }
     }
   }
@@ -83,7 +84,8 @@ SurfaceSamples sample_surface(const Eigen::Ref<const MatX3d>& V, const Eigen::Re
           g = ic;
         } else {
           g = static_cast<int>(points.size());
-          points.push_back(a + (b - a) * (static_cast<double>(i) / n) + (c - a) * (static_cast<double>(j) / n));
+          points.push_back(a + (b - a) * (static_cast<double>(i) / n) +
+                           (c - a) * (static_cast<double>(j) / n));
           gap.push_back(0.0);
           area.push_back(0.0);
           face.push_back(static_cast<int>(f));

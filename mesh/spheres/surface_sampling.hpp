@@ -24,10 +24,10 @@ struct SamplingOptions {
 /// <= r - gap[i] from the centre of some sphere (c, r) covers the surface
 /// completely (the gap is the coverage margin).
 struct SurfaceSamples {
-  MatX3d points;            ///< #S x 3 sample positions
-  Eigen::VectorXd gap;      ///< #S coverage margin of each sample (model units)
-  Eigen::VectorXd area;     ///< #S surface area represented by each sample (sums to the mesh area)
-  Eigen::VectorXi face;     ///< #S triangle the sample lies on (for vertices: one incident face)
+  MatX3d points;         ///< #S x 3 sample positions
+  Eigen::VectorXd gap;   ///< #S coverage margin of each sample (model units)
+  Eigen::VectorXd area;  ///< #S surface area represented by each sample (sums to the mesh area)
+  Eigen::VectorXi face;  ///< #S triangle the sample lies on (for vertices: one incident face)
   int num_vertex_samples = 0;  ///< the first #V samples are the mesh vertices
 };
 

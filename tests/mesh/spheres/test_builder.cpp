@@ -36,15 +36,16 @@ SphereTreeOptions small_options(ReductionMethod method = SphereTreeOptions{}.red
 
 /// The reduction methods every tree-level guarantee is checked for.
 const std::vector<std::pair<std::string, ReductionMethod>> kMethods = {
-    {"split_lloyd", ReductionMethod::split_lloyd},
-    {"merge_burst", ReductionMethod::merge_burst}};
+    {"split_lloyd", ReductionMethod::split_lloyd}, {"merge_burst", ReductionMethod::merge_burst}};
 
 /// The builds of cases(), made once per test program (each takes seconds).
-const SphereTreeBuild& cached_build(const Case& c, ReductionMethod method = SphereTreeOptions{}.reduction) {
+const SphereTreeBuild& cached_build(const Case& c,
+                                    ReductionMethod method = SphereTreeOptions{}.reduction) {
   static std::map<std::pair<std::string, ReductionMethod>, SphereTreeBuild> builds;
   const auto key = std::make_pair(c.name, method);
   auto it = builds.find(key);
-  if (it == builds.end()) it = builds.emplace(key, build_sphere_tree(c.mesh, small_options(method))).first;
+  if (it == builds.end())
+    it = builds.emplace(key, build_sphere_tree(c.mesh, small_options(method))).first;
   return it->second;
 }
 
@@ -71,8 +72,9 @@ icd::MatX3d dense_random_points(const icd::SurfaceMesh& m, int count, unsigned s
   std::uniform_real_distribution<double> u(0, 1);
   icd::MatX3d P(count, 3);
   for (int i = 0; i < count; ++i) {
-    const auto f = static_cast<Eigen::Index>(std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
-                                             cumulative.begin());
+    const auto f = static_cast<Eigen::Index>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
+        cumulative.begin());
     double s = u(rng), t = u(rng);
     if (s + t > 1) s = 1 - s, t = 1 - t;
     const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
@@ -95,16 +97,19 @@ TEST(SphereTreeBuilder, LayoutIsBreadthFirstWithContiguousChildren) {
     int expected_next = 1;
     for (int i = 0; i < tree.num_nodes(); ++i) {
       EXPECT_GE(tree.level[i], 0);
-      EXPECT_TRUE(i >= tree.level_offset[tree.level[i]] && i < tree.level_offset[tree.level[i] + 1]);
+      EXPECT_TRUE(i >= tree.level_offset[tree.level[i]] &&
+                  i < tree.level_offset[tree.level[i] + 1]);
       if (tree.child_count[i] == 0) {
         EXPECT_EQ(tree.first_child[i], -1);
         EXPECT_EQ(tree.level[i], 2) << "leaves are on the last level";
         continue;
       }
       EXPECT_LE(tree.child_count[i], 4);
-      EXPECT_EQ(tree.first_child[i], expected_next) << "children must follow in breadth-first order";
+      EXPECT_EQ(tree.first_child[i], expected_next)
+          << "children must follow in breadth-first order";
       expected_next += tree.child_count[i];
-      for (int k = 0; k < tree.child_count[i]; ++k) EXPECT_EQ(tree.level[tree.first_child[i] + k], tree.level[i] + 1);
+      for (int k = 0; k < tree.child_count[i]; ++k)
+        EXPECT_EQ(tree.level[tree.first_child[i] + k], tree.level[i] + 1);
     }
     EXPECT_EQ(expected_next, tree.num_nodes());
   }
@@ -112,73 +117,77 @@ TEST(SphereTreeBuilder, LayoutIsBreadthFirstWithContiguousChildren) {
 
 TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem) {
   for (const auto& [method_name, method] : kMethods)
-  for (const auto& c : cases()) {
-    SCOPED_TRACE(c.name + " " + method_name);
-    const SphereTreeBuild& build = cached_build(c, method);
-    const auto& tree = build.tree;
-    const auto& P = build.samples.points;
-    ASSERT_EQ(static_cast<int>(build.node_samples.size()), tree.num_nodes());
-    EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), P.rows());
-    for (int i = 0; i < tree.num_nodes(); ++i) {
-      const auto& s = tree.spheres[i];
-      for (int m : build.node_samples[i]) {
-        ASSERT_LE((P.row(m).transpose() - s.center()).norm() + build.samples.gap[m], s.r * (1 + 1e-12) + 1e-12);
+    for (const auto& c : cases()) {
+      SCOPED_TRACE(c.name + " " + method_name);
+      const SphereTreeBuild& build = cached_build(c, method);
+      const auto& tree = build.tree;
+      const auto& P = build.samples.points;
+      ASSERT_EQ(static_cast<int>(build.node_samples.size()), tree.num_nodes());
+      EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), P.rows());
+      for (int i = 0; i < tree.num_nodes(); ++i) {
+        const auto& s = tree.spheres[i];
+        for (int m : build.node_samples[i]) {
+          ASSERT_LE((P.row(m).transpose() - s.center()).norm() + build.samples.gap[m],
+                    s.r * (1 + 1e-12) + 1e-12);
+        }
+        if (tree.child_count[i] == 0) continue;
+        std::vector<int> joined;
+        for (int k = 0; k < tree.child_count[i]; ++k) {
+          const auto& cs = build.node_samples[tree.first_child[i] + k];
+          EXPECT_FALSE(cs.empty());
+          joined.insert(joined.end(), cs.begin(), cs.end());
+        }
+        std::sort(joined.begin(), joined.end());
+        EXPECT_EQ(joined, build.node_samples[i])
+            << "children must divide the samples of node " << i;
       }
-      if (tree.child_count[i] == 0) continue;
-      std::vector<int> joined;
-      for (int k = 0; k < tree.child_count[i]; ++k) {
-        const auto& cs = build.node_samples[tree.first_child[i] + k];
-        EXPECT_FALSE(cs.empty());
-        joined.insert(joined.end(), cs.begin(), cs.end());
-      }
-      std::sort(joined.begin(), joined.end());
-      EXPECT_EQ(joined, build.node_samples[i]) << "children must divide the samples of node " << i;
     }
-  }
 }
 
 TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
   for (const auto& [method_name, method] : kMethods)
-  for (const auto& c : cases()) {
-    SCOPED_TRACE(c.name + " " + method_name);
-    const SphereTreeBuild& build = cached_build(c, method);
-    const auto& tree = build.tree;
-    const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
-    for (int l = 0; l < tree.num_levels(); ++l) {
-      int uncovered = 0;
-      for (Eigen::Index p = 0; p < P.rows(); ++p) {
-        bool covered = false;
-        for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
-          covered = (P.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
+    for (const auto& c : cases()) {
+      SCOPED_TRACE(c.name + " " + method_name);
+      const SphereTreeBuild& build = cached_build(c, method);
+      const auto& tree = build.tree;
+      const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
+      for (int l = 0; l < tree.num_levels(); ++l) {
+        int uncovered = 0;
+        for (Eigen::Index p = 0; p < P.rows(); ++p) {
+          bool covered = false;
+          for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
+            covered = (P.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
+          }
+          uncovered += covered ? 0 : 1;
         }
-        uncovered += covered ? 0 : 1;
+        EXPECT_EQ(uncovered, 0) << "level " << l;
       }
-      EXPECT_EQ(uncovered, 0) << "level " << l;
     }
-  }
 }
 
 TEST(SphereTreeBuilder, ErrorDecreasesFromLevelToLevel) {
   EvaluationOptions eval;
   eval.coverage_spacing = 10.0;
   for (const auto& [method_name, method] : kMethods)
-  for (const auto& c : cases()) {
-    SCOPED_TRACE(c.name + " " + method_name);
-    const SphereTreeBuild& build = cached_build(c, method);
-    const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
-    ASSERT_EQ(metrics.size(), 3u);
-    for (size_t l = 1; l < metrics.size(); ++l) {
-      // The sphere is already fitted exactly by its root (error = margin only).
-      const double slack = c.name == "icosphere" ? 0.01 * 2000 : 0.0;
-      EXPECT_LE(metrics[l].mean_error_162, metrics[l - 1].mean_error_162 + slack) << "level " << l;
-      EXPECT_LE(metrics[l].worst_error_162, metrics[l - 1].worst_error_162 + slack) << "level " << l;
-      if (c.name != "icosphere") {
-        EXPECT_LT(metrics[l].mean_error_162, 0.8 * metrics[l - 1].mean_error_162);
+    for (const auto& c : cases()) {
+      SCOPED_TRACE(c.name + " " + method_name);
+      const SphereTreeBuild& build = cached_build(c, method);
+      const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
+      ASSERT_EQ(metrics.size(), 3u);
+      for (size_t l = 1; l < metrics.size(); ++l) {
+        // The sphere is already fitted exactly by its root (error = margin only).
+        const double slack = c.name == "icosphere" ? 0.01 * 2000 : 0.0;
+        EXPECT_LE(metrics[l].mean_error_162, metrics[l - 1].mean_error_162 + slack)
+            << "level " << l;
+        EXPECT_LE(metrics[l].worst_error_162, metrics[l - 1].worst_error_162 + slack)
+            << "level " << l;
+        if (c.name != "icosphere") {
+          EXPECT_LT(metrics[l].mean_error_162, 0.8 * metrics[l - 1].mean_error_162);
+        }
+        EXPECT_EQ(metrics[l].num_uncovered_samples, 0);
+        EXPECT_EQ(metrics[l].num_uncovered_vertices, 0);
       }
-      EXPECT_EQ(metrics[l].num_uncovered_samples, 0);
-      EXPECT_EQ(metrics[l].num_uncovered_vertices, 0);
     }
-  }
 }
 
 TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {

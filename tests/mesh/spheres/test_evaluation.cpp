@@ -14,7 +14,8 @@ namespace {
 
 using namespace icd::mesh;
 
-icd::collision::SphereTree two_level_tree(double root_r, const Eigen::Vector3d& child_c, double child_r) {
+icd::collision::SphereTree two_level_tree(double root_r, const Eigen::Vector3d& child_c,
+                                          double child_r) {
   icd::collision::SphereTree t;
   t.spheres = {{0, 0, 0, root_r}, {child_c.x(), child_c.y(), child_c.z(), child_r}};
   t.rest_spheres = t.spheres;
@@ -26,7 +27,9 @@ icd::collision::SphereTree two_level_tree(double root_r, const Eigen::Vector3d& 
 }
 
 /// Exact distance from an outside point to the cube [-h, h]^3.
-double cube_distance(const Eigen::Vector3d& p, double h) { return (p.cwiseAbs().array() - h).max(0.0).matrix().norm(); }
+double cube_distance(const Eigen::Vector3d& p, double h) {
+  return (p.cwiseAbs().array() - h).max(0.0).matrix().norm();
+}
 
 TEST(Evaluation, ProbeErrorsMatchTheCubeDistance) {
   const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});  // normalized: half side 1000
@@ -58,7 +61,8 @@ TEST(Evaluation, ProbeErrorsMatchTheCubeDistance) {
 TEST(Evaluation, UncoveredAreaMatchesTheFaceDiskClosedForm) {
   const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
   const double R = 1.2;
-  const auto tree = two_level_tree(R, {0, 0, 0}, std::sqrt(3.0) + 1e-9);  // the child covers everything
+  const auto tree =
+      two_level_tree(R, {0, 0, 0}, std::sqrt(3.0) + 1e-9);  // the child covers everything
   EvaluationOptions options;
   options.coverage_spacing = 5.0;
   const auto metrics = evaluate_sphere_tree(cube, tree, options);
@@ -77,7 +81,8 @@ TEST(Evaluation, RejectsBadOptionsAndTrees) {
   const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
   EvaluationOptions bad;
   bad.coverage_spacing = 0;
-  EXPECT_THROW(evaluate_sphere_tree(cube, two_level_tree(2, {0, 0, 0}, 2), bad), icd::ParameterError);
+  EXPECT_THROW(evaluate_sphere_tree(cube, two_level_tree(2, {0, 0, 0}, 2), bad),
+               icd::ParameterError);
   auto tree = two_level_tree(2, {0, 0, 0}, 2);
   tree.spheres[1].r = std::nan("");
   EXPECT_THROW(evaluate_sphere_tree(cube, tree), icd::ParameterError);

@@ -21,8 +21,8 @@ using namespace icd::mesh;
 
 /// Spheres around random centres, each covering the samples nearest to it
 /// with margin (a valid but poor configuration).
-std::vector<FittedSphere> nearest_centre_spheres(const icd::MatX3d& P, const Eigen::VectorXd& gap, int k,
-                                                 unsigned seed) {
+std::vector<FittedSphere> nearest_centre_spheres(const icd::MatX3d& P, const Eigen::VectorXd& gap,
+                                                 int k, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_int_distribution<Eigen::Index> pick(0, P.rows() - 1);
   std::vector<FittedSphere> spheres(static_cast<size_t>(k));
@@ -30,14 +30,16 @@ std::vector<FittedSphere> nearest_centre_spheres(const icd::MatX3d& P, const Eig
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
     size_t best = 0;
     for (size_t j = 1; j < spheres.size(); ++j) {
-      if ((P.row(i).transpose() - spheres[j].center).norm() < (P.row(i).transpose() - spheres[best].center).norm()) {
+      if ((P.row(i).transpose() - spheres[j].center).norm() <
+          (P.row(i).transpose() - spheres[best].center).norm()) {
         best = j;
       }
     }
     spheres[best].members.push_back(static_cast<int>(i));
   }
   for (auto& s : spheres) {
-    for (int m : s.members) s.radius = std::max(s.radius, (P.row(m).transpose() - s.center).norm() + gap[m]);
+    for (int m : s.members)
+      s.radius = std::max(s.radius, (P.row(m).transpose() - s.center).norm() + gap[m]);
     s.depth = 0.1;
     s.error = s.radius - s.depth;
   }
@@ -52,10 +54,12 @@ TEST(Exchange, KeepsCoverageAndNeverGrowsARadius) {
   const ReductionProblem problem{samples.points, samples.gap, medial, grid};
   std::vector<FittedSphere> spheres = nearest_centre_spheres(samples.points, samples.gap, 12, 3);
   // Inflate some spheres so that they overlap their neighbours a lot.
-  for (size_t j = 0; j < spheres.size(); j += 3) spheres[j].radius *= 1.5, spheres[j].error = spheres[j].radius - 0.1;
+  for (size_t j = 0; j < spheres.size(); j += 3)
+    spheres[j].radius *= 1.5, spheres[j].error = spheres[j].radius - 0.1;
   const auto before = spheres;
   // Receivers with an even index only.
-  const int moved = shrink_by_exchange(problem, spheres, ExchangeOptions{}, [](int k, int) { return k % 2 == 0; });
+  const int moved = shrink_by_exchange(problem, spheres, ExchangeOptions{},
+                                       [](int k, int) { return k % 2 == 0; });
   EXPECT_GT(moved, 0);
   std::vector<int> joined;
   double sum_before = 0, sum_after = 0;
@@ -67,11 +71,13 @@ TEST(Exchange, KeepsCoverageAndNeverGrowsARadius) {
     EXPECT_FALSE(s.members.empty());
     EXPECT_TRUE(std::is_sorted(s.members.begin(), s.members.end()));
     double r = 0;
-    for (int m : s.members) r = std::max(r, (samples.points.row(m).transpose() - s.center).norm() + samples.gap[m]);
+    for (int m : s.members)
+      r = std::max(r, (samples.points.row(m).transpose() - s.center).norm() + samples.gap[m]);
     EXPECT_LE(r, s.radius) << "sphere " << j << " lost coverage of a member";
     // Odd spheres received nothing: their members are a subset of their old ones.
     if (j % 2 == 1) {
-      EXPECT_TRUE(std::includes(before[j].members.begin(), before[j].members.end(), s.members.begin(), s.members.end()));
+      EXPECT_TRUE(std::includes(before[j].members.begin(), before[j].members.end(),
+                                s.members.begin(), s.members.end()));
     }
     joined.insert(joined.end(), s.members.begin(), s.members.end());
     sum_before += before[j].error, sum_after += s.error;
@@ -122,7 +128,8 @@ TEST(Exchange, RelieveWorstReachesTheMinimaxSplitOnALine) {
     minimax = std::min(minimax, std::max(ra, rb));
   }
   FittedSphere a, b;  // A starts with 0..9, B with sample 10 only
-  a.center = Eigen::Vector3d::Zero(), a.radius = 9, a.error = 9, a.members = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+  a.center = Eigen::Vector3d::Zero(), a.radius = 9, a.error = 9,
+  a.members = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
   b.center = Eigen::Vector3d(8, 0, 0), b.radius = 2, b.error = 2, b.members = {10};
   std::vector<FittedSphere> spheres{a, b};
   EXPECT_GT(relieve_worst(problem, spheres, 1000), 0);
@@ -152,7 +159,8 @@ TEST(Exchange, RelieveWorstNeverRaisesTheWorstAndKeepsCoverage) {
   for (auto* sp : {&taker, &giver}) {
     sp->radius = 0;
     for (int m : sp->members) {
-      sp->radius = std::max(sp->radius, (samples.points.row(m).transpose() - sp->center).norm() + samples.gap[m]);
+      sp->radius = std::max(
+          sp->radius, (samples.points.row(m).transpose() - sp->center).norm() + samples.gap[m]);
     }
     sp->error = sp->radius - sp->depth;
   }
@@ -166,7 +174,8 @@ TEST(Exchange, RelieveWorstNeverRaisesTheWorstAndKeepsCoverage) {
     worst_after = std::max(worst_after, s.error);
     EXPECT_FALSE(s.members.empty());
     for (int m : s.members) {
-      EXPECT_LE((samples.points.row(m).transpose() - s.center).norm() + samples.gap[m], s.radius * (1 + 1e-12));
+      EXPECT_LE((samples.points.row(m).transpose() - s.center).norm() + samples.gap[m],
+                s.radius * (1 + 1e-12));
     }
     joined.insert(joined.end(), s.members.begin(), s.members.end());
   }

@@ -43,7 +43,8 @@ struct ReductionSetup {
   std::vector<std::vector<FittedSphere>> reduce(int max_k, double spacing) const {
     MergeBurstOptions o;
     o.neighbour_radius = 1.5 * spacing;
-    return merge_burst_reduce(problem, medial_owners(problem, spacing), all(), max_k, ReductionOptions{}, o);
+    return merge_burst_reduce(problem, medial_owners(problem, spacing), all(), max_k,
+                              ReductionOptions{}, o);
   }
 };
 
@@ -53,7 +54,8 @@ double worst_error(const std::vector<FittedSphere>& config) {
   return w;
 }
 
-void expect_valid(const ReductionSetup& setup, const std::vector<std::vector<FittedSphere>>& configs, int max_k) {
+void expect_valid(const ReductionSetup& setup,
+                  const std::vector<std::vector<FittedSphere>>& configs, int max_k) {
   ASSERT_EQ(static_cast<int>(configs.size()), max_k);
   const auto& P = setup.samples.points;
   for (int k = 1; k <= max_k; ++k) {
@@ -69,7 +71,8 @@ void expect_valid(const ReductionSetup& setup, const std::vector<std::vector<Fit
       EXPECT_TRUE(setup.oracle.inside(s.center));
       EXPECT_NEAR(s.depth, setup.oracle.distance(s.center), 1e-9);
       for (int m : s.members) {
-        EXPECT_LE((P.row(m).transpose() - s.center).norm() + setup.samples.gap[m], s.radius * (1 + 1e-12));
+        EXPECT_LE((P.row(m).transpose() - s.center).norm() + setup.samples.gap[m],
+                  s.radius * (1 + 1e-12));
       }
       joined.insert(joined.end(), s.members.begin(), s.members.end());
     }
@@ -147,11 +150,15 @@ TEST(MergeBurst, RejectsBadArguments) {
   const auto owners = medial_owners(setup.problem, 0.2);
   EXPECT_THROW(medial_owners(setup.problem, 0.0), icd::ParameterError);
   MergeBurstOptions o;
-  EXPECT_THROW(merge_burst_reduce(setup.problem, owners, setup.all(), 0, ReductionOptions{}, o), icd::ParameterError);
-  EXPECT_THROW(merge_burst_reduce(setup.problem, owners, {}, 2, ReductionOptions{}, o), icd::ParameterError);
-  EXPECT_THROW(merge_burst_reduce(setup.problem, {0, 1}, setup.all(), 2, ReductionOptions{}, o), icd::ParameterError);
+  EXPECT_THROW(merge_burst_reduce(setup.problem, owners, setup.all(), 0, ReductionOptions{}, o),
+               icd::ParameterError);
+  EXPECT_THROW(merge_burst_reduce(setup.problem, owners, {}, 2, ReductionOptions{}, o),
+               icd::ParameterError);
+  EXPECT_THROW(merge_burst_reduce(setup.problem, {0, 1}, setup.all(), 2, ReductionOptions{}, o),
+               icd::ParameterError);
   o.neighbour_radius = -1;
-  EXPECT_THROW(merge_burst_reduce(setup.problem, owners, setup.all(), 2, ReductionOptions{}, o), icd::ParameterError);
+  EXPECT_THROW(merge_burst_reduce(setup.problem, owners, setup.all(), 2, ReductionOptions{}, o),
+               icd::ParameterError);
 }
 
 }  // namespace

@@ -13,7 +13,8 @@ namespace {
 using icd::mesh::MeshOracle;
 
 /// Exact distance from p to the surface of the box [lo, hi].
-double box_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+double box_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
+                    const Eigen::Vector3d& hi) {
   const Eigen::Vector3d outside = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
   if (outside.norm() > 0) return outside.norm();
   return std::min((p - lo).minCoeff(), (hi - p).minCoeff());
@@ -29,7 +30,8 @@ TEST(MeshOracle, BoxDistancesAndSidesMatchTheClosedForm) {
     const bool inside = (p.array() > lo.array()).all() && (p.array() < hi.array()).all();
     EXPECT_NEAR(oracle.distance(p), box_distance(p, lo, hi), 1e-9);
     EXPECT_EQ(oracle.inside(p), inside) << p.transpose();
-    EXPECT_NEAR(oracle.signed_distance(p), inside ? box_distance(p, lo, hi) : -box_distance(p, lo, hi), 1e-9);
+    EXPECT_NEAR(oracle.signed_distance(p),
+                inside ? box_distance(p, lo, hi) : -box_distance(p, lo, hi), 1e-9);
     EXPECT_NEAR(box_distance(oracle.closest_point(p), lo, hi), 0.0, 1e-9);
   }
 }
@@ -53,7 +55,8 @@ TEST(CloseHoles, FillsBoundaryLoopsAndKeepsVertices) {
   EXPECT_EQ(icd::mesh::count_boundary_edges(closed.F), 0);
   EXPECT_EQ(closed.V.rows(), open.V.rows());
   EXPECT_EQ(closed.F.rows(), sphere.F.rows());
-  EXPECT_NEAR(icd::mesh::surface_area(closed.V, closed.F), icd::mesh::surface_area(sphere.V, sphere.F), 1e-9);
+  EXPECT_NEAR(icd::mesh::surface_area(closed.V, closed.F),
+              icd::mesh::surface_area(sphere.V, sphere.F), 1e-9);
   const MeshOracle oracle(closed);
   EXPECT_TRUE(oracle.inside(Eigen::Vector3d(0.1, 0.2, 0.1)));
   EXPECT_FALSE(oracle.inside(Eigen::Vector3d(1.1, 0, 0)));
