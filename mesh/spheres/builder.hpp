@@ -55,11 +55,13 @@ struct SphereTreeOptions {
   int exchange_rounds = 2;
   /// After the top-down pass, let the leaves exchange boundary samples across
   /// parents too (a sample may move to a leaf of another parent when that
-  /// leaf and all its ancestors already cover it); inner nodes then shrink to
-  /// the union of their children's samples. No radius grows.
+  /// leaf and all its ancestors already cover it; no radius grows); inner
+  /// nodes are then refitted to the union of their children's samples.
   bool leaf_exchange = true;
   /// With leaf_exchange: at most this many single-sample moves that lower the
-  /// worst leaf error bound (see relieve_worst; 0 disables, >= 0).
+  /// worst leaf error bound (see relieve_worst; 0 disables, >= 0). A receiving
+  /// leaf grows below the worst leaf error; its ancestors may grow, each within
+  /// its level's worst error bound before the moves.
   int relieve_moves = 200000;
   /// After the top-down pass, optimise the leaves jointly (a leaf may take
   /// samples of a neighbour of its parent) and refit the inner nodes
