@@ -148,6 +148,11 @@ void place_object(ObjectAsset& a, const ObjectSpec& spec) {
   for (double& d : a.spheres.assoc_rest_dist) d *= s;
 }
 
+// Bumped whenever icd-preprocess produces different bundles for the same
+// input and options (e.g. a better sphere-tree builder), so that cached
+// bundles of an older pipeline are not reused.
+constexpr const char* kPreprocessVersion = " pipeline-2";
+
 ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::path& cache_dir,
                               const std::filesystem::path& tool_dir) {
   const PreprocessSpec& pre = spec.preprocess;
@@ -155,8 +160,8 @@ ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::pat
   if (!spec.asset.empty()) return coupling::read_asset_bundle(spec.asset);
 
   // A raw mesh: preprocess it into the cache on first use. The cache folder is
-  // named by a hash of the file's bytes and the options, so any change to
-  // either makes a new bundle.
+  // named by a hash of the file's bytes, the options and the pipeline version,
+  // so any change to these makes a new bundle.
   std::ifstream in(spec.mesh, std::ios::binary);
   if (!in) throw InputError("object \"" + spec.name + "\": cannot open mesh " + spec.mesh.string());
   std::ostringstream bytes;
@@ -165,7 +170,7 @@ ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::pat
   std::ostringstream args;
   args << " --coarse-tets " << pre.coarse_tets << " --sphere-depth " << pre.tree_depth
        << " --sphere-branching " << pre.tree_branching << (octree ? " --no-spheres" : "");
-  const std::string key = bytes.str() + args.str();
+  const std::string key = bytes.str() + args.str() + kPreprocessVersion;
   char hash[17];
   std::snprintf(hash, sizeof hash, "%016llx",
                 static_cast<unsigned long long>(coupling::fnv1a64(key.data(), key.size())));
