@@ -256,13 +256,20 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     }
   }
   // Past the staggered scheme's stability margin (explicit limit: omega h = 2)
-  // soften this response rather than let it pump energy.
-  if (m_plan.response && m_node_stiffness > 0) {
-    const double omega_h = std::sqrt(m_node_stiffness / m_min_node_mass) * h;
-    if (omega_h > kContactOmegaLimit) {
-      const double scale = (kContactOmegaLimit / omega_h) * (kContactOmegaLimit / omega_h);
-      for (RuntimeObject& o : m_objects) o.contact_forces *= scale;
-      m_penalty_energy *= scale;
+  // soften the response rather than let it pump energy. The scale only
+  // decreases during a contact (reset once every pair is apart): a penalty
+  // that is softer while loading than while unloading would gain energy.
+  if (m_plan.response) {
+    if (m_node_stiffness == 0 && contact_free()) m_contact_scale = 1;
+    if (m_node_stiffness > 0) {
+      const double omega_h = std::sqrt(m_node_stiffness / m_min_node_mass) * h;
+      if (omega_h > kContactOmegaLimit)
+        m_contact_scale = std::min(m_contact_scale, (kContactOmegaLimit / omega_h) *
+                                                        (kContactOmegaLimit / omega_h));
+    }
+    if (m_contact_scale < 1 && m_node_stiffness > 0) {
+      for (RuntimeObject& o : m_objects) o.contact_forces *= m_contact_scale;
+      m_penalty_energy *= m_contact_scale;
       ++m.softened;
     }
   }
@@ -290,6 +297,7 @@ void World::save(Snapshot& s) const {
   s.complete_time = m_complete_time;
   s.complete_depth = m_complete_depth;
   s.node_stiffness = m_node_stiffness;
+  s.contact_scale = m_contact_scale;
 }
 
 void World::restore(const Snapshot& s) {
@@ -307,6 +315,7 @@ void World::restore(const Snapshot& s) {
   m_complete_time = s.complete_time;
   m_complete_depth = s.complete_depth;
   m_node_stiffness = s.node_stiffness;
+  m_contact_scale = s.contact_scale;
   m_penalty_energy = 0;  // the trial started contact-free
 }
 

@@ -108,6 +108,7 @@ class World {
     std::vector<collision::CollisionResult> complete;
     std::vector<double> complete_time, complete_depth;
     double node_stiffness = 0;
+    double contact_scale = 1;
   };
   void save(Snapshot& s) const;
   void restore(const Snapshot& s);
@@ -140,6 +141,7 @@ class World {
   double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
   double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
   double m_penalty_energy = 0;  ///< penalty spring energy of the last response, J
+  double m_contact_scale = 1;   ///< softening of the current contact episode (1: none)
   Snapshot m_snapshot;          ///< reused storage for the single-cycle trial
   int m_frame = 0;
   double m_time = 0;
