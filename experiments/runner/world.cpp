@@ -108,8 +108,9 @@ int World::contact_cycles(double dt) const {
   if (!m_plan.response) return 1;
   // Conservative: the largest node stiffness (at least k) on the lightest
   // node, every frame. (ContactStats::max_rate, per node k share / m, gave
-  // ~4x fewer cycles but let a head-on bounce gain ~15% energy; so did
-  // running one cycle while the root spheres are apart — both left for study.)
+  // ~4x fewer cycles but let a head-on bounce gain ~15% energy, left for
+  // study. Frames that start apart are tried as one cycle in step(), with a
+  // rollback when they end in contact.)
   const double k = std::max(m_node_stiffness, m_scene.collision.contact.stiffness);
   const double omega = std::sqrt(k / m_min_node_mass);
   return std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1, kMaxContactCycles);
