@@ -302,7 +302,7 @@ void refine_jointly(const ReductionProblem& problem, std::vector<FittedSphere>& 
   std::vector<FittedSphere> best = spheres;
   double best_score = score(spheres);
   for (int it = 0; it < options.lloyd_iterations; ++it) {
-    if (std::chrono::steady_clock::now() > options.deadline) break;
+    if (CpuClock::now() > options.deadline) break;
     const std::vector<int> owner = assign(problem, members, spheres);
     for (auto& s : spheres) s.members.clear();
     for (size_t m = 0; m < members.size(); ++m)
@@ -362,7 +362,7 @@ std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem&
     std::vector<FittedSphere> best_config = spheres;
     double best_obj = objective(spheres);
     for (int it = 0; it < options.lloyd_iterations; ++it) {
-      if (std::chrono::steady_clock::now() > options.deadline) break;
+      if (CpuClock::now() > options.deadline) break;
       std::vector<std::vector<int>> before;
       for (auto& s : spheres) {
         const FittedSphere hint = s;

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "mesh/io/types.hpp"
+#include "mesh/spheres/cpu_clock.hpp"
 #include "mesh/spheres/medial_axis.hpp"
 #include "mesh/spheres/point_grid.hpp"
 
@@ -40,8 +41,9 @@ struct ReductionOptions {
   int lloyd_iterations = 8;   ///< assignment / refit rounds after each split (>= 0)
   int max_candidates = 2500;  ///< candidate centres tried per refit (evenly thinned beyond)
   double depth_bias = 0.05;   ///< preference for deep centres when seeding a new sphere
-  /// Past this time only the greedy splits run (no Lloyd rounds): the result is still valid.
-  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  /// Past this process CPU time only the greedy splits run (no Lloyd rounds):
+  /// the result is still valid.
+  CpuClock::time_point deadline = CpuClock::time_point::max();
 };
 
 /// Fits one sphere to the samples `members`: the candidate centre with the
