@@ -3,6 +3,7 @@
 //                   [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
+//                   [--polish 0|1] [--polish-evals N] [--polish-search N] [--polish-check N]
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -115,7 +116,8 @@ int main(int argc, char** argv) {
            " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
            " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] "
            "[--diagnose N]"
-           " [--exchange-rounds N] [--relieve-moves N]\n";
+           " [--exchange-rounds N] [--relieve-moves N] [--polish 0|1] [--polish-evals N]"
+           " [--polish-search N] [--polish-check N]\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -152,6 +154,14 @@ int main(int argc, char** argv) {
       options.exchange_rounds = std::atoi(value);
     else if (key == "--relieve-moves")
       options.relieve_moves = std::atoi(value);
+    else if (key == "--polish")
+      options.protrusion_polish = std::atoi(value) != 0;
+    else if (key == "--polish-evals")
+      options.protrusion.max_evaluations = std::atoi(value);
+    else if (key == "--polish-search")
+      options.protrusion.search_directions = std::atoi(value);
+    else if (key == "--polish-check")
+      options.protrusion.check_directions = std::atoi(value);
     else if (key == "--coverage-spacing")
       evaluation.coverage_spacing = std::atof(value);
     else if (key == "--reduction") {
@@ -217,9 +227,10 @@ int main(int argc, char** argv) {
                   icd::mesh::evaluate_sphere_tree(mesh, octree, evaluation));
     std::printf(
         "# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f "
-        "s, build CPU time %.1f s%s\n",
+        "s, build CPU time %.1f s (protrusion polish %.1f s, %d nodes moved)%s\n",
         model.name.c_str(), static_cast<long long>(ours.samples.points.rows()),
         ours.num_medial_spheres, ours.num_refinement_points, ours.medial_seconds, build_cpu_s,
+        ours.polish_cpu_seconds, ours.num_polished,
         ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // The builder's own error bound (radius - centre depth), normalized, per level.
     const double to_2000 =

@@ -33,6 +33,11 @@ void check_options(const SphereTreeOptions& o) {
   if (o.relieve_moves < 0) fail("relieve_moves must be >= 0");
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
+  if (o.protrusion.search_directions < 1 || o.protrusion.check_directions < 1 ||
+      o.protrusion.max_evaluations < 0 || !(o.protrusion.initial_step > 0) ||
+      !(o.protrusion.min_step > 0)) {
+    fail("protrusion: search/check directions must be >= 1, evaluations >= 0, steps > 0");
+  }
 }
 
 /// A node under construction: its sphere and its samples (coverage and medial).
@@ -263,8 +268,9 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
 SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOptions& options) {
   check_options(options);
   const auto start = Clock::now();
-  const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(options.time_limit));
+  const auto cpu_start = CpuClock::now();
+  const auto deadline = cpu_start + std::chrono::duration_cast<CpuClock::duration>(
+                                        std::chrono::duration<double>(options.time_limit));
   SphereTreeBuild out;
   const SurfaceMesh closed = close_holes(input);
   const MeshOracle oracle(closed);
@@ -386,6 +392,19 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   }
   if (options.leaf_exchange && levels.size() > 1)
     exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
+  if (options.protrusion_polish) {
+    const auto polish_start = CpuClock::now();
+    for (size_t l = levels.size(); l-- > 0;) {
+      for (size_t i = 0; i < levels[l].size() && CpuClock::now() < deadline; ++i) {
+        const auto seed = static_cast<unsigned>(1000003 * l + i);
+        const ProtrusionPolishResult r =
+            polish_protrusion(dense, oracle, levels[l][i].sphere, seed, options.protrusion);
+        out.num_polished += r.moved ? 1 : 0;
+      }
+    }
+    out.polish_cpu_seconds =
+        std::chrono::duration<double>(CpuClock::now() - polish_start).count();
+  }
 
   // Flatten breadth-first: level by level, children of a node contiguous.
   collision::SphereTree& tree = out.tree;
@@ -420,7 +439,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     }
   }
   out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  out.hit_time_limit = Clock::now() > deadline;
+  out.cpu_seconds = std::chrono::duration<double>(CpuClock::now() - cpu_start).count();
+  out.hit_time_limit = CpuClock::now() > deadline;
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include "mesh/io/types.hpp"
 #include "mesh/spheres/exchange.hpp"
 #include "mesh/spheres/merge_burst.hpp"
+#include "mesh/spheres/protrusion.hpp"
 #include "mesh/spheres/reduction.hpp"
 #include "mesh/spheres/surface_sampling.hpp"
 
@@ -67,8 +68,16 @@ struct SphereTreeOptions {
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.
   bool joint_leaf_refinement = false;
-  /// Wall-clock budget (seconds, > 0). Past it the optimisation stops early
-  /// (no more refinement or Lloyd rounds); the tree stays valid and covering.
+  /// Last step: every node, leaves first, moves its centre to lower its true
+  /// error (how far its surface sticks out of the object, measured on points
+  /// of the sphere's surface; see polish_protrusion), its radius the smallest
+  /// that covers its samples with margin. Samples and coverage are kept.
+  bool protrusion_polish = true;
+  ProtrusionPolishOptions protrusion;  ///< see polish_protrusion
+  /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),
+  /// not wall-clock time, so a loaded machine does not change the tree; > 0).
+  /// Past it the optimisation stops early (no more Lloyd rounds or polish
+  /// steps); the tree stays valid and covering.
   double time_limit = 60.0;
 };
 
@@ -83,7 +92,10 @@ struct SphereTreeBuild {
   int num_medial_spheres = 0;      ///< medial spheres (Voronoi + cover) after refinement
   int num_refinement_points = 0;   ///< points added by the adaptive refinement
   double seconds = 0;              ///< wall-clock build time
+  double cpu_seconds = 0;          ///< process CPU time of the build
   double medial_seconds = 0;       ///< of which sampling + medial axis
+  double polish_cpu_seconds = 0;   ///< CPU time of the protrusion polish
+  int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
 };
 

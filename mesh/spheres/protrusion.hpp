@@ -1,0 +1,62 @@
+#pragma once
+/// The true error of a sphere (how far its surface sticks out of the object,
+/// measured on sphere-surface points) and a centre polish that lowers it
+/// while the sphere keeps covering its samples (issue 5).
+#include <Eigen/Core>
+
+#include "mesh/io/types.hpp"
+#include "mesh/spheres/mesh_oracle.hpp"
+#include "mesh/spheres/reduction.hpp"
+
+namespace icd::mesh {
+
+/// `count` (>= 1) unit vectors on a Fibonacci spiral, #count x 3: nearly
+/// uniform, with no symmetry shared with the icosahedral probe sets of the
+/// evaluation (probe_directions), so that fitting against them does not fit
+/// the evaluation's directions. Throws ParameterError for count < 1.
+MatX3d spiral_directions(int count);
+
+/// Largest distance to the surface of the points center + radius * d (d: the
+/// rows of `directions`, unit vectors) that lie outside the closed mesh behind
+/// `oracle`, 0 when none does (the error of evaluate_sphere_tree with other
+/// directions). Distances are taken for every point, inside tests only for
+/// the farthest ones until one lies outside.
+double sphere_protrusion(const MeshOracle& oracle, const Eigen::Vector3d& center, double radius,
+                         const Eigen::Ref<const MatX3d>& directions);
+
+/// Options of polish_protrusion().
+struct ProtrusionPolishOptions {
+  /// Sphere-surface points per evaluation in the search (spiral_directions,
+  /// turned by a rotation drawn from the sphere's index; >= 1).
+  int search_directions = 256;
+  /// Points of the acceptance check (spiral_directions, not turned; >= 1):
+  /// a move is kept only when the protrusion measured on these drops.
+  int check_directions = 1000;
+  int max_evaluations = 200;   ///< search evaluations per sphere (>= 0)
+  double initial_step = 0.08;  ///< first step of the pattern search (fraction of the radius, > 0)
+  double min_step = 0.004;     ///< the search stops below this step (fraction of the radius, > 0)
+};
+
+/// What polish_protrusion() did to one sphere.
+struct ProtrusionPolishResult {
+  double before = 0;    ///< protrusion on the check points at the start
+  double after = 0;     ///< and at the end (<= before)
+  int evaluations = 0;  ///< search evaluations spent
+  bool moved = false;   ///< true when the centre (and radius) changed
+};
+
+/// Moves the centre of `sphere` (its members given) to lower its protrusion
+/// (sphere_protrusion) by a pattern search (steps towards the 26 neighbours
+/// of a cube cell, the last successful direction tried first, the step halved
+/// when none improves), the radius being a function of the centre: the smallest that
+/// covers every member with margin, r(c) = max |s - c| + gap[s]. Every member
+/// stays covered with margin; the move is kept only when the protrusion on the
+/// check points drops (so it never rises). Updates centre, radius, depth
+/// (distance to the surface when the centre is inside, else 0) and the error
+/// bound (radius - depth). `seed` picks the search rotation (deterministic).
+/// Throws ParameterError for invalid options.
+ProtrusionPolishResult polish_protrusion(const ReductionProblem& problem, const MeshOracle& oracle,
+                                         FittedSphere& sphere, unsigned seed,
+                                         const ProtrusionPolishOptions& options = {});
+
+}  // namespace icd::mesh
