@@ -10,6 +10,7 @@
 #include "fem/constitutive.hpp"
 #include "fem/element_kernels.hpp"
 #include "fem/lane_kernels.hpp"
+#include "fem/lane_loops.hpp"
 #include "fem/polar.hpp"
 #include "mesh/io/error.hpp"
 
@@ -297,47 +298,26 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
   auto run = [&](auto model_tag) {
     constexpr MaterialModel kModel = decltype(model_tag)::value;
     if constexpr (kModel != MaterialModel::Corotational) {
-      // 8 elements at a time in lane loops; scatter in element order.
+      // 8 elements at a time in lane loops (lane_loops.hpp); scatter in element order.
+      lanes::LaneLoopInput in;
+      in.x = xp;
+      in.tets = T;
+      in.blocks = blocks;
+      in.mu = mu;
+      in.lambda = lambda;
+      in.forces = direct ? fp : nullptr;
+      in.element_forces = buf;
       for_chunks([&](int begin, int end) {
-        // Health in lane-wise accumulators (vectorised): energy partial sums,
-        // smallest det F and its element; merged in lane order at the end.
-        double lane_sum[lanes::kLanes] = {}, lane_min[lanes::kLanes], lane_arg[lanes::kLanes];
-        for (int l = 0; l < lanes::kLanes; ++l) {
-          lane_min[l] = std::numeric_limits<double>::infinity();
-          lane_arg[l] = -1;
-        }
-        for (int e0 = begin; e0 < end; e0 += lanes::kLanes) {
-          const int count = std::min(lanes::kLanes, end - e0);
-          const lanes::Block& block = blocks[e0 / lanes::kLanes];
-          double out[lanes::kLanes][12];
-          double psi[lanes::kLanes], det[lanes::kLanes];
-          lanes::block_forces<kModel, kHealth>(xp, T + 4 * e0, count, block, mu, lambda, out, psi, det);
-          if constexpr (kHealth) {
-            for (int l = 0; l < lanes::kLanes; ++l) {  // padding lanes: volume 0, det F = 0 ignored
-              const bool valid = l < count;
-              lane_sum[l] += valid ? block.volume[l] * psi[l] : 0.0;
-              const bool lower = valid && det[l] < lane_min[l];
-              lane_min[l] = lower ? det[l] : lane_min[l];
-              lane_arg[l] = lower ? static_cast<double>(e0 + l) : lane_arg[l];
-            }
-          }
-          for (int l = 0; l < count; ++l) scatter(e0 + l, out[l]);
-        }
-        double sum = 0;
+        lanes::LaneRangeHealth rh;
+        lanes::force_range<kModel, kHealth>(in, begin, end, &rh);
         if constexpr (kHealth) {
           ChunkHealth ch;
-          for (int l = 0; l < lanes::kLanes; ++l) {
-            sum += lane_sum[l];
-            if (lane_arg[l] >= 0 && (lane_min[l] < ch.min_det ||
-                                     (lane_min[l] == ch.min_det && lane_arg[l] < ch.min_element))) {
-              ch.min_det = lane_min[l];
-              ch.min_element = static_cast<int>(lane_arg[l]);
-            }
-          }
-          ch.nonfinite = std::isfinite(sum) ? -1 : begin;  // located by health() on failure
+          ch.min_det = rh.min_det;
+          ch.min_element = rh.min_element;
+          ch.nonfinite = std::isfinite(rh.energy) ? -1 : begin;  // located by health() on failure
           chunk_health[begin / kChunk] = ch;
         }
-        return sum;
+        return rh.energy;
       });
       return;
     }
@@ -495,27 +475,18 @@ void ElasticForces::differential_fast(const double* xp, const double* dp, double
   double* buf = m_element_forces.data();
   const double mu = m_mu, lambda = m_lambda;
   const auto* blocks = reinterpret_cast<const lanes::Block*>(m_lane_blocks.data());
+  lanes::LaneLoopInput in;
+  in.x = xp;
+  in.tets = T;
+  in.blocks = blocks;
+  in.mu = mu;
+  in.lambda = lambda;
+  in.forces = direct ? df : nullptr;
+  in.element_forces = buf;
   auto run = [&](auto model_tag) {
     constexpr MaterialModel kModel = decltype(model_tag)::value;
     for_chunks([&](int begin, int end) {
-      for (int e0 = begin; e0 < end; e0 += lanes::kLanes) {
-        const int count = std::min(lanes::kLanes, end - e0);
-        double out[lanes::kLanes][12];
-        lanes::block_differential<kModel>(xp, dp, T + 4 * e0, count, blocks[e0 / lanes::kLanes], mu, lambda, out);
-        for (int l = 0; l < count; ++l) {
-          if (!direct) {
-            std::copy(out[l], out[l] + 12, buf + 12 * static_cast<size_t>(e0 + l));
-            continue;
-          }
-          const int* t = T + 4 * (e0 + l);
-          for (int a = 0; a < 4; ++a) {
-            double* fa = df + 3 * t[a];
-            fa[0] += out[l][3 * a];
-            fa[1] += out[l][3 * a + 1];
-            fa[2] += out[l][3 * a + 2];
-          }
-        }
-      }
+      lanes::differential_range<kModel>(in, dp, begin, end);
       return 0.0;
     });
   };

@@ -3,6 +3,8 @@
 /// structure-of-arrays lane loops (a[k][lane]) that the compiler vectorises.
 /// Per element, the arithmetic is the same sequence of operations as the
 /// scalar kernels (element_kernels.hpp), so results are bitwise identical.
+/// Always inlined: lane_loops.cpp compiles the loops that call them for two
+/// instruction sets.
 #include "fem/element_kernels.hpp"
 #include "fem/material.hpp"
 
@@ -23,7 +25,7 @@ struct Block {
 /// every lane, with the same operations as kernels::*_energy and
 /// kernels::determinant (bitwise equal to ElasticForces::health()).
 template <MaterialModel kModel, bool kHealth = false>
-inline void block_forces(const double* x, const int* tets, int count, const Block& b, double mu, double lambda,
+[[gnu::always_inline]] inline void block_forces(const double* x, const int* tets, int count, const Block& b, double mu, double lambda,
                          double (*out)[12], double* psi = nullptr, double* det = nullptr) {
   double d[9][kLanes];
   for (int l = 0; l < kLanes; ++l) {
@@ -152,7 +154,7 @@ inline void block_forces(const double* x, const int* tets, int count, const Bloc
 /// block_forces: out[e][12] for the valid lanes. Linear, StVK and stable
 /// Neo-Hookean (the laws of element_kernels.hpp, *_stress_differential).
 template <MaterialModel kModel>
-inline void block_differential(const double* x, const double* dx, const int* tets, int count, const Block& b,
+[[gnu::always_inline]] inline void block_differential(const double* x, const double* dx, const int* tets, int count, const Block& b,
                                double mu, double lambda, double (*out)[12]) {
   double d[9][kLanes], dd[9][kLanes];
   for (int l = 0; l < kLanes; ++l) {

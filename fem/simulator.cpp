@@ -56,6 +56,7 @@ double Simulator::stable_step_limit() {
   if (m_options.integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
   // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time).
   const bool fresh = m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
+  m_last_products = 0;
   if (fresh) return m_cached_limit;
   FrequencyOptions fo = m_options.frequency;
   if (m_warm_mode.size() == 3 * m_model.num_nodes()) {
@@ -63,6 +64,7 @@ double Simulator::stable_step_limit() {
     fo.tolerance = std::max(fo.tolerance, m_options.frequency_refresh_tolerance);
   }
   m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode);
+  m_last_products = m_frequency.iterations;
   if (m_model.strain_rate_damping().enabled()) {
     FrequencyOptions fd = m_options.frequency;
     if (m_warm_damping.size() == 3 * m_model.num_nodes()) {
@@ -271,6 +273,7 @@ AdvanceReport Simulator::advance(double frame_dt) {
   AdvanceReport rep;
   rep.step_limit = stable_step_limit();
   rep.omega_max = m_frequency.omega_bound;
+  rep.frequency_products = m_last_products;
   double h;
   if (m_options.fixed_step > 0) {
     refuse_if_above_limit(m_options.fixed_step, rep.step_limit, "fixed_step");
@@ -287,6 +290,7 @@ AdvanceReport Simulator::step(double dt) {
   AdvanceReport rep;
   rep.step_limit = stable_step_limit();
   rep.omega_max = m_frequency.omega_bound;
+  rep.frequency_products = m_last_products;
   refuse_if_above_limit(dt, rep.step_limit, "step dt");
   return run(dt, dt, rep);
 }

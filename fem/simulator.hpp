@@ -70,6 +70,9 @@ struct AdvanceReport {
   double step = 0;        ///< last sub-step used, s
   double step_limit = 0;  ///< stable limit at the start of the frame, s (inf for backward Euler)
   double omega_max = 0;   ///< largest eigenfrequency bound at the start (FrequencyEstimate::omega_bound), rad/s
+  /// Lanczos products spent on that bound in this call (0: reused, see
+  /// frequency_reuse_time), rate of the strain-rate damping excluded.
+  int frequency_products = 0;
 };
 
 /// One object over time. Starts at rest in the rest configuration.
@@ -135,6 +138,7 @@ class Simulator {
   double m_energy_floor = 0;
   double m_estimate_time = -1;  ///< simulated time of the last frequency estimate (-1: none)
   double m_cached_limit = 0;    ///< stable step limit of that estimate, s
+  int m_last_products = 0;      ///< Lanczos products of the last stable_step_limit()
   bool m_checked_valid = false; ///< m_checked_elastic is the elastic energy of m_state
   double m_checked_elastic = 0;
 };

@@ -1,10 +1,12 @@
-// Determinism of the threaded element loops: bitwise-identical results for
-// 1 and 2 threads (forces, energy, differential, and whole simulations).
+// Determinism of the element loops: bitwise-identical results for 1 and 2
+// threads (forces, energy, differential, and whole simulations) and for the
+// baseline and AVX2 builds of the lane loops.
 #include <cstring>
 
 #include <gtest/gtest.h>
 
 #include "fem/forces.hpp"
+#include "fem/lane_loops.hpp"
 #include "fem/simulator.hpp"
 #include "fem_test_utils.hpp"
 
@@ -39,6 +41,31 @@ TEST_P(ParallelPerModel, ForcesEnergyAndDifferentialAreBitwiseIdenticalFor1And2T
   MatX3d f3(d.num_nodes, 3);
   two.compute(x + 1e-9 * dx, f3);
   EXPECT_FALSE(bitwise_equal(f1, f3));
+}
+
+TEST_P(ParallelPerModel, LaneLoopsAreBitwiseIdenticalForTheBaselineAndAvx2InstructionSets) {
+  // Only where the CPU has AVX2 (else there is one build to run).
+  if (!lanes::set_lane_isa(lanes::LaneIsa::AVX2)) GTEST_SKIP() << "no AVX2 on this CPU";
+  const TetMeshData d = test::box_data(9, 2, 1);  // 108 tets: 13 whole 8-lane blocks and a partial one
+  const MatX3d x = d.rest_positions + 0.01 * test::random_field(d.num_nodes, 21);
+  const MatX3d dx = test::random_field(d.num_nodes, 22);
+  MatX3d f[2], df[2];
+  ElementHealth h[2];
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_TRUE(lanes::set_lane_isa(k == 0 ? lanes::LaneIsa::Baseline : lanes::LaneIsa::AVX2));
+    ElasticForces forces(d, test::material(GetParam()));
+    f[k].resize(d.num_nodes, 3);
+    df[k].resize(d.num_nodes, 3);
+    h[k] = forces.compute_with_health(x, f[k]);
+    forces.differential(x, dx, df[k]);
+  }
+  EXPECT_TRUE(bitwise_equal(f[0], f[1]));
+  EXPECT_TRUE(bitwise_equal(df[0], df[1]));
+  EXPECT_EQ(std::memcmp(&h[0].energy, &h[1].energy, sizeof(double)), 0);
+  EXPECT_EQ(h[0].min_det_f, h[1].min_det_f);
+  EXPECT_EQ(h[0].min_det_f_element, h[1].min_det_f_element);
+  EXPECT_GT(f[0].norm(), 0.0);
+  EXPECT_GT(h[0].energy, 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(AllModels, ParallelPerModel, ::testing::ValuesIn(test::all_models()), test::model_name);
