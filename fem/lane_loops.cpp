@@ -14,12 +14,14 @@ namespace {
 
 bool cpu_has_avx2() {
 #if ICD_FEM_HAVE_AVX2_LOOPS
+  __builtin_cpu_init();  // g_isa is initialised by a static constructor, maybe before libgcc's
   return __builtin_cpu_supports("avx2");
 #else
   return false;
 #endif
 }
 
+// Zero (Baseline) until this initialiser has run: a safe default for any earlier caller.
 LaneIsa g_isa = cpu_has_avx2() ? LaneIsa::AVX2 : LaneIsa::Baseline;
 
 // Scatter of one element's 12 nodal forces (element order: deterministic sums).
