@@ -4,6 +4,8 @@
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
 //                   [--polish 0|1] [--polish-evals N] [--polish-search N] [--polish-check N]
+//                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
+//                                        evaluation directions, to show what that fit does)
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -30,6 +32,7 @@
 #include "mesh/spheres/builder.hpp"
 #include "mesh/spheres/evaluation.hpp"
 #include "mesh/spheres/mesh_oracle.hpp"
+#include "mesh/spheres/protrusion.hpp"
 
 namespace {
 
@@ -107,6 +110,51 @@ void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTre
   }
 }
 
+/// Worst and mean true error of each level, measured on 2562 directions (a
+/// 4 times subdivided icosahedron): close to the continuous protrusion.
+void print_dense_errors(const std::string& model, const icd::SurfaceMesh& mesh,
+                        const icd::collision::SphereTree& tree, double to_2000) {
+  const icd::mesh::MeshOracle oracle(icd::mesh::close_holes(mesh));
+  const icd::MatX3d dirs = icd::mesh::probe_directions(4);
+  for (int l = 0; l < tree.num_levels(); ++l) {
+    double worst = 0, sum = 0;
+    const int begin = tree.level_offset[static_cast<size_t>(l)],
+              end = tree.level_offset[static_cast<size_t>(l) + 1];
+    for (int i = begin; i < end; ++i) {
+      const auto& s = tree.spheres[static_cast<size_t>(i)];
+      const double e = to_2000 * icd::mesh::sphere_protrusion(oracle, s.center(), s.r, dirs);
+      worst = std::max(worst, e), sum += e;
+    }
+    std::printf("# %s level %d: error on 2562 directions: worst %.1f mean %.2f\n", model.c_str(),
+                l, worst, sum / (end - begin));
+  }
+}
+
+/// A copy of the tree whose leaves are re-polished against the 42 evaluation
+/// directions themselves (search and acceptance): what fitting against the
+/// probes of the metric does to it.
+icd::collision::SphereTree fit_leaves_to_probes(const icd::SurfaceMesh& mesh,
+                                                const icd::mesh::SphereTreeBuild& build) {
+  const icd::mesh::MeshOracle oracle(icd::mesh::close_holes(mesh));
+  const icd::mesh::MedialSpheres medial;  // unused by the polish
+  const icd::mesh::PointGrid grid(build.samples.points.topRows(1), 1.0);
+  const icd::mesh::ReductionProblem problem{build.samples.points, build.samples.gap, medial, grid};
+  const icd::MatX3d probes = icd::mesh::probe_directions(1);
+  icd::collision::SphereTree tree = build.tree;
+  const int leaf_level = tree.num_levels() - 1;
+  for (int i = tree.level_offset[static_cast<size_t>(leaf_level)]; i < tree.num_nodes(); ++i) {
+    auto& s = tree.spheres[static_cast<size_t>(i)];
+    icd::mesh::FittedSphere f;
+    f.center = s.center();
+    f.radius = s.r;
+    f.members = build.node_samples[static_cast<size_t>(i)];
+    icd::mesh::polish_protrusion_on(problem, oracle, f, probes, probes);
+    s = {f.center.x(), f.center.y(), f.center.z(), f.radius};
+    tree.rest_spheres[static_cast<size_t>(i)] = s;
+  }
+  return tree;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -117,7 +165,7 @@ int main(int argc, char** argv) {
            " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] "
            "[--diagnose N]"
            " [--exchange-rounds N] [--relieve-moves N] [--polish 0|1] [--polish-evals N]"
-           " [--polish-search N] [--polish-check N]\n";
+           " [--polish-search N] [--polish-check N] [--fit-probes 0|1]\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -128,6 +176,7 @@ int main(int argc, char** argv) {
   options.max_spheres_per_level = {1, 8, 64, 445};
   bool with_octree = true;
   int diagnose = 0;
+  bool fit_probes = false;
   icd::mesh::EvaluationOptions evaluation;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
@@ -154,6 +203,8 @@ int main(int argc, char** argv) {
       options.exchange_rounds = std::atoi(value);
     else if (key == "--relieve-moves")
       options.relieve_moves = std::atoi(value);
+    else if (key == "--fit-probes")
+      fit_probes = std::atoi(value) != 0;
     else if (key == "--polish")
       options.protrusion_polish = std::atoi(value) != 0;
     else if (key == "--polish-evals")
@@ -248,6 +299,13 @@ int main(int argc, char** argv) {
                   model.name.c_str(), l, worst, sum / (end - begin));
     }
     if (diagnose > 0) print_worst_leaves(mesh, ours, to_2000, diagnose);
+    print_dense_errors(model.name, mesh, ours.tree, to_2000);
+    if (fit_probes) {
+      const icd::collision::SphereTree fitted = fit_leaves_to_probes(mesh, ours);
+      print_table(model.name, "fit42", 0.0,
+                  icd::mesh::evaluate_sphere_tree(mesh, fitted, evaluation));
+      print_dense_errors(model.name + " fit42", mesh, fitted, to_2000);
+    }
     std::fflush(stdout);
     write_tree(results, model.name + "_medial", ours.tree);
     write_tree(results, model.name + "_octree", octree);

@@ -263,6 +263,77 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
   }
 }
 
+/// Samples of each inner node := union of its children's, radius refitted
+/// exactly around the fixed centre (a moved sample was covered by every
+/// ancestor of its receiver, so no radius grows).
+void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
+                       const std::vector<std::vector<int>>& parent_of) {
+  for (size_t l = levels.size() - 1; l >= 1; --l) {
+    std::vector<std::vector<int>> unions(levels[l - 1].size());
+    for (size_t i = 0; i < levels[l].size(); ++i) {
+      const auto& m = levels[l][i].sphere.members;
+      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
+      u.insert(u.end(), m.begin(), m.end());
+    }
+    for (size_t p = 0; p < unions.size(); ++p) {
+      FittedSphere& sp = levels[l - 1][p].sphere;
+      std::sort(unions[p].begin(), unions[p].end());
+      sp.members = std::move(unions[p]);
+      double r = 0;
+      for (int s : sp.members)
+        r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
+      sp.radius = r;
+      sp.error = r - sp.depth;
+    }
+  }
+}
+
+/// The protrusion polish of every node (polish_protrusion), leaves first;
+/// between the two leaf passes the leaves hand boundary samples to
+/// neighbours whose ancestors all cover them (shrink_by_exchange), and the
+/// leaves that changed are polished again. Returns the number of moves kept.
+int polish_tree(const ReductionProblem& dense, const MeshOracle& oracle,
+                std::vector<std::vector<Node>>& levels,
+                const std::vector<std::vector<int>>& parent_of,
+                const ProtrusionPolishOptions& options, CpuClock::time_point deadline) {
+  int moved = 0;
+  const size_t last = levels.size() - 1;
+  auto polish_level = [&](size_t l, const std::vector<char>* only) {
+    for (size_t i = 0; i < levels[l].size() && CpuClock::now() < deadline; ++i) {
+      if (only != nullptr && !(*only)[i]) continue;
+      const auto seed = static_cast<unsigned>(1000003 * l + i);
+      moved += polish_protrusion(dense, oracle, levels[l][i].sphere, seed, options).moved ? 1 : 0;
+    }
+  };
+  polish_level(last, nullptr);
+  if (last >= 1) {
+    auto accepts = [&](int leaf, int s) {
+      int node = leaf;
+      for (size_t l = last; l >= 1; --l) {
+        node = parent_of[l][static_cast<size_t>(node)];
+        const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
+        if ((dense.points.row(s).transpose() - a.center).norm() + dense.gap[s] > a.radius)
+          return false;
+      }
+      return true;
+    };
+    std::vector<FittedSphere> leaves;
+    for (const Node& n : levels[last]) leaves.push_back(n.sphere);
+    ExchangeOptions exchange;
+    exchange.rounds = 2;
+    shrink_by_exchange(dense, leaves, exchange, accepts);
+    std::vector<char> changed(leaves.size(), 0);
+    for (size_t i = 0; i < leaves.size(); ++i) {
+      changed[i] = leaves[i].members != levels[last][i].sphere.members ? 1 : 0;
+      levels[last][i].sphere = std::move(leaves[i]);
+    }
+    refit_inner_nodes(dense, levels, parent_of);
+    polish_level(last, &changed);
+  }
+  for (size_t l = last; l-- > 0;) polish_level(l, nullptr);
+  return moved;
+}
+
 }  // namespace
 
 SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOptions& options) {
@@ -394,14 +465,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
-    for (size_t l = levels.size(); l-- > 0;) {
-      for (size_t i = 0; i < levels[l].size() && CpuClock::now() < deadline; ++i) {
-        const auto seed = static_cast<unsigned>(1000003 * l + i);
-        const ProtrusionPolishResult r =
-            polish_protrusion(dense, oracle, levels[l][i].sphere, seed, options.protrusion);
-        out.num_polished += r.moved ? 1 : 0;
-      }
-    }
+    out.num_polished = polish_tree(dense, oracle, levels, parent_of, options.protrusion, deadline);
     out.polish_cpu_seconds =
         std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }

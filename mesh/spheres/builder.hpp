@@ -71,7 +71,9 @@ struct SphereTreeOptions {
   /// Last step: every node, leaves first, moves its centre to lower its true
   /// error (how far its surface sticks out of the object, measured on points
   /// of the sphere's surface; see polish_protrusion), its radius the smallest
-  /// that covers its samples with margin. Samples and coverage are kept.
+  /// that covers its samples with margin. Between the two passes over the
+  /// leaves, they hand boundary samples to neighbours that already cover them
+  /// (and whose ancestors do; shrink_by_exchange). Coverage is kept.
   bool protrusion_polish = true;
   ProtrusionPolishOptions protrusion;  ///< see polish_protrusion
   /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),

@@ -37,12 +37,24 @@ class CoverRadius {
 
   double operator()(const Eigen::Vector3d& c) {
     if (m_shell.empty() || (c - m_c0).norm() > m_reach) rebuild(c);
+    return on_shell(c);
+  }
+
+  /// The caller will stay within `reach` of `c` for a while: a thinner shell
+  /// is built around c when that halves the current reach or more.
+  void narrow(const Eigen::Vector3d& c, double reach) {
+    if (reach > 0.5 * m_reach) return;
+    m_reach = reach;
+    rebuild(c);
+  }
+
+ private:
+  double on_shell(const Eigen::Vector3d& c) const {
     double r = 0;
     for (const Eigen::Vector4d& s : m_shell) r = std::max(r, (s.head<3>() - c).norm() + s[3]);
     return r;
   }
 
- private:
   void rebuild(const Eigen::Vector3d& c0) {
     m_c0 = c0;
     double r0 = 0;
@@ -188,11 +200,24 @@ ProtrusionPolishResult polish_protrusion(const ReductionProblem& problem, const 
                                          FittedSphere& sphere, unsigned seed,
                                          const ProtrusionPolishOptions& options) {
   check_options(options);
+  return polish_protrusion_on(
+      problem, oracle, sphere,
+      spiral_directions(options.search_directions) * random_rotation(seed).transpose(),
+      spiral_directions(options.check_directions), options);
+}
+
+ProtrusionPolishResult polish_protrusion_on(const ReductionProblem& problem,
+                                            const MeshOracle& oracle, FittedSphere& sphere,
+                                            const Eigen::Ref<const MatX3d>& search_directions,
+                                            const Eigen::Ref<const MatX3d>& check_directions,
+                                            const ProtrusionPolishOptions& options) {
+  check_options(options);
+  if (search_directions.rows() < 1 || check_directions.rows() < 1)
+    throw ParameterError("polish_protrusion_on: empty direction set");
   ProtrusionPolishResult result;
   if (sphere.members.empty()) return result;
-  ProbeSet check(oracle, spiral_directions(options.check_directions));
-  ProbeSet search(oracle,
-                  spiral_directions(options.search_directions) * random_rotation(seed).transpose());
+  ProbeSet check(oracle, check_directions);
+  ProbeSet search(oracle, search_directions);
   const double r0 = sphere.radius;
   result.before = check.reset(sphere.center, sphere.radius);
   result.after = result.before;
@@ -227,7 +252,10 @@ ProtrusionPolishResult polish_protrusion(const ReductionProblem& problem, const 
         best = e, center = trial, radius = r, improved = true, last_direction = direction;
       }
     }
-    if (!improved) step *= 0.5;
+    if (!improved) {
+      step *= 0.5;
+      cover.narrow(center, 2 * step);
+    }
   }
   if (center == sphere.center) return result;
   const double after = check.try_move(center, radius, result.before);

@@ -28,11 +28,11 @@ double sphere_protrusion(const MeshOracle& oracle, const Eigen::Vector3d& center
 struct ProtrusionPolishOptions {
   /// Sphere-surface points per evaluation in the search (spiral_directions,
   /// turned by a rotation drawn from the sphere's index; >= 1).
-  int search_directions = 256;
+  int search_directions = 128;
   /// Points of the acceptance check (spiral_directions, not turned; >= 1):
   /// a move is kept only when the protrusion measured on these drops.
-  int check_directions = 1000;
-  int max_evaluations = 200;   ///< search evaluations per sphere (>= 0)
+  int check_directions = 600;
+  int max_evaluations = 80;    ///< search evaluations per sphere (>= 0)
   double initial_step = 0.08;  ///< first step of the pattern search (fraction of the radius, > 0)
   double min_step = 0.004;     ///< the search stops below this step (fraction of the radius, > 0)
 };
@@ -58,5 +58,15 @@ struct ProtrusionPolishResult {
 ProtrusionPolishResult polish_protrusion(const ReductionProblem& problem, const MeshOracle& oracle,
                                          FittedSphere& sphere, unsigned seed,
                                          const ProtrusionPolishOptions& options = {});
+
+/// polish_protrusion() with given search and check directions (unit rows, at
+/// least one each) instead of the spiral sets; `options`' direction counts
+/// are ignored. For experiments that show how a sphere fitted against one
+/// fixed direction set looks on others (the builder does not use it).
+ProtrusionPolishResult polish_protrusion_on(const ReductionProblem& problem,
+                                            const MeshOracle& oracle, FittedSphere& sphere,
+                                            const Eigen::Ref<const MatX3d>& search_directions,
+                                            const Eigen::Ref<const MatX3d>& check_directions,
+                                            const ProtrusionPolishOptions& options = {});
 
 }  // namespace icd::mesh

@@ -229,17 +229,20 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
   }
 }
 
-TEST(SphereTreeBuilder, ProtrusionPolishLowersNodeErrorsAndKeepsSamples) {
+TEST(SphereTreeBuilder, ProtrusionPolishNeverRaisesANodesError) {
   // The polish is the last step: the same build without it has the same
-  // samples per node; each polished node protrudes no more (measured on the
-  // polish's check directions, recomputed here), and some protrude less.
+  // nodes; each polished node protrudes no more (measured on the polish's
+  // check directions, recomputed here: the polish keeps only moves that lower
+  // it, and the exchange between its leaf passes only shrinks radii), and
+  // some protrude less.
   const Case torus = cases()[2];
   const SphereTreeBuild& polished = cached_build(torus);
   SphereTreeOptions o = small_options();
   o.protrusion_polish = false;
   const SphereTreeBuild plain = build_sphere_tree(torus.mesh, o);
   ASSERT_EQ(plain.tree.num_nodes(), polished.tree.num_nodes());
-  EXPECT_EQ(plain.node_samples, polished.node_samples);
+  EXPECT_EQ(plain.tree.level_offset, polished.tree.level_offset);
+  EXPECT_EQ(plain.node_samples.front(), polished.node_samples.front());
   EXPECT_GT(polished.num_polished, 0);
   const MeshOracle oracle(torus.mesh);
   const icd::MatX3d check = spiral_directions(o.protrusion.check_directions);
@@ -249,7 +252,7 @@ TEST(SphereTreeBuilder, ProtrusionPolishLowersNodeErrorsAndKeepsSamples) {
     const auto& b = polished.tree.spheres[i];
     const double ea = sphere_protrusion(oracle, a.center(), a.r, check);
     const double eb = sphere_protrusion(oracle, b.center(), b.r, check);
-    EXPECT_LE(eb, ea) << "node " << i;
+    EXPECT_LE(eb, ea + 1e-12) << "node " << i;
     sum_plain += ea, sum_polished += eb;
   }
   EXPECT_LT(sum_polished, sum_plain);
