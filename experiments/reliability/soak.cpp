@@ -14,7 +14,16 @@
 // --relaunch K: every K frames, give each deformable object its initial
 // speed again (keeping its deformation), aimed at the centroid of the other
 // objects: objects that bounced apart come back, so a two-object scene such
-// as bunny-dragon collides again and again.
+// as bunny-dragon collides again and again. A relaunch is external work: it
+// replaces the kinetic energy. With relaunches the energy bound applies to
+// each launch: the objects' largest energy until the next relaunch must stay
+// below --energy-factor times their energy just after the relaunch (the
+// previous frame's energy with its kinetic part replaced by the new one).
+// The energy bounded is the objects' own (kinetic + elastic + gravity): the
+// frame's energy column also holds the penalty springs of the last response,
+// which for an interrupted query are springs between coarse spheres assumed
+// colliding, a number the objects never receive in full (see the runner's
+// collision.passive). Both ratios to the initial energy are reported.
 #include <unistd.h>
 
 #include <algorithm>
@@ -79,10 +88,17 @@ Args parse_args(int argc, char** argv) {
   return a;
 }
 
-// Each deformable object gets its initial speed towards the centroid of the others.
-void relaunch(icd::runner::World& world) {
+double kinetic_energy(const icd::runner::RuntimeObject& o) {
+  const icd::MatX3d& v = o.sim->velocities();
+  return 0.5 * v.rowwise().squaredNorm().dot(o.node_mass);
+}
+
+// Each deformable object gets its initial speed towards the centroid of the
+// others. Returns the change of kinetic energy (J).
+double relaunch(icd::runner::World& world) {
   auto& objects = world.objects();
-  if (objects.size() < 2) return;
+  double change = 0;
+  if (objects.size() < 2) return change;
   for (size_t i = 0; i < objects.size(); ++i) {
     icd::runner::RuntimeObject& o = objects[i];
     if (!o.sim) continue;
@@ -94,8 +110,11 @@ void relaunch(icd::runner::World& world) {
     if (d.norm() <= 0) continue;
     icd::MatX3d v(o.positions.rows(), 3);
     v.rowwise() = (o.spec.velocity.norm() / d.norm() * d).transpose();
+    change -= kinetic_energy(o);
     o.sim->set_velocities(v);  // zero at fixed nodes
+    change += kinetic_energy(o);
   }
+  return change;
 }
 
 }  // namespace
@@ -116,19 +135,33 @@ int main(int argc, char** argv) {
     }
     runner::World world(scene, std::filesystem::path(ICD_SOURCE_DIR) / "assets", ICD_TOOL_DIR);
     std::FILE* csv = a.csv.empty() ? nullptr : std::fopen(a.csv.c_str(), "w");
-    const char* header = "frame,fps,rss_mb,energy,max_energy_ratio,contact_frames,tests,interrupted\n";
+    const char* header =
+        "frame,fps,rss_mb,energy,penalty_energy,max_energy_ratio,max_object_energy_ratio,"
+        "max_launch_gain,contact_frames,tests,interrupted\n";
     if (csv) std::fputs(header, csv);
     std::printf("%s", header);
 
-    double e0 = -1, max_ratio = 0, rss_first = -1, rss_max = 0;
+    double e0 = -1, max_ratio = 0, max_object_ratio = 0, rss_first = -1, rss_max = 0;
+    // Energy just after the current launch, the largest energy since, and the
+    // largest ratio of the two over all launches (the bound checked).
+    double e_launch = -1, e_prev = 0, max_gain = 0;
+    int worst_launch_frame = 0;
     long long contact_frames = 0, tests = 0, interrupted = 0;
     bool failed = false;
     auto t_window = std::chrono::steady_clock::now();
     const auto t_start = t_window;
     for (int f = 0; f < a.frames; ++f) {
-      if (a.relaunch > 0 && f > 0 && f % a.relaunch == 0) relaunch(world);
+      if (a.relaunch > 0 && f > 0 && f % a.relaunch == 0) e_launch = e_prev + relaunch(world);
       const runner::FrameMetrics m = world.step();
       if (e0 < 0) e0 = m.energy;
+      if (e_launch < 0) e_launch = e0;
+      const double e_objects = m.energy - m.penalty_energy;
+      e_prev = e_objects;
+      max_object_ratio = std::max(max_object_ratio, e0 > 0 ? e_objects / e0 : 0.0);
+      if (e_launch > 0 && e_objects / e_launch > max_gain) {
+        max_gain = e_objects / e_launch;
+        worst_launch_frame = a.relaunch > 0 ? f - f % a.relaunch : 0;
+      }
       bool finite = std::isfinite(m.energy);
       for (runner::RuntimeObject& o : world.objects()) finite = finite && o.positions.allFinite();
       if (!finite) {
@@ -149,8 +182,9 @@ int main(int argc, char** argv) {
         if (rss_first < 0) rss_first = rss;
         rss_max = std::max(rss_max, rss);
         char row[256];
-        std::snprintf(row, sizeof row, "%d,%.1f,%.1f,%.6g,%.4f,%lld,%lld,%lld\n", f + 1, n / dt,
-                      rss, m.energy, max_ratio, contact_frames, tests, interrupted);
+        std::snprintf(row, sizeof row, "%d,%.1f,%.1f,%.6g,%.6g,%.4f,%.4f,%.4f,%lld,%lld,%lld\n",
+                      f + 1, n / dt, rss, m.energy, m.penalty_energy, max_ratio, max_object_ratio,
+                      max_gain, contact_frames, tests, interrupted);
         std::fputs(row, stdout);
         std::fflush(stdout);
         if (csv) std::fputs(row, csv);
@@ -159,13 +193,18 @@ int main(int argc, char** argv) {
     if (csv) std::fclose(csv);
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     std::printf("soak: %d frames in %.1f s (%.1f fps), initial energy %.6g J, max energy ratio "
-                "%.4f, %lld frames with contact, %lld interrupted queries, RSS first window "
-                "%.1f MB, max %.1f MB\n",
-                a.frames, total, a.frames / total, e0, max_ratio, contact_frames, interrupted,
-                rss_first, rss_max);
-    if (max_ratio > a.energy_factor) {
-      std::fprintf(stderr, "soak: FAIL energy grew to %.4f x the initial energy (limit %.4f)\n",
-                   max_ratio, a.energy_factor);
+                "%.4f (objects %.4f, with the penalty springs %.4f), %lld frames with contact, "
+                "%lld interrupted queries, RSS first window %.1f MB, max %.1f MB\n",
+                a.frames, total, a.frames / total, e0, max_object_ratio, max_object_ratio,
+                max_ratio, contact_frames, interrupted, rss_first, rss_max);
+    if (a.relaunch > 0)
+      std::printf("soak: largest object energy within a launch / energy at its start: %.4f "
+                  "(launch at frame %d)\n",
+                  max_gain, worst_launch_frame);
+    if (max_gain > a.energy_factor) {
+      std::fprintf(stderr, "soak: FAIL energy grew to %.4f x the energy at %s (limit %.4f)\n",
+                   max_gain, a.relaunch > 0 ? "the start of its launch" : "the start",
+                   a.energy_factor);
       failed = true;
     }
     if (rss_max - rss_first > a.max_growth_mb) {

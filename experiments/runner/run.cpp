@@ -87,14 +87,14 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
   csv.precision(9);
   csv << "frame,time,wall,fem,links,sphere_update,collision,response,budget,pair_list,"
          "collision_list,tests,interrupted,completed_level,active_pairs,max_penetration,"
-         "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened\n";
+         "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened,limited\n";
   for (const FrameMetrics& m : frames)
     csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
         << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
         << ',' << m.budget << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests
         << ',' << m.interrupted << ',' << m.completed_level << ',' << m.active_pairs << ','
         << m.max_penetration << ',' << m.contact_force << ',' << m.cycles << ',' << m.substeps << ',' << m.min_step
-        << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback << ',' << m.reused << ',' << m.softened << '\n';
+        << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback << ',' << m.reused << ',' << m.softened << ',' << m.limited << '\n';
   return csv.str();
 }
 

@@ -230,6 +230,7 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.layered = f.boolean("layered", true);
   c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", true);
   c.midpoint = f.boolean("midpoint", true);
+  c.passive = f.boolean("passive", true);
   const std::string upd = f.string("sphere_update", "paper", {"paper", "conservative"});
   c.update.mode = upd == "paper" ? collision::SphereUpdateMode::PaperRatio
                                  : collision::SphereUpdateMode::DisplacementBound;

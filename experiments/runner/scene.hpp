@@ -105,6 +105,15 @@ struct CollisionSpec {
   /// cycle earlier, centred on the contact, which cancels most of the energy
   /// it would otherwise gain per contact.
   bool midpoint = true;
+  /// Keep the response passive: over a contact episode (from first contact
+  /// until every pair is apart again) the contact forces may give the
+  /// objects back the work they absorbed, plus kPassiveTolerance of the
+  /// kinetic energy at the episode's start, not more. A cycle whose forces
+  /// would do more is scaled down (World::limit_contact_work). A switching
+  /// contact set (an interrupted query answering with coarser or partial
+  /// pairs, a pair appearing already overlapping) is not a conservative
+  /// force and otherwise gains energy; false: the paper's response as computed.
+  bool passive = true;
   collision::SphereUpdateOptions update;
   coupling::ContactOptions contact;
   InterruptedResponse on_interrupt = InterruptedResponse::Previous;

@@ -127,9 +127,15 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
   //    forces), rigid motion for kinematic ones.
   for (RuntimeObject& o : m_objects) {
     if (o.plan.fem) {
+      const bool track_work = m_plan.response && m_scene.collision.passive &&
+                              m_passive_allowance >= 0;
       if (m_plan.response) o.sim->set_external_forces(o.contact_forces);
+      if (track_work) o.cycle_start = o.positions;
       const fem::AdvanceReport rep = o.sim->advance(h);
       o.positions = o.sim->positions();
+      // The forces are constant over the cycle: their work is f . dx.
+      if (track_work)
+        m_contact_work += o.contact_forces.cwiseProduct(o.positions - o.cycle_start).sum();
       m.substeps += rep.substeps;
       m.min_step = std::min(m.min_step, rep.step);
       if (last) m.energy += mechanical_energy(*o.sim, m_scene.gravity);
@@ -273,10 +279,44 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       m_penalty_energy *= m_contact_scale;
       ++m.softened;
     }
+    if (m_scene.collision.passive) limit_contact_work(h, m);
   }
   m.times.response += seconds_since(t0);
-  if (last) m.energy += m_penalty_energy;
+  if (last) {
+    m.energy += m_penalty_energy;
+    m.penalty_energy = m_penalty_energy;
+  }
 
+}
+
+void World::limit_contact_work(double h, FrameMetrics& m) {
+  if (m_node_stiffness == 0) {
+    if (contact_free()) {  // the episode is over
+      m_contact_work = 0;
+      m_passive_allowance = -1;
+    }
+    return;
+  }
+  double power = 0, kinetic = 0;  // contact force . velocity (W); kinetic energy (J)
+  for (const RuntimeObject& o : m_objects) {
+    if (!o.sim) continue;  // static and kinematic objects: external motion
+    const MatX3d& v = o.sim->velocities();
+    power += o.contact_forces.cwiseProduct(v).sum();
+    if (m_passive_allowance < 0) kinetic += 0.5 * v.rowwise().squaredNorm().dot(o.node_mass);
+  }
+  if (m_passive_allowance < 0) m_passive_allowance = kPassiveTolerance * kinetic;
+  // The contact is passive while the net work its forces have done on the
+  // objects (negative while it resists their approach, positive while it
+  // pushes them apart) stays below the allowance: it may give back what it
+  // absorbed, not more. The work of the coming cycle is predicted from the
+  // current velocities; the actual work is summed in cycle().
+  const double work = h * power;
+  const double room = m_passive_allowance - m_contact_work;
+  if (work <= 0 || work <= room) return;
+  const double s = std::clamp(room / work, 0.0, 1.0);
+  for (RuntimeObject& o : m_objects) o.contact_forces *= s;
+  m_penalty_energy *= s;
+  ++m.limited;
 }
 
 bool World::contact_free() const {
@@ -299,6 +339,8 @@ void World::save(Snapshot& s) const {
   s.complete_depth = m_complete_depth;
   s.node_stiffness = m_node_stiffness;
   s.contact_scale = m_contact_scale;
+  s.contact_work = m_contact_work;
+  s.passive_allowance = m_passive_allowance;
 }
 
 void World::restore(const Snapshot& s) {
@@ -317,6 +359,8 @@ void World::restore(const Snapshot& s) {
   m_complete_depth = s.complete_depth;
   m_node_stiffness = s.node_stiffness;
   m_contact_scale = s.contact_scale;
+  m_contact_work = s.contact_work;
+  m_passive_allowance = s.passive_allowance;
   m_penalty_energy = 0;  // the trial started contact-free
 }
 

@@ -47,12 +47,18 @@ struct FrameMetrics {
   /// Cycles whose penalty forces were scaled down because the stiffness on
   /// the lightest node exceeded what the cycle length allows (see kContactOmegaLimit).
   int softened = 0;
+  /// Cycles whose penalty forces were scaled down to keep the contact
+  /// passive (collision.passive).
+  int limited = 0;
   int substeps = 0;            ///< FEM sub-steps summed over objects
   double min_step = 0;         ///< smallest FEM step used, s
   /// Mechanical energy of the deformable objects, J: kinetic + elastic +
   /// gravity potential, plus the energy in the penalty springs of the last
   /// response (contact forces are not counted as loads with a potential).
   double energy = 0;
+  /// The part of `energy` held by the penalty springs of the last response, J
+  /// (for an interrupted query, springs between coarse spheres assumed colliding).
+  double penalty_energy = 0;
   int exact_contacts = -1;     ///< exact intersecting dense triangle pairs (-1: not computed)
 };
 
@@ -68,6 +74,7 @@ struct RuntimeObject {
   MatX3d dense;           ///< current dense positions (when the plan updates them)
   coupling::LinkEvaluator links;  ///< the rigid links, grouped by node triple (when dense_update)
   MatX3d predicted;       ///< coarse positions half a cycle ahead (collision.midpoint)
+  MatX3d cycle_start;     ///< coarse positions at the start of the cycle (collision.passive)
   Eigen::VectorXd node_mass;  ///< lumped coarse node masses (kg); huge for objects without FEM
 };
 
@@ -87,6 +94,11 @@ class World {
   /// Advances one frame of 1 / frame_rate simulated seconds. `budget` is the
   /// collision budget per query (seconds); negative uses the scene's.
   FrameMetrics step(double budget = -1);
+
+  /// Net energy a contact episode may give the objects with collision.passive,
+  /// as a fraction of their kinetic energy when it began (the explicit
+  /// penalty's own small gain, ~0.4% per bounce, stays untouched).
+  static constexpr double kPassiveTolerance = 0.01;
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -109,6 +121,7 @@ class World {
     std::vector<double> complete_time, complete_depth;
     double node_stiffness = 0;
     double contact_scale = 1;
+    double contact_work = 0, passive_allowance = -1;
   };
   void save(Snapshot& s) const;
   void restore(const Snapshot& s);
@@ -126,6 +139,9 @@ class World {
   /// than kMaxContactCycles, or stiffness jumping within a frame) its forces
   /// are scaled by (kContactOmegaLimit / omega h)^2: a softer but stable penalty.
   static constexpr double kContactOmegaLimit = 1.0;
+  /// Scales this cycle's contact forces so the episode stays passive (see
+  /// CollisionSpec::passive); h is the cycle length (s).
+  void limit_contact_work(double h, FrameMetrics& m);
 
   Scene m_scene;
   StagePlan m_plan;
@@ -142,6 +158,11 @@ class World {
   double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
   double m_penalty_energy = 0;  ///< penalty spring energy of the last response, J
   double m_contact_scale = 1;   ///< softening of the current contact episode (1: none)
+  /// Work done by the contact forces on the deformable objects since the
+  /// contact episode began, J (collision.passive).
+  double m_contact_work = 0;
+  /// Net energy the current episode may add, J (-1: no episode under way).
+  double m_passive_allowance = -1;
   Snapshot m_snapshot;          ///< reused storage for the single-cycle trial
   int m_frame = 0;
   double m_time = 0;
