@@ -62,6 +62,7 @@ double Simulator::stable_step_limit() {
   if (m_warm_mode.size() == 3 * m_model.num_nodes()) {
     fo.max_iterations = std::min(fo.max_iterations, m_options.frequency_refresh_iterations);
     fo.tolerance = std::max(fo.tolerance, m_options.frequency_refresh_tolerance);
+    fo.finite_difference_products = fo.finite_difference_products || m_options.frequency_refresh_finite_differences;
   }
   m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode);
   m_last_products = m_frequency.iterations;

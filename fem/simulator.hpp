@@ -39,6 +39,10 @@ struct SimulatorOptions {
   /// at most 2.3% low; a single warm vector with 4 iterations was up to 7%
   /// (tolerance 1e-5) or 10% (1e-2) low, as the top mode changes.
   double frequency_refresh_tolerance = 1e-3;
+  /// Those warm re-estimates take their products by forward differences of
+  /// the forces (FrequencyOptions::finite_difference_products: one force
+  /// evaluation each instead of a force differential, relative error ~1e-7).
+  bool frequency_refresh_finite_differences = true;
   /// Reuse the last largest-eigenfrequency estimate for calls of advance() /
   /// step() within this much simulated time (s, >= 0; 0 = estimate at every
   /// call). For callers that advance in many short pieces (the runner's
