@@ -3,7 +3,8 @@
 //                   [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
-//                   [--polish 0|1] [--polish-evals N] [--polish-search N] [--polish-check N]
+//                   [--polish 0|1] [--polish-rounds N] [--polish-evals N]
+//                   [--polish-search N] [--polish-check N]
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
 //
@@ -125,8 +126,8 @@ void print_dense_errors(const std::string& model, const icd::SurfaceMesh& mesh,
       const double e = to_2000 * icd::mesh::sphere_protrusion(oracle, s.center(), s.r, dirs);
       worst = std::max(worst, e), sum += e;
     }
-    std::printf("# %s level %d: error on 2562 directions: worst %.1f mean %.2f\n", model.c_str(),
-                l, worst, sum / (end - begin));
+    std::printf("# %s level %d: error on 2562 directions: worst %.1f mean %.2f\n", model.c_str(), l,
+                worst, sum / (end - begin));
   }
 }
 
@@ -164,7 +165,8 @@ int main(int argc, char** argv) {
            " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
            " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] "
            "[--diagnose N]"
-           " [--exchange-rounds N] [--relieve-moves N] [--polish 0|1] [--polish-evals N]"
+           " [--exchange-rounds N] [--relieve-moves N] [--polish 0|1] [--polish-rounds N]"
+           " [--polish-evals N]"
            " [--polish-search N] [--polish-check N] [--fit-probes 0|1]\n";
     return 2;
   }
@@ -207,6 +209,8 @@ int main(int argc, char** argv) {
       fit_probes = std::atoi(value) != 0;
     else if (key == "--polish")
       options.protrusion_polish = std::atoi(value) != 0;
+    else if (key == "--polish-rounds")
+      options.protrusion_exchange_rounds = std::atoi(value);
     else if (key == "--polish-evals")
       options.protrusion.max_evaluations = std::atoi(value);
     else if (key == "--polish-search")
@@ -281,8 +285,7 @@ int main(int argc, char** argv) {
         "s, build CPU time %.1f s (protrusion polish %.1f s, %d nodes moved)%s\n",
         model.name.c_str(), static_cast<long long>(ours.samples.points.rows()),
         ours.num_medial_spheres, ours.num_refinement_points, ours.medial_seconds, build_cpu_s,
-        ours.polish_cpu_seconds, ours.num_polished,
-        ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+        ours.polish_cpu_seconds, ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // The builder's own error bound (radius - centre depth), normalized, per level.
     const double to_2000 =
         2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();

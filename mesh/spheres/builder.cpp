@@ -31,6 +31,7 @@ void check_options(const SphereTreeOptions& o) {
   if (o.merge_burst_lloyd_iterations < 0) fail("merge_burst_lloyd_iterations must be >= 0");
   if (o.exchange_rounds < 0) fail("exchange_rounds must be >= 0");
   if (o.relieve_moves < 0) fail("relieve_moves must be >= 0");
+  if (o.protrusion_exchange_rounds < 0) fail("protrusion_exchange_rounds must be >= 0");
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
   if (o.protrusion.search_directions < 1 || o.protrusion.check_directions < 1 ||
@@ -289,13 +290,14 @@ void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<No
 }
 
 /// The protrusion polish of every node (polish_protrusion), leaves first;
-/// between the two leaf passes the leaves hand boundary samples to
-/// neighbours whose ancestors all cover them (shrink_by_exchange), and the
+/// then `exchange_rounds` times the leaves hand boundary samples to
+/// neighbours whose ancestors all cover them (shrink_by_exchange) and the
 /// leaves that changed are polished again. Returns the number of moves kept.
 int polish_tree(const ReductionProblem& dense, const MeshOracle& oracle,
                 std::vector<std::vector<Node>>& levels,
                 const std::vector<std::vector<int>>& parent_of,
-                const ProtrusionPolishOptions& options, CpuClock::time_point deadline) {
+                const ProtrusionPolishOptions& options, int exchange_rounds,
+                CpuClock::time_point deadline) {
   int moved = 0;
   const size_t last = levels.size() - 1;
   auto polish_level = [&](size_t l, const std::vector<char>* only) {
@@ -306,7 +308,7 @@ int polish_tree(const ReductionProblem& dense, const MeshOracle& oracle,
     }
   };
   polish_level(last, nullptr);
-  if (last >= 1) {
+  for (int round = 0; round < exchange_rounds && last >= 1; ++round) {
     auto accepts = [&](int leaf, int s) {
       int node = leaf;
       for (size_t l = last; l >= 1; --l) {
@@ -321,7 +323,7 @@ int polish_tree(const ReductionProblem& dense, const MeshOracle& oracle,
     for (const Node& n : levels[last]) leaves.push_back(n.sphere);
     ExchangeOptions exchange;
     exchange.rounds = 2;
-    shrink_by_exchange(dense, leaves, exchange, accepts);
+    if (shrink_by_exchange(dense, leaves, exchange, accepts) == 0) break;
     std::vector<char> changed(leaves.size(), 0);
     for (size_t i = 0; i < leaves.size(); ++i) {
       changed[i] = leaves[i].members != levels[last][i].sphere.members ? 1 : 0;
@@ -465,9 +467,9 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
-    out.num_polished = polish_tree(dense, oracle, levels, parent_of, options.protrusion, deadline);
-    out.polish_cpu_seconds =
-        std::chrono::duration<double>(CpuClock::now() - polish_start).count();
+    out.num_polished = polish_tree(dense, oracle, levels, parent_of, options.protrusion,
+                                   options.protrusion_exchange_rounds, deadline);
+    out.polish_cpu_seconds = std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }
 
   // Flatten breadth-first: level by level, children of a node contiguous.

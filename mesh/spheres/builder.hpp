@@ -38,7 +38,7 @@ struct SphereTreeOptions {
   /// one per parent go where the summed child error drops most (favours the
   /// mean error), the rest to the parents with the worst child (favours the
   /// worst error). In [0, 1].
-  double worst_share = 0.3;
+  double worst_share = 0.2;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;
@@ -71,10 +71,13 @@ struct SphereTreeOptions {
   /// Last step: every node, leaves first, moves its centre to lower its true
   /// error (how far its surface sticks out of the object, measured on points
   /// of the sphere's surface; see polish_protrusion), its radius the smallest
-  /// that covers its samples with margin. Between the two passes over the
-  /// leaves, they hand boundary samples to neighbours that already cover them
-  /// (and whose ancestors do; shrink_by_exchange). Coverage is kept.
+  /// that covers its samples with margin. Coverage is kept.
   bool protrusion_polish = true;
+  /// With protrusion_polish: rounds in which the polished leaves hand
+  /// boundary samples to neighbours that already cover them (and whose
+  /// ancestors do; shrink_by_exchange), each followed by a new polish of the
+  /// leaves that changed (>= 0).
+  int protrusion_exchange_rounds = 1;
   ProtrusionPolishOptions protrusion;  ///< see polish_protrusion
   /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),
   /// not wall-clock time, so a loaded machine does not change the tree; > 0).

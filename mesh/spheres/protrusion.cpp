@@ -155,10 +155,9 @@ Eigen::Matrix3d random_rotation(unsigned seed) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
   const double two_pi = 2 * std::numbers::pi;
-  const Eigen::Quaterniond q(std::sqrt(u1) * std::cos(two_pi * u3),
-                             std::sqrt(1 - u1) * std::sin(two_pi * u2),
-                             std::sqrt(1 - u1) * std::cos(two_pi * u2),
-                             std::sqrt(u1) * std::sin(two_pi * u3));
+  const Eigen::Quaterniond q(
+      std::sqrt(u1) * std::cos(two_pi * u3), std::sqrt(1 - u1) * std::sin(two_pi * u2),
+      std::sqrt(1 - u1) * std::cos(two_pi * u2), std::sqrt(u1) * std::sin(two_pi * u3));
   return q.normalized().toRotationMatrix();
 }
 
@@ -219,9 +218,7 @@ ProtrusionPolishResult polish_protrusion_on(const ReductionProblem& problem,
   ProbeSet check(oracle, check_directions);
   ProbeSet search(oracle, search_directions);
   const double r0 = sphere.radius;
-  result.before = check.reset(sphere.center, sphere.radius);
-  result.after = result.before;
-  if (result.before == 0 || options.max_evaluations == 0) return result;
+  if (options.max_evaluations == 0) return result;
 
   CoverRadius cover(problem, sphere.members, 2 * options.initial_step * r0);
   Eigen::Vector3d center = sphere.center;
@@ -258,7 +255,11 @@ ProtrusionPolishResult polish_protrusion_on(const ReductionProblem& problem,
     }
   }
   if (center == sphere.center) return result;
+  // The check points are evaluated only when the search moved the centre.
+  result.checked = true;
+  result.before = check.reset(sphere.center, sphere.radius);
   const double after = check.try_move(center, radius, result.before);
+  result.after = result.before;
   if (!(after < result.before)) return result;
   assert(radius >= 0);
   sphere.center = center;

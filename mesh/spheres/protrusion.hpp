@@ -39,6 +39,9 @@ struct ProtrusionPolishOptions {
 
 /// What polish_protrusion() did to one sphere.
 struct ProtrusionPolishResult {
+  /// True when the search found a better centre, so that both were measured
+  /// on the check points; before and after are 0 otherwise.
+  bool checked = false;
   double before = 0;    ///< protrusion on the check points at the start
   double after = 0;     ///< and at the end (<= before)
   int evaluations = 0;  ///< search evaluations spent
