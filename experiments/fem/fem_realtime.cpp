@@ -3,11 +3,27 @@
 // (0.025 m cells) or a 10 x 8 x 8-cell block 1.0 x 0.8 x 0.8 m (0.1 m cells);
 // StVK (the paper's model), advanced frame by frame (1/60 s) by the
 // Simulator with automatic steps (0.9 x the stable limit, re-estimated each
-// frame, health checks on). Prints, for RK4 and symplectic Euler, the process
-// CPU time and the wall time per simulated second (medians of 7 repetitions
-// of 1 simulated second, a fresh Simulator each), their ratios, and the cost
-// of the health checks: every step (the default), every 4th step, and only
-// at the end of each frame. The load average is printed
+// frame, health checks on). For RK4 and symplectic Euler it measures the
+// process CPU time and the wall time per simulated second (medians of 11
+// repetitions of 1 simulated second, a fresh Simulator each; the ratios also
+// from the minima, which interference from other processes does not inflate) of:
+//   - the default configuration (health checks every step, lane loops in
+//     the best instruction set the CPU has: AVX2 on x86-64 where present);
+//   - health checks every 2nd and every 4th step, and only at the end of
+//     each frame (the same check cadence for both integrators: the pure
+//     integrator ratio);
+//   - the default configuration with exact (force-differential) Lanczos
+//     products in the per-frame re-estimates instead of forward differences,
+//     with the baseline x86-64 lane loops instead of AVX2, and with both
+//     (the configuration before this round).
+// All configurations are interleaved repetition by repetition, so that load
+// changes on a shared machine hit all of them alike. Then it splits the
+// default configuration's CPU time into force evaluations (with the health
+// check fused into one of them per step), the omega_max estimates (the cold
+// first one with force differentials, the warm per-frame ones with a force
+// evaluation per product and one for f(x)) and the rest (node passes, step
+// control, the in-situ slowdown of the kernels), from the cost of one force
+// evaluation and one force differential measured in the same run. The load average is printed
 // before and after: the machine may be shared.
 //
 // Usage: fem_realtime [bar|block] [threads]
@@ -20,10 +36,14 @@
 #include <string>
 #include <vector>
 
+#include "fem/lane_loops.hpp"
 #include "fem/simulator.hpp"
 #include "mesh/io/primitives.hpp"
 
 namespace {
+
+using namespace icd;
+using namespace icd::fem;
 
 std::string load_average() {
   std::ifstream in("/proc/loadavg");
@@ -32,15 +52,16 @@ std::string load_average() {
   return in ? a + " " + b + " " + c : "unknown";
 }
 
+double cpu_seconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+
 struct Run {
   double wall = 0, cpu = 0;
-  icd::fem::AdvanceReport last;
-  long force_evaluations = 0;  // in the simulated second, from the sub-step counts
+  AdvanceReport last;
+  long substeps = 0;
+  long first_products = 0, products = 0;  // Lanczos products: first (cold) estimate, later frames
 };
 
-// One simulated second (60 frames) with a fresh Simulator.
-Run run_once(const icd::TetMesh& m, icd::fem::Integrator integ, int check_interval, int threads) {
-  using namespace icd::fem;
+Model bar_model(const TetMesh& m, int threads) {
   Material mat;
   mat.model = MaterialModel::StVK;
   mat.young = 1e6;
@@ -53,21 +74,28 @@ Run run_once(const icd::TetMesh& m, icd::fem::Integrator integ, int check_interv
   for (int i = 0; i < m.V.rows(); ++i)
     if (m.V(i, 0) < 1e-12) fixed.push_back(i);
   model.set_fixed_nodes(fixed);
+  return model;
+}
+
+// One simulated second (60 frames) with a fresh Simulator.
+Run run_once(const TetMesh& m, Integrator integ, int check_interval, bool fd_products,
+             lanes::LaneIsa isa, int threads) {
+  lanes::set_lane_isa(isa);
   SimulatorOptions so;
   so.integrator = integ;
   so.check_interval = check_interval;
-  Simulator sim(std::move(model), so);
+  so.frequency_refresh_finite_differences = fd_products;
+  Simulator sim(bar_model(m, threads), so);
   Run r;
-  long substeps = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  const std::clock_t c0 = std::clock();
+  const double c0 = cpu_seconds();
   for (int f = 0; f < 60; ++f) {
     r.last = sim.advance(1.0 / 60);
-    substeps += r.last.substeps;
+    r.substeps += r.last.substeps;
+    (f == 0 ? r.first_products : r.products) += r.last.frequency_products;
   }
-  r.cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+  r.cpu = cpu_seconds() - c0;
   r.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  r.force_evaluations = substeps * (integ == Integrator::RK4 ? 4 : 1);
   return r;
 }
 
@@ -76,11 +104,21 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// CPU seconds of one call of op (median of 3 batches of 100 calls).
+template <class Op>
+double cpu_per_call(Op&& op) {
+  std::vector<double> t;
+  for (int b = 0; b < 3; ++b) {
+    const double c0 = cpu_seconds();
+    for (int k = 0; k < 100; ++k) op();
+    t.push_back((cpu_seconds() - c0) / 100);
+  }
+  return median(t);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  using namespace icd;
-  using namespace icd::fem;
   const bool block = argc > 1 && std::string(argv[1]) == "block";
   const int threads = argc > 2 ? std::atoi(argv[2]) : 1;
   BoxMeshOptions bo;
@@ -89,44 +127,114 @@ int main(int argc, char** argv) {
   bo.nz = block ? 8 : 4;
   bo.size = block ? Eigen::Vector3d(1.0, 0.8, 0.8) : Eigen::Vector3d(1.0, 0.1, 0.1);
   const TetMesh m = make_box_tet_mesh(bo);
-  std::printf("%s mesh: %ld tets, %ld nodes, %d thread(s); load average before: %s\n", block ? "block" : "bar",
-              static_cast<long>(m.T.rows()), static_cast<long>(m.V.rows()), threads, load_average().c_str());
-  // Six configurations (2 integrators x checks every step / every 4th step /
-  // at frame ends only), interleaved repetition by repetition so that load
-  // changes on a shared machine hit all of them alike; medians of 7.
+  const lanes::LaneIsa best = lanes::lane_isa();
+  std::printf(
+      "%s mesh: %ld tets, %ld nodes, %d thread(s), lane loops: %s; load average before: %s\n",
+      block ? "block" : "bar", static_cast<long>(m.T.rows()), static_cast<long>(m.V.rows()),
+      threads, lanes::to_string(best), load_average().c_str());
+  struct Config {
+    int check_interval;
+    bool fd_products;
+    lanes::LaneIsa isa;
+    const char* name;
+  };
+  const lanes::LaneIsa base = lanes::LaneIsa::Baseline;
+  const Config configs[] = {
+      {1, true, best, "checks every step (default)"},
+      {2, true, best, "checks every 2nd step"},
+      {4, true, best, "checks every 4th step"},
+      {1 << 30, true, best, "checks at frame ends only"},
+      {1, false, best,
+       "checks every step, exact Lanczos products (force differentials) in the re-estimates"},
+      {1, true, base, "checks every step, baseline x86-64 lane loops"},
+      {1, false, base,
+       "checks every step, baseline lane loops and exact products (before this round)"}};
+  const int nconfigs = sizeof(configs) / sizeof(configs[0]);
   const Integrator integs[2] = {Integrator::RK4, Integrator::SymplecticEuler};
-  const int intervals[3] = {1, 4, 1 << 30};
-  const int reps = 7;
-  std::vector<double> cpu[2][3], wall[2][3];
-  Run last[2];
-  for (int rep = 0; rep < reps; ++rep)
+  // Unit costs: one force evaluation with and without the fused health
+  // check, and one force differential, at a sagged state; measured once per
+  // repetition (interleaved with the runs) with the best lane loops.
+  Simulator sagged(bar_model(m, threads));
+  for (int f = 0; f < 30; ++f) sagged.advance(1.0 / 60);
+  const MatX3d x = sagged.positions();
+  const MatX3d dx = MatX3d::Constant(x.rows(), 3, 1e-3);
+  MatX3d out(x.rows(), 3);
+  ElasticForces& forces = sagged.model().elastic();
+  const int reps = 11;
+  std::vector<double> cpu[2][nconfigs], wall[2][nconfigs], u_eval, u_health, u_product;
+  Run last[2][nconfigs];
+  for (int rep = 0; rep < reps; ++rep) {
     for (int k = 0; k < 2; ++k)
-      for (int c = 0; c < 3; ++c) {
-        const Run r = run_once(m, integs[k], intervals[c], threads);
+      for (int c = 0; c < nconfigs; ++c) {
+        const Run r = run_once(m, integs[k], configs[c].check_interval, configs[c].fd_products,
+                               configs[c].isa, threads);
         cpu[k][c].push_back(r.cpu);
         wall[k][c].push_back(r.wall);
-        if (c == 0) last[k] = r;
+        last[k][c] = r;
       }
-  double cpu_med[2], wall_med[2];
-  for (int k = 0; k < 2; ++k) {
-    cpu_med[k] = median(cpu[k][0]);
-    wall_med[k] = median(wall[k][0]);
-    const Run& t = last[k];
-    std::printf("%-17s last frame: step %.3e s (limit %.3e s, omega bound %.0f rad/s), %d substeps; %ld force "
-                "evaluations per simulated second: process CPU %.3f s, wall %.3f s (medians of %d) -> %.2fx real "
-                "time by CPU, %.2fx by wall; %.0f ns CPU per tet and force evaluation\n",
-                to_string(integs[k]), t.last.step, t.last.step_limit, t.last.omega_max, t.last.substeps,
-                t.force_evaluations, cpu_med[k], wall_med[k], reps, 1.0 / cpu_med[k], 1.0 / wall_med[k],
-                cpu_med[k] / t.force_evaluations / m.T.rows() * 1e9);
+    lanes::set_lane_isa(best);
+    u_eval.push_back(cpu_per_call([&] { forces.compute(x, out); }));
+    u_health.push_back(cpu_per_call([&] { forces.compute_with_health(x, out); }));
+    u_product.push_back(cpu_per_call([&] { forces.differential(x, dx, out); }));
   }
-  std::printf("symplectic Euler is %.2fx faster than RK4 by CPU time, %.2fx by wall time (4 evaluations vs 1 "
-              "at limits 2.83/omega vs 2/omega: 2.83x)\n",
-              cpu_med[0] / cpu_med[1], wall_med[0] / wall_med[1]);
+  const double t_eval = median(u_eval), t_health = median(u_health), t_product = median(u_product);
+  const double ntets = static_cast<double>(m.T.rows());
+  std::printf(
+      "unit CPU costs (medians over the repetitions of 3 x 100 calls): force evaluation %.1f "
+      "ns/tet, with the fused health check %.1f ns/tet, force differential %.1f ns/tet\n",
+      t_eval / ntets * 1e9, t_health / ntets * 1e9, t_product / ntets * 1e9);
+  double cpu_med[2][nconfigs], wall_med[2][nconfigs], cpu_min[2][nconfigs];
+  for (int k = 0; k < 2; ++k)
+    for (int c = 0; c < nconfigs; ++c) {
+      cpu_med[k][c] = median(cpu[k][c]);
+      wall_med[k][c] = median(wall[k][c]);
+      cpu_min[k][c] = *std::min_element(cpu[k][c].begin(), cpu[k][c].end());
+    }
+  for (int c = 0; c < nconfigs; ++c) {
+    std::printf("%s:\n", configs[c].name);
+    for (int k = 0; k < 2; ++k) {
+      const Run& t = last[k][c];
+      const long evals = t.substeps * (integs[k] == Integrator::RK4 ? 4 : 1);
+      std::printf(
+          "  %-17s last frame: step %.3e s (limit %.3e s, omega bound %.0f rad/s), %d substeps; "
+          "%ld force evaluations per simulated second: process CPU %.3f s, wall %.3f s (medians of "
+          "%d) -> %.2fx real time by CPU, %.2fx by wall; %.1f ns CPU per tet and force "
+          "evaluation\n",
+          to_string(integs[k]), t.last.step, t.last.step_limit, t.last.omega_max, t.last.substeps,
+          evals, cpu_med[k][c], wall_med[k][c], reps, 1.0 / cpu_med[k][c], 1.0 / wall_med[k][c],
+          cpu_med[k][c] / evals / ntets * 1e9);
+    }
+    std::printf(
+        "  symplectic Euler is %.2fx faster than RK4 by CPU time (%.2fx from the minima), %.2fx by "
+        "wall time (4 evaluations vs 1 at limits 2.83/omega vs 2/omega: 2.83x)\n",
+        cpu_med[0][c] / cpu_med[1][c], cpu_min[0][c] / cpu_min[1][c],
+        wall_med[0][c] / wall_med[1][c]);
+  }
+  std::printf(
+      "same check cadence: RK4 checked every step (%ld checks per simulated s) vs symplectic Euler "
+      "every 2nd step (%ld): %.2fx by CPU\n",
+      last[0][0].substeps, (last[1][1].substeps + 1) / 2, cpu_med[0][0] / cpu_med[1][1]);
+  std::printf(
+      "this round (default) vs before (baseline lane loops, exact products), CPU: RK4 %.2fx, "
+      "symplectic Euler %.2fx faster\n",
+      cpu_med[0][nconfigs - 1] / cpu_med[0][0], cpu_med[1][nconfigs - 1] / cpu_med[1][0]);
+  std::printf(
+      "where the default configuration's CPU time goes (per simulated second; unit costs "
+      "above):\n");
   for (int k = 0; k < 2; ++k) {
-    const double every = cpu_med[k], every4 = median(cpu[k][1]), end = median(cpu[k][2]);
-    std::printf("%-17s health checks every step / every 4th step / at frame ends only: CPU %.3f / %.3f / %.3f s "
-                "per simulated s: every step %+.1f%%, every 4th %+.1f%% vs frame ends only\n",
-                to_string(integs[k]), every, every4, end, 100 * (every / end - 1), 100 * (every4 / end - 1));
+    const Run& t = last[k][0];
+    const int per_step = integs[k] == Integrator::RK4 ? 4 : 1;
+    const double evals = t.substeps * ((per_step - 1) * t_eval + t_health);
+    const double lanczos = t.first_products * t_product + (t.products + 59) * t_eval;
+    const double total = cpu_med[k][0];
+    std::printf(
+        "  %-17s %.3f s: force evaluations %.3f s (%.0f%%, of which fused health checks %.3f s), "
+        "omega_max estimates %.3f s (%.0f%%: %ld cold products, then %ld warm ones + 59 f(x) in 59 "
+        "frames), rest %.3f s (%.0f%%: node passes, frame-end health pass, step control, in-situ "
+        "kernel slowdown)\n",
+        to_string(integs[k]), total, evals, 100 * evals / total, t.substeps * (t_health - t_eval),
+        lanczos, 100 * lanczos / total, t.first_products, t.products, total - evals - lanczos,
+        100 * (total - evals - lanczos) / total);
   }
   std::printf("load average after: %s\n", load_average().c_str());
   return 0;
