@@ -134,29 +134,24 @@ int main(int argc, char** argv) {
   // one cycle's push (the energy column counts the deep springs' energy the
   // balls never receive); "passive": false releases the springs' energy (the
   // paper's response).
-  cases.push_back({"coincident_centres",
-                   "both balls at the same place"});
+  const char* raw = R"("budget_tests": 2000, "passive": false)";
+  const auto overlapping = [&](const char* name, const char* what, const char* collision) {
+    cases.push_back({name, what});
+    cases.back().left_x = -0.075;
+    cases.back().right_x = 0.075;
+    cases.back().speed = 0;
+    if (collision) cases.back().collision = collision;
+  };
+  cases.push_back({"coincident_centres", "both balls at the same place"});
   cases.back().left_x = cases.back().right_x = 0;
   cases.push_back({"coincident_centres_raw", "as above, \"passive\": false"});
   cases.back().left_x = cases.back().right_x = 0;
-  cases.back().collision = R"("budget_tests": 2000, "passive": false)";
-  cases.push_back({"start_interpenetrated",
-                   "balls overlap by half a radius at t = 0, at rest"});
-  cases.back().left_x = -0.075;
-  cases.back().right_x = 0.075;
-  cases.back().speed = 0;
-  cases.push_back({"start_interpenetrated_raw", "as above, \"passive\": false"});
-  cases.back().left_x = -0.075;
-  cases.back().right_x = 0.075;
-  cases.back().speed = 0;
-  cases.back().collision = R"("budget_tests": 2000, "passive": false)";
-  cases.push_back({"start_interpenetrated_snh_raw",
-                   "as above, inversion-safe stable Neo-Hookean: pushed apart"});
-  cases.back().left_x = -0.075;
-  cases.back().right_x = 0.075;
-  cases.back().speed = 0;
+  cases.back().collision = raw;
+  overlapping("start_interpenetrated", "balls overlap by half a radius at t = 0, at rest", nullptr);
+  overlapping("start_interpenetrated_raw", "as above, \"passive\": false", raw);
+  overlapping("start_interpenetrated_snh_raw",
+              "as above, inversion-safe stable Neo-Hookean: pushed apart", raw);
   cases.back().model = "stable_neo_hookean";
-  cases.back().collision = R"("budget_tests": 2000, "passive": false)";
   cases.push_back({"sudden_huge_force", "impulse: +100 m/s on the left ball mid-run"});
   cases.back().kick_at_half = 100;
 
