@@ -4,9 +4,10 @@
 // StVK (the paper's model), advanced frame by frame (1/60 s) by the
 // Simulator with automatic steps (0.9 x the stable limit, re-estimated each
 // frame, health checks on). For RK4 and symplectic Euler it measures the
-// process CPU time and the wall time per simulated second (medians of 11
-// repetitions of 1 simulated second, a fresh Simulator each; the ratios also
-// from the minima, which interference from other processes does not inflate) of:
+// process CPU time and the wall time per simulated second (11 repetitions of
+// 1 simulated second, a fresh Simulator each; per frame the median over the
+// repetitions, summed over the 60 frames; the ratios also from the smallest
+// per-second totals, which interference from other processes inflates least) of:
 //   - the default configuration (health checks every step, lane loops in
 //     the best instruction set the CPU has: AVX2 on x86-64 where present);
 //   - health checks every 2nd and every 4th step, and only at the end of
@@ -16,8 +17,9 @@
 //     products in the per-frame re-estimates instead of forward differences,
 //     with the baseline x86-64 lane loops instead of AVX2, and with both
 //     (the configuration before this round).
-// All configurations are interleaved repetition by repetition, so that load
-// changes on a shared machine hit all of them alike. Then it splits the
+// All configurations are interleaved frame by frame (one Simulator each, a
+// frame of each in turn), so that load changes on a shared machine hit all
+// of them alike. Then it splits the
 // default configuration's CPU time into force evaluations (with the health
 // check fused into one of them per step), the omega_max estimates (the cold
 // first one with force differentials, the warm per-frame ones with a force
@@ -33,6 +35,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -77,26 +80,13 @@ Model bar_model(const TetMesh& m, int threads) {
   return model;
 }
 
-// One simulated second (60 frames) with a fresh Simulator.
-Run run_once(const TetMesh& m, Integrator integ, int check_interval, bool fd_products,
-             lanes::LaneIsa isa, int threads) {
-  lanes::set_lane_isa(isa);
+std::unique_ptr<Simulator> make_simulator(const TetMesh& m, Integrator integ, int check_interval,
+                                          bool fd_products, int threads) {
   SimulatorOptions so;
   so.integrator = integ;
   so.check_interval = check_interval;
   so.frequency_refresh_finite_differences = fd_products;
-  Simulator sim(bar_model(m, threads), so);
-  Run r;
-  const auto t0 = std::chrono::steady_clock::now();
-  const double c0 = cpu_seconds();
-  for (int f = 0; f < 60; ++f) {
-    r.last = sim.advance(1.0 / 60);
-    r.substeps += r.last.substeps;
-    (f == 0 ? r.first_products : r.products) += r.last.frequency_products;
-  }
-  r.cpu = cpu_seconds() - c0;
-  r.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return r;
+  return std::make_unique<Simulator>(bar_model(m, threads), so);
 }
 
 double median(std::vector<double> v) {
@@ -163,14 +153,45 @@ int main(int argc, char** argv) {
   const int reps = 11;
   std::vector<double> cpu[2][nconfigs], wall[2][nconfigs], u_eval, u_health, u_product;
   Run last[2][nconfigs];
+  // Per configuration and frame, the CPU and wall time of each repetition.
+  std::vector<std::vector<double>> frame_cpu[2][nconfigs], frame_wall[2][nconfigs];
+  for (int k = 0; k < 2; ++k)
+    for (int c = 0; c < nconfigs; ++c) {
+      frame_cpu[k][c].assign(60, {});
+      frame_wall[k][c].assign(60, {});
+    }
   for (int rep = 0; rep < reps; ++rep) {
+    // A fresh Simulator per configuration; they advance frame by frame in
+    // turn, so that load changes on the shared machine hit all alike.
+    std::vector<std::unique_ptr<Simulator>> sims;
+    for (int k = 0; k < 2; ++k)
+      for (int c = 0; c < nconfigs; ++c)
+        sims.push_back(make_simulator(m, integs[k], configs[c].check_interval,
+                                      configs[c].fd_products, threads));
+    Run run[2][nconfigs];
+    for (int f = 0; f < 60; ++f)
+      for (int k = 0; k < 2; ++k)
+        for (int c = 0; c < nconfigs; ++c) {
+          lanes::set_lane_isa(configs[c].isa);
+          Run& r = run[k][c];
+          const auto t0 = std::chrono::steady_clock::now();
+          const double c0 = cpu_seconds();
+          r.last = sims[k * nconfigs + c]->advance(1.0 / 60);
+          const double dc = cpu_seconds() - c0;
+          const double dw =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          r.cpu += dc;
+          r.wall += dw;
+          frame_cpu[k][c][f].push_back(dc);
+          frame_wall[k][c][f].push_back(dw);
+          r.substeps += r.last.substeps;
+          (f == 0 ? r.first_products : r.products) += r.last.frequency_products;
+        }
     for (int k = 0; k < 2; ++k)
       for (int c = 0; c < nconfigs; ++c) {
-        const Run r = run_once(m, integs[k], configs[c].check_interval, configs[c].fd_products,
-                               configs[c].isa, threads);
-        cpu[k][c].push_back(r.cpu);
-        wall[k][c].push_back(r.wall);
-        last[k][c] = r;
+        cpu[k][c].push_back(run[k][c].cpu);
+        wall[k][c].push_back(run[k][c].wall);
+        last[k][c] = run[k][c];
       }
     lanes::set_lane_isa(best);
     u_eval.push_back(cpu_per_call([&] { forces.compute(x, out); }));
@@ -183,11 +204,16 @@ int main(int argc, char** argv) {
       "unit CPU costs (medians over the repetitions of 3 x 100 calls): force evaluation %.1f "
       "ns/tet, with the fused health check %.1f ns/tet, force differential %.1f ns/tet\n",
       t_eval / ntets * 1e9, t_health / ntets * 1e9, t_product / ntets * 1e9);
+  // Per simulated second: the sum over the 60 frames of each frame's median
+  // over the repetitions; and the smallest per-second total of a repetition.
   double cpu_med[2][nconfigs], wall_med[2][nconfigs], cpu_min[2][nconfigs];
   for (int k = 0; k < 2; ++k)
     for (int c = 0; c < nconfigs; ++c) {
-      cpu_med[k][c] = median(cpu[k][c]);
-      wall_med[k][c] = median(wall[k][c]);
+      cpu_med[k][c] = wall_med[k][c] = 0;
+      for (int f = 0; f < 60; ++f) {
+        cpu_med[k][c] += median(frame_cpu[k][c][f]);
+        wall_med[k][c] += median(frame_wall[k][c][f]);
+      }
       cpu_min[k][c] = *std::min_element(cpu[k][c].begin(), cpu[k][c].end());
     }
   for (int c = 0; c < nconfigs; ++c) {
@@ -197,7 +223,8 @@ int main(int argc, char** argv) {
       const long evals = t.substeps * (integs[k] == Integrator::RK4 ? 4 : 1);
       std::printf(
           "  %-17s last frame: step %.3e s (limit %.3e s, omega bound %.0f rad/s), %d substeps; "
-          "%ld force evaluations per simulated second: process CPU %.3f s, wall %.3f s (medians of "
+          "%ld force evaluations per simulated second: process CPU %.3f s, wall %.3f s (frame "
+          "medians of "
           "%d) -> %.2fx real time by CPU, %.2fx by wall; %.1f ns CPU per tet and force "
           "evaluation\n",
           to_string(integs[k]), t.last.step, t.last.step_limit, t.last.omega_max, t.last.substeps,
