@@ -51,10 +51,11 @@ struct SimulatorOptions {
   /// Sub-steps between health checks (>= 1; default: every step). With the
   /// explicit integrators a check rides on the element pass of the next
   /// step's first force evaluation (energy, det F and finiteness of state n
-  /// computed while evaluating f(x_n)) plus O(#V) passes: ~7 ns/tet, a
-  /// quarter of a StVK force evaluation, i.e. +5% per RK4 step and +15-23%
-  /// per symplectic Euler step (4: +1% and +3-5%; measured in
-  /// experiments/fem/results/README.md). Only the last state of an
+  /// computed while evaluating f(x_n)) plus O(#V) passes: ~3 ns/tet in the
+  /// element loop (StVK, AVX2 lane loops; a force evaluation is ~20), i.e.
+  /// +5% per simulated second with RK4 and +13-17% with symplectic Euler
+  /// (4: +1-2.5% for both; measured in experiments/fem/results/README.md).
+  /// Only the last state of an
   /// advance()/step() call needs a separate element pass. A blow-up is
   /// caught at most this many steps late and rolled back to the last
   /// checked state.

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "fem/backward_euler.hpp"
+#include "fem/lane_loops.hpp"
 #include "fem/reorder.hpp"
 #include "fem/simulator.hpp"
 #include "fem/stable_step.hpp"
@@ -185,6 +186,13 @@ BENCHMARK(BM_ForcesAsset)->ArgsProduct({{0, 1, 2, 3}, {0, 1}})->ArgNames({"model
 // Args: kind (0 compute, 1 compute_with_health, 2 health, 3 differential), model; the ~4k-tet bar.
 void BM_Kernels(benchmark::State& state) {
   const int kind = static_cast<int>(state.range(0));
+  // isa 1: the lane loops' AVX2 build (the default where the CPU has it), 0: baseline x86-64.
+  const lanes::LaneIsa isa = state.range(2) == 1 ? lanes::LaneIsa::AVX2 : lanes::LaneIsa::Baseline;
+  const lanes::LaneIsa before = lanes::lane_isa();
+  if (!lanes::set_lane_isa(isa)) {
+    state.SkipWithError("the CPU lacks AVX2");
+    return;
+  }
   const TetMesh m = bar(1);
   ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(state.range(1))));
   MatX3d x = m.V;
@@ -202,10 +210,15 @@ void BM_Kernels(benchmark::State& state) {
     benchmark::ClobberMemory();
   }
   const char* names[4] = {"forces", "forces + health", "health", "differential"};
-  state.SetLabel(std::string(names[kind]) + " " + to_string(forces.material().model));
+  state.SetLabel(std::string(names[kind]) + " " + to_string(forces.material().model) + " " +
+                 lanes::to_string(isa));
+  lanes::set_lane_isa(before);
   set_per_tet(state, m.T.rows());
 }
-BENCHMARK(BM_Kernels)->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2, 3}})->ArgNames({"kind", "model"})->MinTime(0.2);
+BENCHMARK(BM_Kernels)
+    ->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1}})
+    ->ArgNames({"kind", "model", "isa"})
+    ->MinTime(0.2);
 
 // Single thread: rates from CPU time (robust on a shared machine).
 BENCHMARK(BM_Forces)
