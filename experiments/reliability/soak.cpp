@@ -187,7 +187,10 @@ int main(int argc, char** argv) {
                       max_gain, contact_frames, tests, interrupted);
         std::fputs(row, stdout);
         std::fflush(stdout);
-        if (csv) std::fputs(row, csv);
+        if (csv) {
+          std::fputs(row, csv);
+          std::fflush(csv);  // a stopped run keeps its windows
+        }
       }
     }
     if (csv) std::fclose(csv);
