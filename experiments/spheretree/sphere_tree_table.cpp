@@ -209,6 +209,12 @@ int main(int argc, char** argv) {
       fit_probes = std::atoi(value) != 0;
     else if (key == "--polish")
       options.protrusion_polish = std::atoi(value) != 0;
+    else if (key == "--sum-passes")
+      options.sum_exchange_passes = std::atoi(value);
+    else if (key == "--sum-share")
+      options.sum_exchange_max_share = std::atof(value);
+    else if (key == "--sum-cap")
+      options.sum_exchange_cap = std::atof(value);
     else if (key == "--polish-rounds")
       options.protrusion_exchange_rounds = std::atoi(value);
     else if (key == "--polish-evals")

@@ -12,6 +12,7 @@
 #include "mesh/spheres/medial_axis.hpp"
 #include "mesh/spheres/mesh_oracle.hpp"
 #include "mesh/spheres/point_grid.hpp"
+#include "mesh/spheres/sum_exchange.hpp"
 
 namespace icd::mesh {
 namespace {
@@ -32,6 +33,10 @@ void check_options(const SphereTreeOptions& o) {
   if (o.exchange_rounds < 0) fail("exchange_rounds must be >= 0");
   if (o.relieve_moves < 0) fail("relieve_moves must be >= 0");
   if (o.protrusion_exchange_rounds < 0) fail("protrusion_exchange_rounds must be >= 0");
+  if (o.sum_exchange_passes < 0 || !(o.sum_exchange_cap > 0 && o.sum_exchange_cap <= 1) ||
+      !(o.sum_exchange_max_share > 0)) {
+    fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
+  }
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
   if (o.protrusion.search_directions < 1 || o.protrusion.check_directions < 1 ||
@@ -465,6 +470,29 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   }
   if (options.leaf_exchange && levels.size() > 1)
     exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
+  if (options.sum_exchange_passes > 0 && levels.size() > 1) {
+    const size_t last = levels.size() - 1;
+    std::vector<FittedSphere> leaves;
+    double worst = 0;
+    for (const Node& n : levels[last])
+      leaves.push_back(n.sphere), worst = std::max(worst, n.sphere.error);
+    auto accepts = [&](int leaf, int s) {
+      int node = leaf;
+      for (size_t l = last; l >= 1; --l) {
+        node = parent_of[l][static_cast<size_t>(node)];
+        const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
+        if ((dense.points.row(s).transpose() - a.center).norm() + dense.gap[s] > a.radius)
+          return false;
+      }
+      return true;
+    };
+    SumExchangeOptions sum;
+    sum.passes = options.sum_exchange_passes;
+    sum.cap_fraction = options.sum_exchange_cap;
+    lower_error_sum(dense, leaves, options.sum_exchange_max_share * worst, sum, accepts);
+    for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
+    refit_inner_nodes(dense, levels, parent_of);
+  }
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
     out.num_polished = polish_tree(dense, oracle, levels, parent_of, options.protrusion,

@@ -68,6 +68,15 @@ struct SphereTreeOptions {
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.
   bool joint_leaf_refinement = false;
+  /// Passes of lower_error_sum over the leaves after the exchanges, which
+  /// lowers the mean leaf error bound: a leaf hands the cap of samples that
+  /// sets its radius to neighbours that grow less than it shrinks, whose
+  /// ancestors already cover them (0: off, >= 0).
+  int sum_exchange_passes = 4;
+  double sum_exchange_cap = 0.1;  ///< see SumExchangeOptions::cap_fraction
+  /// A receiving leaf's error bound stays below this share of the worst leaf
+  /// bound (> 0; 1 lets the mean drop more but raised the dragon's worst42 to 80.3).
+  double sum_exchange_max_share = 0.8;
   /// Last step: every node, leaves first, moves its centre to lower its true
   /// error (how far its surface sticks out of the object, measured on points
   /// of the sphere's surface; see polish_protrusion), its radius the smallest
