@@ -5,6 +5,7 @@
 //                   [--exchange-rounds N] [--relieve-moves N]
 //                   [--polish 0|1] [--polish-rounds N] [--polish-evals N]
 //                   [--polish-search N] [--polish-check N]
+//                   [--sum-passes N] [--sum-cap F] [--sum-share F]   (lower_error_sum)
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
 //
@@ -167,7 +168,8 @@ int main(int argc, char** argv) {
            "[--diagnose N]"
            " [--exchange-rounds N] [--relieve-moves N] [--polish 0|1] [--polish-rounds N]"
            " [--polish-evals N]"
-           " [--polish-search N] [--polish-check N] [--fit-probes 0|1]\n";
+           " [--polish-search N] [--polish-check N] [--fit-probes 0|1] [--sum-passes N]"
+           " [--sum-cap F] [--sum-share F]\n";
     return 2;
   }
   const fs::path results = argv[1];
