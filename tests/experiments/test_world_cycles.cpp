@@ -251,7 +251,9 @@ TEST(WorldCycles, PassiveResponseBoundsTheEnergyOfInterruptedQueries) {
     std::printf("%s response: energy after the bounce / initial kinetic energy %.4f (%d cycles "
                 "limited)\n",
                 passive ? "passive" : "raw", gain[passive], limited);
-    if (passive) EXPECT_GT(limited, 0);
+    if (passive) {
+      EXPECT_GT(limited, 0);
+    }
   }
   EXPECT_GT(gain[0], 1.5) << "the raw response no longer gains energy here";
   // The scene's Rayleigh damping only removes energy; one cycle of predicted
