@@ -280,7 +280,6 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
   Eigen::Quaterniond* rot = m_rotations.data();
   const int max_it = m_options.polar_max_iterations;
   const double tol = m_options.polar_tolerance;
-  const auto* blocks = reinterpret_cast<const lanes::Block*>(m_lane_blocks.data());
   ChunkHealth* chunk_health = m_chunk_health.data();
   auto scatter = [&](int e, const double* out) {
     if (!direct) {
@@ -299,14 +298,7 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
     constexpr MaterialModel kModel = decltype(model_tag)::value;
     if constexpr (kModel != MaterialModel::Corotational) {
       // 8 elements at a time in lane loops (lane_loops.hpp); scatter in element order.
-      lanes::LaneLoopInput in;
-      in.x = xp;
-      in.tets = T;
-      in.blocks = blocks;
-      in.mu = mu;
-      in.lambda = lambda;
-      in.forces = direct ? fp : nullptr;
-      in.element_forces = buf;
+      const lanes::LaneLoopInput in = lane_input(xp, fp);
       for_chunks([&](int begin, int end) {
         lanes::LaneRangeHealth rh;
         lanes::force_range<kModel, kHealth>(in, begin, end, &rh);
@@ -468,21 +460,22 @@ void ElasticForces::differential(const Eigen::Ref<const MatX3d>& x, const Eigen:
   }
 }
 
+lanes::LaneLoopInput ElasticForces::lane_input(const double* x, double* forces) {
+  lanes::LaneLoopInput in;
+  in.x = x;
+  in.tets = m_mesh.tets.data();
+  in.blocks = reinterpret_cast<const lanes::Block*>(m_lane_blocks.data());
+  in.mu = m_mu;
+  in.lambda = m_lambda;
+  in.forces = m_options.num_threads == 1 ? forces : nullptr;
+  in.element_forces = m_element_forces.data();
+  return in;
+}
+
 void ElasticForces::differential_fast(const double* xp, const double* dp, double* df) {
   // 8-lane kernels (lane_kernels.hpp); the Eigen laws of constitutive.hpp are the reference.
-  const int* T = m_mesh.tets.data();
   const bool direct = m_options.num_threads == 1;
-  double* buf = m_element_forces.data();
-  const double mu = m_mu, lambda = m_lambda;
-  const auto* blocks = reinterpret_cast<const lanes::Block*>(m_lane_blocks.data());
-  lanes::LaneLoopInput in;
-  in.x = xp;
-  in.tets = T;
-  in.blocks = blocks;
-  in.mu = mu;
-  in.lambda = lambda;
-  in.forces = direct ? df : nullptr;
-  in.element_forces = buf;
+  const lanes::LaneLoopInput in = lane_input(xp, df);
   auto run = [&](auto model_tag) {
     constexpr MaterialModel kModel = decltype(model_tag)::value;
     for_chunks([&](int begin, int end) {

@@ -13,6 +13,9 @@
 #include "fem/tet_mesh_data.hpp"
 
 namespace icd::fem {
+namespace lanes {
+struct LaneLoopInput;
+}
 
 /// Options of the element loops.
 struct ForceOptions {
@@ -76,6 +79,9 @@ class ElasticForces {
   void gather(double* f);
   template <bool kEnergy> double compute_impl(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
   void differential_fast(const double* x, const double* dx, double* df);
+  /// Lane-loop input at positions x: element forces go to `forces` directly
+  /// with one thread, else to the per-element scratch for gather().
+  lanes::LaneLoopInput lane_input(const double* x, double* forces);
   template <bool kHealth>
   void compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health);
   struct ChunkHealth {
