@@ -88,11 +88,6 @@ Args parse_args(int argc, char** argv) {
   return a;
 }
 
-double kinetic_energy(const icd::runner::RuntimeObject& o) {
-  const icd::MatX3d& v = o.sim->velocities();
-  return 0.5 * v.rowwise().squaredNorm().dot(o.node_mass);
-}
-
 // Each deformable object gets its initial speed towards the centroid of the
 // others. Returns the change of kinetic energy (J).
 double relaunch(icd::runner::World& world) {
@@ -110,9 +105,9 @@ double relaunch(icd::runner::World& world) {
     if (d.norm() <= 0) continue;
     icd::MatX3d v(o.positions.rows(), 3);
     v.rowwise() = (o.spec.velocity.norm() / d.norm() * d).transpose();
-    change -= kinetic_energy(o);
+    change -= o.sim->model().kinetic_energy(o.sim->velocities());
     o.sim->set_velocities(v);  // zero at fixed nodes
-    change += kinetic_energy(o);
+    change += o.sim->model().kinetic_energy(o.sim->velocities());
   }
   return change;
 }

@@ -130,12 +130,11 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       const bool track_work = m_plan.response && m_scene.collision.passive &&
                               m_passive_allowance >= 0;
       if (m_plan.response) o.sim->set_external_forces(o.contact_forces);
-      if (track_work) o.cycle_start = o.positions;
+      // The forces are constant over the cycle: their work is f . x1 - f . x0.
+      if (track_work) m_contact_work -= o.contact_forces.cwiseProduct(o.positions).sum();
       const fem::AdvanceReport rep = o.sim->advance(h);
       o.positions = o.sim->positions();
-      // The forces are constant over the cycle: their work is f . dx.
-      if (track_work)
-        m_contact_work += o.contact_forces.cwiseProduct(o.positions - o.cycle_start).sum();
+      if (track_work) m_contact_work += o.contact_forces.cwiseProduct(o.positions).sum();
       m.substeps += rep.substeps;
       m.min_step = std::min(m.min_step, rep.step);
       if (last) m.energy += mechanical_energy(*o.sim, m_scene.gravity);
@@ -302,7 +301,7 @@ void World::limit_contact_work(double h, FrameMetrics& m) {
     if (!o.sim) continue;  // static and kinematic objects: external motion
     const MatX3d& v = o.sim->velocities();
     power += o.contact_forces.cwiseProduct(v).sum();
-    if (m_passive_allowance < 0) kinetic += 0.5 * v.rowwise().squaredNorm().dot(o.node_mass);
+    if (m_passive_allowance < 0) kinetic += o.sim->model().kinetic_energy(v);
   }
   if (m_passive_allowance < 0) m_passive_allowance = kPassiveTolerance * kinetic;
   // The contact is passive while the net work its forces have done on the

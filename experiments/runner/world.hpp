@@ -74,7 +74,6 @@ struct RuntimeObject {
   MatX3d dense;           ///< current dense positions (when the plan updates them)
   coupling::LinkEvaluator links;  ///< the rigid links, grouped by node triple (when dense_update)
   MatX3d predicted;       ///< coarse positions half a cycle ahead (collision.midpoint)
-  MatX3d cycle_start;     ///< coarse positions at the start of the cycle (collision.passive)
   Eigen::VectorXd node_mass;  ///< lumped coarse node masses (kg); huge for objects without FEM
 };
 
