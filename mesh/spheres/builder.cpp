@@ -199,6 +199,32 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
   }
 }
 
+/// Samples of each inner node := union of its children's, radius refitted
+/// exactly around the fixed centre (a sample moved by shrink_by_exchange was
+/// covered by every ancestor of its receiver, so no radius grows; after
+/// relieve_worst an ancestor grows within its level's worst error).
+void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
+                       const std::vector<std::vector<int>>& parent_of) {
+  for (size_t l = levels.size() - 1; l >= 1; --l) {
+    std::vector<std::vector<int>> unions(levels[l - 1].size());
+    for (size_t i = 0; i < levels[l].size(); ++i) {
+      const auto& m = levels[l][i].sphere.members;
+      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
+      u.insert(u.end(), m.begin(), m.end());
+    }
+    for (size_t p = 0; p < unions.size(); ++p) {
+      FittedSphere& sp = levels[l - 1][p].sphere;
+      std::sort(unions[p].begin(), unions[p].end());
+      sp.members = std::move(unions[p]);
+      double r = 0;
+      for (int s : sp.members)
+        r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
+      sp.radius = r;
+      sp.error = r - sp.depth;
+    }
+  }
+}
+
 /// Boundary exchange across the whole leaf level: a sample may move to a leaf
 /// whose ancestors all cover it with margin (shrink_by_exchange), or, to lower
 /// the worst leaf error (relieve_worst), whose ancestors would stay within
@@ -249,49 +275,8 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
     shrink_by_exchange(dense, leaves, exchange, accepts);
   }
   for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
-  for (size_t l = last; l >= 1; --l) {
-    std::vector<std::vector<int>> unions(levels[l - 1].size());
-    for (size_t i = 0; i < levels[l].size(); ++i) {
-      const auto& m = levels[l][i].sphere.members;
-      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
-      u.insert(u.end(), m.begin(), m.end());
-    }
-    for (size_t p = 0; p < unions.size(); ++p) {
-      FittedSphere& sp = levels[l - 1][p].sphere;
-      std::sort(unions[p].begin(), unions[p].end());
-      sp.members = std::move(unions[p]);
-      double r = 0;
-      for (int s : sp.members)
-        r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
-      sp.radius = r;  // grows only within the level's worst error (accepts_growing)
-      sp.error = r - sp.depth;
-    }
-  }
-}
-
-/// Samples of each inner node := union of its children's, radius refitted
-/// exactly around the fixed centre (a moved sample was covered by every
-/// ancestor of its receiver, so no radius grows).
-void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
-                       const std::vector<std::vector<int>>& parent_of) {
-  for (size_t l = levels.size() - 1; l >= 1; --l) {
-    std::vector<std::vector<int>> unions(levels[l - 1].size());
-    for (size_t i = 0; i < levels[l].size(); ++i) {
-      const auto& m = levels[l][i].sphere.members;
-      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
-      u.insert(u.end(), m.begin(), m.end());
-    }
-    for (size_t p = 0; p < unions.size(); ++p) {
-      FittedSphere& sp = levels[l - 1][p].sphere;
-      std::sort(unions[p].begin(), unions[p].end());
-      sp.members = std::move(unions[p]);
-      double r = 0;
-      for (int s : sp.members)
-        r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
-      sp.radius = r;
-      sp.error = r - sp.depth;
-    }
-  }
+  // Radii grow only within each level's worst error (accepts_growing).
+  refit_inner_nodes(dense, levels, parent_of);
 }
 
 /// The protrusion polish of every node (polish_protrusion), leaves first;
