@@ -1,6 +1,7 @@
 #include "fem/lane_loops.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 
 namespace icd::fem::lanes {
@@ -40,16 +41,69 @@ LaneIsa g_isa = cpu_has_avx2() ? LaneIsa::AVX2 : LaneIsa::Baseline;
   }
 }
 
+// Health of a range of elements in lane-wise accumulators: energy partial
+// sums, smallest det F and its element per lane, merged in lane order at the
+// end. GCC vector types of 2 doubles (one SSE2 register, the baseline
+// x86-64 width) make the per-block update compare + select instructions in
+// both builds; written as a plain loop with a select, GCC turned the select
+// into a conditional store and emitted 8 scalar branches per block.
+struct LaneHealth {
+  typedef double Vec2 __attribute__((vector_size(16)));
+  static constexpr int kVectors = kLanes / 2;
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  Vec2 sum[kVectors], min[kVectors], arg[kVectors];  // arg: element index as a double, -1: none
+
+  LaneHealth() {
+    for (int k = 0; k < kVectors; ++k) {
+      sum[k] = Vec2{0.0, 0.0};
+      min[k] = Vec2{kInf, kInf};
+      arg[k] = Vec2{-1.0, -1.0};
+    }
+  }
+  // A full block of 8 elements starting at e0: no per-lane condition.
+  [[gnu::always_inline]] void add_full(int e0, const double* volume, const double* psi, const double* det) {
+    const double b = static_cast<double>(e0);
+    for (int k = 0; k < kVectors; ++k) {
+      Vec2 v, p, d;
+      std::memcpy(&v, volume + 2 * k, sizeof v);
+      std::memcpy(&p, psi + 2 * k, sizeof p);
+      std::memcpy(&d, det + 2 * k, sizeof d);
+      const Vec2 index{b + 2 * k, b + 2 * k + 1};
+      sum[k] += v * p;
+      const auto lower = d < min[k];
+      min[k] = lower ? d : min[k];
+      arg[k] = lower ? index : arg[k];
+    }
+  }
+  // The first `count` lanes of a block (padding lanes: volume 0, det F = 0, ignored).
+  void add_partial(int e0, int count, const double* volume, const double* psi, const double* det) {
+    for (int l = 0; l < count; ++l) {
+      sum[l / 2][l % 2] += volume[l] * psi[l];
+      if (det[l] < min[l / 2][l % 2]) {
+        min[l / 2][l % 2] = det[l];
+        arg[l / 2][l % 2] = static_cast<double>(e0 + l);
+      }
+    }
+  }
+  LaneRangeHealth result() const {
+    LaneRangeHealth h;
+    h.min_det = kInf;
+    for (int l = 0; l < kLanes; ++l) {
+      const double lane_min = min[l / 2][l % 2], lane_arg = arg[l / 2][l % 2];
+      h.energy += sum[l / 2][l % 2];
+      if (lane_arg >= 0 && (lane_min < h.min_det || (lane_min == h.min_det && lane_arg < h.min_element))) {
+        h.min_det = lane_min;
+        h.min_element = static_cast<int>(lane_arg);
+      }
+    }
+    return h;
+  }
+};
+
 template <MaterialModel kModel, bool kHealth>
 [[gnu::always_inline]] inline void force_body(const LaneLoopInput& in, int begin, int end,
                                               LaneRangeHealth* health) {
-  // Health in lane-wise accumulators (vectorised): energy partial sums,
-  // smallest det F and its element; merged in lane order at the end.
-  double lane_sum[kLanes] = {}, lane_min[kLanes], lane_arg[kLanes];
-  for (int l = 0; l < kLanes; ++l) {
-    lane_min[l] = std::numeric_limits<double>::infinity();
-    lane_arg[l] = -1;
-  }
+  LaneHealth lane_health;
   for (int e0 = begin; e0 < end; e0 += kLanes) {
     const int count = end - e0 < kLanes ? end - e0 : kLanes;
     const Block& block = in.blocks[e0 / kLanes];
@@ -58,29 +112,12 @@ template <MaterialModel kModel, bool kHealth>
     block_forces<kModel, kHealth>(in.x, in.tets + 4 * e0, count, block, in.mu, in.lambda, out, psi,
                                   det);
     if constexpr (kHealth) {
-      for (int l = 0; l < kLanes; ++l) {  // padding lanes: volume 0, det F = 0 ignored
-        const bool valid = l < count;
-        lane_sum[l] += valid ? block.volume[l] * psi[l] : 0.0;
-        const bool lower = valid && det[l] < lane_min[l];
-        lane_min[l] = lower ? det[l] : lane_min[l];
-        lane_arg[l] = lower ? static_cast<double>(e0 + l) : lane_arg[l];
-      }
+      if (count == kLanes) lane_health.add_full(e0, block.volume, psi, det);
+      else lane_health.add_partial(e0, count, block.volume, psi, det);
     }
     for (int l = 0; l < count; ++l) scatter(in, e0 + l, out[l]);
   }
-  if constexpr (kHealth) {
-    LaneRangeHealth h;
-    h.min_det = std::numeric_limits<double>::infinity();
-    for (int l = 0; l < kLanes; ++l) {
-      h.energy += lane_sum[l];
-      if (lane_arg[l] >= 0 &&
-          (lane_min[l] < h.min_det || (lane_min[l] == h.min_det && lane_arg[l] < h.min_element))) {
-        h.min_det = lane_min[l];
-        h.min_element = static_cast<int>(lane_arg[l]);
-      }
-    }
-    *health = h;
-  }
+  if constexpr (kHealth) *health = lane_health.result();
 }
 
 template <MaterialModel kModel>

@@ -1,5 +1,6 @@
 #include "fem/model.hpp"
 
+#include <cassert>
 #include <cmath>
 #include <string>
 
@@ -96,15 +97,26 @@ void Model::total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<cons
   }
 }
 
-void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                         Eigen::Ref<MatX3d> a, ElementHealth* health) {
-  if (health) *health = m_forces.compute_with_health(x, a);
-  else m_forces.compute(x, a);
+void Model::element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
+                           Eigen::Ref<MatX3d> f, ElementHealth* health, const MatX3d* elastic) {
+  if (elastic) {
+    assert(!health && elastic->rows() == num_nodes());
+    f = *elastic;
+  } else if (health) {
+    *health = m_forces.compute_with_health(x, f);
+  } else {
+    m_forces.compute(x, f);
+  }
   if (m_damping.beta > 0) {
     m_forces.differential(x, v, m_scratch);  // -K v
-    a += m_damping.beta * m_scratch;
+    f += m_damping.beta * m_scratch;
   }
-  add_strain_rate_damping_forces(mesh(), m_strain_rate_damping, x, v, a);
+  add_strain_rate_damping_forces(mesh(), m_strain_rate_damping, x, v, f);
+}
+
+void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
+                         Eigen::Ref<MatX3d> a, ElementHealth* health, const MatX3d* elastic) {
+  element_forces(x, v, a, health, elastic);
   const int n = num_nodes();
   const double alpha = m_damping.alpha;
   const double* load = m_load.data();

@@ -70,8 +70,21 @@ class Model {
   /// Accelerations M^-1 total_force (#V x 3, m/s^2), zero at fixed nodes, in
   /// one pass over the nodes after the element loop. health (optional): the
   /// health of x from the same element pass (ElasticForces::compute_with_health).
+  /// elastic (optional): f_int(x) already computed, see element_forces().
   void acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                    Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr);
+                    Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr);
+  /// The element part of total_force (#V x 3, N, overwritten): f_int(x) - beta
+  /// K(x) v + the strain-rate damping force, at every node (fixed ones
+  /// included); the nodal part, loads() - alpha m v at free nodes, is left to
+  /// the caller's node pass (acceleration() and the fused integrator passes).
+  /// elastic (optional): f_int(x) already computed (e.g. by a health check at
+  /// x), used instead of a force evaluation. health: as in acceleration().
+  void element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
+                      Eigen::Ref<MatX3d> f, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr);
+  /// Conservative nodal loads f_ext + m g at free nodes, 0 at fixed ones (#V x 3), N.
+  const MatX3d& loads() const { return m_load; }
+  /// 1 / lumped mass per node (#V), 1/kg.
+  const Eigen::VectorXd& inverse_mass() const { return m_inv_mass; }
   /// Kinetic energy 1/2 sum m |v|^2, J; not finite if any entry of v is not.
   double kinetic_energy(const Eigen::Ref<const MatX3d>& v) const;
   /// Potential of the conservative loads: -sum (f_ext + m g) . x over the free

@@ -41,6 +41,7 @@ void Simulator::set_positions(const Eigen::Ref<const MatX3d>& x) {
   m_state.x = x;
   m_estimate_time = -1;  // a new configuration: estimate again
   m_checked_valid = false;
+  m_end_force_valid = false;
 }
 
 void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
@@ -64,7 +65,8 @@ double Simulator::stable_step_limit() {
     fo.tolerance = std::max(fo.tolerance, m_options.frequency_refresh_tolerance);
     fo.finite_difference_products = fo.finite_difference_products || m_options.frequency_refresh_finite_differences;
   }
-  m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode);
+  m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode,
+                                       m_end_force_valid ? &m_end_force : nullptr);
   m_last_products = m_frequency.iterations;
   if (m_model.strain_rate_damping().enabled()) {
     FrequencyOptions fd = m_options.frequency;
@@ -100,12 +102,12 @@ void Simulator::refuse_if_above_limit(double h, double limit, const char* what) 
   throw ParameterError(os.str());
 }
 
-std::string Simulator::integrate(double h, ElementHealth* start_health) {
+std::string Simulator::integrate(double h, const StepExtras& extras) {
   switch (m_options.integrator) {
-    case Integrator::RK4: m_explicit.rk4(m_model, m_state, m_next, h, start_health); break;
-    case Integrator::SymplecticEuler: m_explicit.symplectic_euler(m_model, m_state, m_next, h, start_health); break;
+    case Integrator::RK4: m_explicit.rk4(m_model, m_state, m_next, h, extras); break;
+    case Integrator::SymplecticEuler: m_explicit.symplectic_euler(m_model, m_state, m_next, h, extras); break;
     case Integrator::BackwardEuler: {
-      assert(!start_health);
+      assert(!extras.health && !extras.energies && !extras.elastic);
       m_next = m_state;
       const NewtonReport rep = m_implicit.step(m_model, m_next, h, m_options.newton);
       if (!rep.converged) {
@@ -120,10 +122,11 @@ std::string Simulator::integrate(double h, ElementHealth* start_health) {
   return {};
 }
 
-Simulator::Check Simulator::evaluate(const Check& before, const State& s, const ElementHealth& h) const {
+Simulator::Check Simulator::evaluate(const Check& before, const State& s, const StateEnergies& energies,
+                                     const ElementHealth& h) const {
   Check c;
-  c.kinetic = m_model.kinetic_energy(s.v);
-  c.load = m_model.load_potential(s.x);
+  c.kinetic = energies.kinetic;
+  c.load = energies.load;
   // Every entry of x and v enters these sums (0 * NaN = NaN): finite sums, finite state.
   if (!std::isfinite(c.kinetic) || !std::isfinite(c.load)) {
     const int n = m_model.num_nodes();
@@ -178,17 +181,32 @@ void swap_states(State& a, State& b) {
 }  // namespace
 
 AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
-  // Explicit integrators check state n in the element pass of the first force
-  // evaluation of step n + 1 (which is at x_n), so a check costs no extra
-  // pass; the last state of the call is checked by a separate pass. Buffers
-  // rotate: m_good (last checked state), m_state (current), m_next (step output).
+  // Explicit integrators check state n in the passes of step n + 1: element
+  // health in the element pass of its first force evaluation (which is at
+  // x_n), kinetic energy and load potential in its first node pass; so a
+  // check costs no extra pass. The last state of the call is checked by a
+  // separate element pass that also computes f_int there, which the next
+  // call's estimate and first step use. Buffers rotate: m_good (last checked
+  // state), m_state (current), m_next (step output).
   const bool fused = m_options.integrator != Integrator::BackwardEuler;
   m_good = m_state;
   double t_good = 0, t = 0;
   Check before;
-  before.kinetic = m_model.kinetic_energy(m_state.v);
-  before.elastic = m_checked_valid ? m_checked_elastic : m_model.elastic().energy(m_state.x);
-  before.load = m_model.load_potential(m_state.x);
+  // f_int(m_state.x) from the last call's final check, for the first step.
+  const MatX3d* start_force = m_end_force_valid ? &m_end_force : nullptr;
+  m_end_force_valid = false;
+  if (m_checked_valid) {
+    before.elastic = m_checked_elastic;
+  } else if (fused) {
+    m_end_force.resize(m_model.num_nodes(), 3);
+    before.elastic = m_model.elastic().compute_with_health(m_state.x, m_end_force).energy;
+    start_force = &m_end_force;
+  } else {
+    before.elastic = m_model.elastic().energy(m_state.x);
+  }
+  const StateEnergies start_energies = state_energies(m_model, m_state);
+  before.kinetic = start_energies.kinetic;
+  before.load = start_energies.load;
   m_checked_valid = false;
   const double h0 = h;
   int since_check = 0, steps = 0, steps_good = 0;
@@ -212,17 +230,28 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
     h *= 0.5;
     since_check = 0;
     pending = false;
+    start_force = nullptr;
   };
   while (true) {
     if (pending && (t >= total || !fused)) {
       pending = false;
-      const Check c = evaluate(before, m_state, m_model.elastic().health(m_state.x));
+      ElementHealth health;
+      if (fused) {
+        m_end_force.resize(m_model.num_nodes(), 3);
+        health = m_model.elastic().compute_with_health(m_state.x, m_end_force);
+      } else {
+        health = m_model.elastic().health(m_state.x);
+      }
+      const Check c = evaluate(before, m_state, state_energies(m_model, m_state), health);
       if (!c.ok) {
         reject(c);
         continue;
       }
       before = c;
-      if (t >= total) break;
+      if (t >= total) {
+        m_end_force_valid = fused;
+        break;
+      }
       m_good = m_state;
       t_good = t;
       steps_good = steps;
@@ -231,11 +260,20 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
     const int remaining = static_cast<int>(std::ceil((total - t) / h * (1 - 1e-12)));
     hh = (total - t) / std::max(remaining, 1);
     ElementHealth health;
+    StateEnergies energies;
     const bool check_now = pending;
-    const std::string step_failure = integrate(hh, check_now ? &health : nullptr);
+    StepExtras extras;
+    if (check_now) {
+      extras.health = &health;
+      extras.energies = &energies;
+    } else if (start_force) {
+      extras.elastic = start_force;  // only at the call's start state, never due a check
+    }
+    start_force = nullptr;
+    const std::string step_failure = integrate(hh, extras);
     if (check_now) {
       pending = false;
-      const Check c = evaluate(before, m_state, health);
+      const Check c = evaluate(before, m_state, energies, health);
       if (!c.ok) {
         reject(c);  // the step just taken from the bad state is discarded
         continue;

@@ -122,11 +122,12 @@ class Simulator {
     std::string message;
     double kinetic = 0, elastic = 0, load = 0;
   };
-  /// Health check of state s with the element health h of s.x, against the last accepted check.
-  Check evaluate(const Check& before, const State& s, const ElementHealth& h) const;
+  /// Health check of state s with its energies and the element health h of
+  /// s.x, against the last accepted check.
+  Check evaluate(const Check& before, const State& s, const StateEnergies& energies, const ElementHealth& h) const;
   /// One step from m_state into m_next; returns an empty string, or why the
-  /// step failed (Newton). start_health: health of m_state.x (explicit only).
-  std::string integrate(double h, ElementHealth* start_health = nullptr);
+  /// step failed (Newton). extras: explicit integrators only.
+  std::string integrate(double h, const StepExtras& extras = {});
   AdvanceReport run(double total, double h, AdvanceReport rep);
   void refuse_if_above_limit(double h, double limit, const char* what) const;
 
@@ -146,6 +147,11 @@ class Simulator {
   int m_last_products = 0;      ///< Lanczos products of the last stable_step_limit()
   bool m_checked_valid = false; ///< m_checked_elastic is the elastic energy of m_state
   double m_checked_elastic = 0;
+  /// f_int(m_state.x) from the health check that ended the last run()
+  /// (explicit integrators): the next frame's estimate and first step use it
+  /// instead of evaluating the forces at the same positions again.
+  MatX3d m_end_force;
+  bool m_end_force_valid = false;
 };
 
 }  // namespace icd::fem

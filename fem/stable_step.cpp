@@ -157,7 +157,8 @@ void free_dofs(const Model& model, Eigen::VectorXd& free, Eigen::VectorXd& inv_s
 }  // namespace
 
 FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const MatX3d>& x,
-                                         const FrequencyOptions& options, Eigen::VectorXd* warm) {
+                                         const FrequencyOptions& options, Eigen::VectorXd* warm,
+                                         const MatX3d* forces_at_x) {
   check_options(options);
   const int n = model.num_nodes();
   const int ndof = 3 * n;
@@ -168,9 +169,16 @@ FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const Ma
   MatX3d f0, xe;
   double step_scale = 0;  // eps = step_scale / max |u_i|
   if (options.finite_difference_products) {
-    f0.resize(n, 3);
     xe.resize(n, 3);
-    model.elastic().compute(x, f0);
+    if (forces_at_x) {
+      if (forces_at_x->rows() != n)
+        throw ParameterError("fem::estimate_max_frequency: forces_at_x has " + std::to_string(forces_at_x->rows()) +
+                             " rows, expected #V = " + std::to_string(n));
+      f0 = *forces_at_x;
+    } else {
+      f0.resize(n, 3);
+      model.elastic().compute(x, f0);
+    }
     const double mean_volume = model.mesh().rest_volume.mean();
     step_scale = 1e-7 * std::cbrt(6.0 * std::max(mean_volume, 0.0));
   }

@@ -54,8 +54,11 @@ struct FrequencyEstimate {
 /// top of the spectrum; Lanczos' top Ritz value converges to lambda_max within
 /// ~1e-5 in tens of products, and is warm-started from the last Ritz vector
 /// (`warm`: in/out, 3#V scaled-space vector; empty = fixed-seed random start).
+/// forces_at_x (optional): f_int(x) (#V x 3, N) already computed, used as the
+/// base point of the forward-difference products instead of evaluating it.
 FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const MatX3d>& x,
-                                         const FrequencyOptions& options, Eigen::VectorXd* warm = nullptr);
+                                         const FrequencyOptions& options, Eigen::VectorXd* warm = nullptr,
+                                         const MatX3d* forces_at_x = nullptr);
 
 /// Largest stable step (s) of an integrator for modes with circular frequency
 /// up to omega_max and Rayleigh damping c(omega) = alpha + beta omega^2

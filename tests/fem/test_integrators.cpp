@@ -3,6 +3,9 @@
 // the discrete eigenfrequency.
 #include "fem/integrators.hpp"
 
+#include <cmath>
+#include <limits>
+
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
@@ -125,6 +128,115 @@ TEST(Integrators, OscillationFrequencyMatchesTheDiscreteEigenfrequency) {
   const double hb = 0.01 / f1, w = 2 * M_PI * f1;
   const double fb = measured_frequency(Integrator::BackwardEuler, model, x0, phi, hb, 4.0 / f1);
   EXPECT_NEAR(fb, std::atan(hb * w) / hb / (2 * M_PI), 1e-3 * f1);
+}
+
+// A cantilever with every nodal term of the node pass: fixed nodes, gravity,
+// external forces, Rayleigh alpha (and, with `element_damping`, beta and the
+// strain-rate damping, which add element passes), at a random state.
+struct FusedCase {
+  Model model;
+  State in;
+};
+
+FusedCase fused_case(bool element_damping) {
+  const Material mat = test::material(MaterialModel::StVK, 1e6, 0.3);
+  Model model = test::cantilever(1, mat, 9.81, {2.0, element_damping ? 1e-4 : 0.0});
+  if (element_damping) model.set_strain_rate_damping({1.0, 2.0});
+  const int n = model.num_nodes();
+  model.set_external_forces(test::random_field(n, 3));
+  State in{model.mesh().rest_positions + 0.01 * test::random_field(n, 1), 0.1 * test::random_field(n, 2)};
+  for (int i = 0; i < n; ++i)
+    if (model.fixed_nodes()[i]) in.v.row(i).setZero();
+  return {std::move(model), std::move(in)};
+}
+
+TEST(Integrators, FusedSymplecticEulerNodePassEqualsAccelerationThenUpdate) {
+  // One node pass forms a, v1, x1 and the input's energies: the state must be
+  // bitwise that of Model::acceleration followed by v1 = v + h a, x1 = x + h v1;
+  // the energies those of Model::kinetic_energy / load_potential (other
+  // summation order: equal to rounding); the health that of the separate pass.
+  for (bool element_damping : {false, true}) {
+    FusedCase c = fused_case(element_damping);
+    const int n = c.model.num_nodes();
+    const double h = 1e-4;
+    MatX3d a(n, 3);
+    c.model.acceleration(c.in.x, c.in.v, a);
+    const MatX3d v1 = c.in.v + h * a;
+    const MatX3d x1 = c.in.x + h * v1;
+    ExplicitStepper stepper;
+    State out;
+    ElementHealth health;
+    StateEnergies energies;
+    StepExtras extras;
+    extras.health = &health;
+    extras.energies = &energies;
+    stepper.symplectic_euler(c.model, c.in, out, h, extras);
+    EXPECT_TRUE(out.v.cwiseEqual(v1).all()) << element_damping;
+    EXPECT_TRUE(out.x.cwiseEqual(x1).all()) << element_damping;
+    const double ke = c.model.kinetic_energy(c.in.v), lp = c.model.load_potential(c.in.x);
+    ASSERT_GT(ke, 0);
+    EXPECT_NEAR(energies.kinetic, ke, 1e-14 * ke);
+    EXPECT_NEAR(energies.load, lp, 1e-14 * std::abs(lp));
+    const StateEnergies plain = state_energies(c.model, c.in);
+    EXPECT_EQ(plain.kinetic, energies.kinetic);
+    EXPECT_EQ(plain.load, energies.load);
+    const ElementHealth ref = c.model.elastic().health(c.in.x);
+    EXPECT_NEAR(health.energy, ref.energy, 1e-12 * ref.energy);
+    EXPECT_EQ(health.min_det_f_element, ref.min_det_f_element);
+    // Fixed nodes stay exactly where they are.
+    for (int i = 0; i < n; ++i)
+      if (c.model.fixed_nodes()[i]) {
+        EXPECT_TRUE(out.x.row(i) == c.in.x.row(i)) << i;
+      }
+  }
+}
+
+TEST(Integrators, GivenElasticForcesReplaceTheFirstEvaluationBitwise) {
+  // StepExtras::elastic (f_int(x) from a health check at x) gives the state of
+  // a step that evaluates it, for both integrators and with element damping.
+  for (bool element_damping : {false, true}) {
+    FusedCase c = fused_case(element_damping);
+    const int n = c.model.num_nodes();
+    MatX3d f(n, 3);
+    c.model.elastic().compute(c.in.x, f);
+    for (Integrator integ : {Integrator::RK4, Integrator::SymplecticEuler}) {
+      ExplicitStepper stepper;
+      State out[2];
+      for (int k = 0; k < 2; ++k) {
+        StepExtras extras;
+        StateEnergies energies;
+        extras.energies = &energies;
+        if (k == 1) extras.elastic = &f;
+        if (integ == Integrator::RK4) stepper.rk4(c.model, c.in, out[k], 1e-4, extras);
+        else stepper.symplectic_euler(c.model, c.in, out[k], 1e-4, extras);
+        EXPECT_NEAR(energies.kinetic, c.model.kinetic_energy(c.in.v), 1e-14 * energies.kinetic);
+      }
+      EXPECT_TRUE(out[0].x.cwiseEqual(out[1].x).all()) << to_string(integ) << element_damping;
+      EXPECT_TRUE(out[0].v.cwiseEqual(out[1].v).all()) << to_string(integ) << element_damping;
+      EXPECT_GT((out[0].x - c.in.x).cwiseAbs().maxCoeff(), 0.0);
+    }
+  }
+}
+
+TEST(Integrators, StateEnergiesAreNotFiniteForANonFiniteEntry) {
+  // The health check relies on it: every entry of x and v enters the sums,
+  // also where the load or the mass weight is zero (0 * inf = NaN).
+  FusedCase c = fused_case(false);
+  const double inf = std::numeric_limits<double>::infinity();
+  int fixed_node = -1;
+  for (int i = 0; i < c.model.num_nodes(); ++i)
+    if (c.model.fixed_nodes()[i]) fixed_node = i;
+  ASSERT_GE(fixed_node, 0);
+  c.model.set_external_forces(MatX3d::Zero(c.model.num_nodes(), 3));  // load only along z
+  EXPECT_TRUE(std::isfinite(state_energies(c.model, c.in).kinetic));
+  for (int k = 0; k < 3; ++k) {
+    State s = c.in;
+    if (k == 0) s.v(7, 1) = std::numeric_limits<double>::quiet_NaN();
+    if (k == 1) s.x(7, 0) = inf;  // no load along x
+    if (k == 2) s.x(fixed_node, 1) = -inf;  // no load at a fixed node
+    const StateEnergies e = state_energies(c.model, s);
+    EXPECT_FALSE(std::isfinite(e.kinetic) && std::isfinite(e.load)) << k;
+  }
 }
 
 }  // namespace

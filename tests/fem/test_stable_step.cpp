@@ -81,6 +81,32 @@ TEST(StableStep, FiniteDifferenceProductsGiveTheExactEstimateTo1e6) {
   }
 }
 
+TEST(StableStep, GivenForcesAtXReplaceTheBaseEvaluationOfTheForwardDifferences) {
+  // The Simulator hands the forces of its last health check at x to the
+  // per-frame re-estimate: the estimate must be bitwise the one that
+  // evaluates them (the lane-kernel materials are deterministic at a given x).
+  for (MaterialModel mm : {MaterialModel::Linear, MaterialModel::StVK, MaterialModel::StableNeoHookean}) {
+    Model model = test::cantilever(1, test::material(mm, 1e7, 0.45));
+    const MatX3d x = model.mesh().rest_positions + 0.01 * test::random_field(model.num_nodes(), 5);
+    FrequencyOptions o;
+    o.max_iterations = 8;
+    o.finite_difference_products = true;
+    MatX3d f(model.num_nodes(), 3);
+    model.elastic().compute(x, f);
+    Eigen::VectorXd warm[2];
+    const FrequencyEstimate plain = estimate_max_frequency(model, x, o, &warm[0]);
+    const FrequencyEstimate given = estimate_max_frequency(model, x, o, &warm[1], &f);
+    EXPECT_EQ(plain.omega_max, given.omega_max) << to_string(mm);
+    EXPECT_EQ(plain.omega_bound, given.omega_bound) << to_string(mm);
+    EXPECT_TRUE(warm[0].cwiseEqual(warm[1]).all()) << to_string(mm);
+    // A wrong base point must change the estimate (the test can fail).
+    const MatX3d wrong = f + MatX3d::Constant(f.rows(), 3, 1e-3);
+    EXPECT_NE(estimate_max_frequency(model, x, o, nullptr, &wrong).omega_max, plain.omega_max);
+    const MatX3d short_f = f.topRows(3);
+    EXPECT_THROW(estimate_max_frequency(model, x, o, nullptr, &short_f), ParameterError);
+  }
+}
+
 TEST(StableStep, MaxFrequencyGrowsUnderCompression) {
   // 70% compression of a free cube with the lateral bulge of a nearly
   // incompressible solid, F = diag(0.3, 1/sqrt(0.3), 1/sqrt(0.3)) (J = 1). The
