@@ -157,19 +157,29 @@ icd::collision::SphereTree fit_leaves_to_probes(const icd::SurfaceMesh& mesh,
   return tree;
 }
 
+void print_usage(std::ostream& os) {
+  os << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
+        " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
+        " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]"
+        " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
+        " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
+        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F]\n"
+        "       sphere_tree_table --help\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::cerr
-        << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
-           " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-           " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both] "
-           "[--diagnose N]"
-           " [--exchange-rounds N] [--relieve-moves N] [--polish 0|1] [--polish-rounds N]"
-           " [--polish-evals N]"
-           " [--polish-search N] [--polish-check N] [--fit-probes 0|1] [--sum-passes N]"
-           " [--sum-cap F] [--sum-share F]\n";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      print_usage(std::cout);
+      return 0;
+    }
+  }
+  // RESULTS_DIR first, then "--key value" pairs.
+  if (argc < 2 || std::string(argv[1]).rfind("-", 0) == 0 || argc % 2 != 0) {
+    print_usage(std::cerr);
     return 2;
   }
   const fs::path results = argv[1];
@@ -241,6 +251,7 @@ int main(int argc, char** argv) {
       }
     } else {
       std::cerr << "unknown option " << key << "\n";
+      print_usage(std::cerr);
       return 2;
     }
   }
@@ -294,6 +305,10 @@ int main(int argc, char** argv) {
         model.name.c_str(), static_cast<long long>(ours.samples.points.rows()),
         ours.num_medial_spheres, ours.num_refinement_points, ours.medial_seconds, build_cpu_s,
         ours.polish_cpu_seconds, ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+    std::printf("# %s build steps (CPU s):", model.name.c_str());
+    for (const auto& [step, seconds] : ours.step_cpu_seconds)
+      std::printf(" %s %.1f;", step.c_str(), seconds);
+    std::printf("\n");
     // The builder's own error bound (radius - centre depth), normalized, per level.
     const double to_2000 =
         2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();

@@ -335,6 +335,12 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   const auto deadline = cpu_start + std::chrono::duration_cast<CpuClock::duration>(
                                         std::chrono::duration<double>(options.time_limit));
   SphereTreeBuild out;
+  auto step_start = CpuClock::now();
+  auto end_step = [&](const char* name) {
+    const auto now = CpuClock::now();
+    out.step_cpu_seconds.emplace_back(name, std::chrono::duration<double>(now - step_start).count());
+    step_start = now;
+  };
   const SurfaceMesh closed = close_holes(input);
   const MeshOracle oracle(closed);
   const double scale = longest_bounding_box_side(closed.V);
@@ -344,6 +350,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   out.samples = sample_surface(input.V, input.F, SamplingOptions{options.cover_spacing * scale});
   const SurfaceSamples medial_samples =
       sample_surface(closed.V, closed.F, SamplingOptions{options.medial_spacing * scale});
+  end_step("hole closing, oracle, sampling");
   MedialAxisOptions medial_options;
   medial_options.refinement_iterations = options.refinement_iterations;
   medial_options.error_tolerance = options.refinement_tolerance * scale;
@@ -351,6 +358,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   out.num_medial_spheres = static_cast<int>(medial.radii.size());
   out.num_refinement_points = medial.num_inserted;
   const PointGrid grid(medial.centers, scale / 64.0);
+  end_step("medial axis");
   out.medial_seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
   // The medial samples drive the placement; their margin is that of the coverage samples.
@@ -449,12 +457,14 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     }
     levels.push_back(std::move(children));
     parent_of.push_back(std::move(parent_index));
+    end_step(l == 1 ? "level 1" : l == 2 ? "level 2" : l == 3 ? "level 3" : "level > 3");
   }
   if (options.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
   }
   if (options.leaf_exchange && levels.size() > 1)
     exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
+  end_step("leaf exchange");
   if (options.sum_exchange_passes > 0 && levels.size() > 1) {
     const size_t last = levels.size() - 1;
     std::vector<FittedSphere> leaves;
@@ -478,12 +488,14 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
     refit_inner_nodes(dense, levels, parent_of);
   }
+  end_step("sum exchange");
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
     out.num_polished = polish_tree(dense, oracle, levels, parent_of, options.protrusion,
                                    options.protrusion_exchange_rounds, deadline);
     out.polish_cpu_seconds = std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }
+  end_step("protrusion polish");
 
   // Flatten breadth-first: level by level, children of a node contiguous.
   collision::SphereTree& tree = out.tree;

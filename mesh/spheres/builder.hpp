@@ -1,6 +1,8 @@
 #pragma once
 /// Top-down construction of a wrapped sphere tree from an adaptive
 /// medial-axis approximation (paper sec. 4.1; Bradshaw & O'Sullivan 2004).
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "collision/sphere_tree.hpp"
@@ -111,6 +113,8 @@ struct SphereTreeBuild {
   double polish_cpu_seconds = 0;   ///< CPU time of the protrusion polish
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
+  /// Process CPU seconds of each build step, in order (step name, seconds).
+  std::vector<std::pair<std::string, double>> step_cpu_seconds;
 };
 
 /// Builds the wrapped sphere tree of the triangle mesh (V #V x 3, F #F x 3,

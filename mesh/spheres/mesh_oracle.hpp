@@ -1,6 +1,6 @@
 #pragma once
-/// Distance and inside queries on a closed triangle mesh (CGAL AABB tree and
-/// Side_of_triangle_mesh behind a small interface, so that CGAL stays inside
+/// Distance and inside queries on a closed triangle mesh (our TriangleBvh and
+/// CGAL's Side_of_triangle_mesh behind a small interface, so that CGAL stays inside
 /// the .cpp files of mesh/).
 #include <memory>
 

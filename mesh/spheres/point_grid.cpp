@@ -14,50 +14,71 @@ PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_ce
     throw ParameterError("PointGrid: cell_size must be positive and finite, got " +
                          std::to_string(cell_size));
   }
-  m_points.resize(static_cast<size_t>(P.rows()));
-  m_point_cells.resize(static_cast<size_t>(P.rows()));
-  for (Eigen::Index i = 0; i < P.rows(); ++i) {
-    m_points[static_cast<size_t>(i)] = P.row(i);
-    const Eigen::Vector3i c = cell_of(m_points[static_cast<size_t>(i)]);
-    m_point_cells[static_cast<size_t>(i)] = c;
-    if (i == 0) {
-      m_min_cell = m_max_cell = c;
-    } else {
-      m_min_cell = m_min_cell.cwiseMin(c);
-      m_max_cell = m_max_cell.cwiseMax(c);
-    }
-    m_cells[key(c.x(), c.y(), c.z())].push_back(static_cast<int>(i));
+  const auto n = static_cast<size_t>(P.rows());
+  m_points.resize(n);
+  for (size_t i = 0; i < n; ++i) m_points[i] = P.row(static_cast<Eigen::Index>(i));
+  if (n == 0) return;
+  Eigen::Vector3d lo = m_points.front(), hi = m_points.front();
+  for (const auto& p : m_points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  // The cell size only affects speed (queries are exact): coarsen it so that
+  // the dense cell array stays within a few cells per point.
+  const double max_cells = std::max(4.0 * static_cast<double>(n), double{1 << 20});
+  auto cells_for = [&](double cell) {
+    double total = 1;
+    for (int k = 0; k < 3; ++k) total *= std::floor((hi[k] - lo[k]) / cell) + 1;
+    return total;
+  };
+  while (cells_for(m_cell) > max_cells) m_cell *= 1.25;
+  m_origin = lo;
+  for (int k = 0; k < 3; ++k)
+    m_dims[k] = static_cast<int>(std::floor((hi[k] - lo[k]) / m_cell)) + 1;
+  const auto num_cells = static_cast<size_t>(m_dims[0]) * static_cast<size_t>(m_dims[1]) *
+                         static_cast<size_t>(m_dims[2]);
+  // Counting sort of the points by cell (CSR); indices stay increasing per cell.
+  std::vector<size_t> cell(n);
+  m_start.assign(num_cells + 1, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3i c = cell_of(m_points[i]);
+    cell[i] = linear(c.x(), c.y(), c.z());
+    m_start[cell[i] + 1] += 1;
   }
+  for (size_t c = 0; c < num_cells; ++c) m_start[c + 1] += m_start[c];
+  m_index.resize(n);
+  std::vector<int> fill(m_start.begin(), m_start.end() - 1);
+  for (size_t i = 0; i < n; ++i) m_index[static_cast<size_t>(fill[cell[i]]++)] = static_cast<int>(i);
 }
 
-long long PointGrid::key(long long i, long long j, long long k) const {
-  return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
+size_t PointGrid::linear(int i, int j, int k) const {
+  return (static_cast<size_t>(i) * static_cast<size_t>(m_dims[1]) + static_cast<size_t>(j)) *
+             static_cast<size_t>(m_dims[2]) +
+         static_cast<size_t>(k);
 }
 
 Eigen::Vector3i PointGrid::cell_of(const Eigen::Vector3d& p) const {
-  return {static_cast<int>(std::floor(p.x() / m_cell)),
-          static_cast<int>(std::floor(p.y() / m_cell)),
-          static_cast<int>(std::floor(p.z() / m_cell))};
+  Eigen::Vector3i c;
+  for (int k = 0; k < 3; ++k) {
+    const double x = std::floor((p[k] - m_origin[k]) / m_cell);
+    c[k] = static_cast<int>(std::clamp(x, -1.0, static_cast<double>(m_dims[k])));
+  }
+  return c;
 }
 
 std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double radius) const {
   std::vector<int> out;
-  if (m_points.empty() || radius < 0) return out;
+  if (m_points.empty() || !(radius >= 0)) return out;
   const Eigen::Vector3i lo =
-      cell_of(center - Eigen::Vector3d::Constant(radius)).cwiseMax(m_min_cell);
-  const Eigen::Vector3i hi =
-      cell_of(center + Eigen::Vector3d::Constant(radius)).cwiseMin(m_max_cell);
+      cell_of(center - Eigen::Vector3d::Constant(radius)).cwiseMax(Eigen::Vector3i::Zero());
+  const Eigen::Vector3i hi = cell_of(center + Eigen::Vector3d::Constant(radius))
+                                 .cwiseMin(Eigen::Vector3i(m_dims[0] - 1, m_dims[1] - 1,
+                                                           m_dims[2] - 1));
   const double r2 = radius * radius;
   for (int i = lo.x(); i <= hi.x(); ++i) {
     for (int j = lo.y(); j <= hi.y(); ++j) {
-      for (int k = lo.z(); k <= hi.z(); ++k) {
-        auto it = m_cells.find(key(i, j, k));
-        if (it == m_cells.end()) continue;
-        for (int idx : it->second) {
-          const Eigen::Vector3i& c = m_point_cells[static_cast<size_t>(idx)];
-          if (c.x() != i || c.y() != j || c.z() != k) continue;  // hash collision
-          if ((m_points[static_cast<size_t>(idx)] - center).squaredNorm() <= r2) out.push_back(idx);
-        }
+      // Cells (i, j, lo.z .. hi.z) are contiguous in the CSR arrays.
+      const int begin = m_start[linear(i, j, lo.z())], end = m_start[linear(i, j, hi.z()) + 1];
+      for (int t = begin; t < end; ++t) {
+        const int idx = m_index[static_cast<size_t>(t)];
+        if ((m_points[static_cast<size_t>(idx)] - center).squaredNorm() <= r2) out.push_back(idx);
       }
     }
   }
@@ -67,9 +88,17 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
 
 int PointGrid::nearest(const Eigen::Vector3d& q) const {
   if (m_points.empty()) return -1;
-  double radius = m_cell;
-  const double max_radius = m_cell * (2.0 + (m_max_cell - m_min_cell).cast<double>().norm()) +
-                            (q - m_points.front()).norm();
+  // Distance from q to the grid's box, plus its diagonal: a ball of that
+  // radius holds every point.
+  double outside = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double hi = m_origin[k] + m_cell * m_dims[k];
+    const double d = std::max({m_origin[k] - q[k], q[k] - hi, 0.0});
+    outside += d * d;
+  }
+  const Eigen::Vector3d extent(m_dims[0], m_dims[1], m_dims[2]);
+  const double max_radius = std::sqrt(outside) + m_cell * extent.norm();
+  double radius = std::max(m_cell, std::sqrt(outside) + m_cell);
   while (true) {
     const std::vector<int> near = query_ball(q, radius);
     if (!near.empty()) {

@@ -1,6 +1,6 @@
 #pragma once
-/// A uniform hash grid over a fixed point set, for ball queries.
-#include <unordered_map>
+/// A uniform grid over a fixed point set, for ball queries.
+#include <cstddef>
 #include <vector>
 
 #include <Eigen/Core>
@@ -9,8 +9,11 @@
 
 namespace icd::mesh {
 
-/// Buckets the rows of P (#P x 3) in cubic cells of side `cell_size` (> 0).
-/// The grid keeps a reference to nothing: it copies the points it needs.
+/// Buckets the rows of P (#P x 3) in cubic cells of side `cell_size` (> 0),
+/// stored as a dense cell array over the points' bounding box (compressed
+/// rows; the cell side is enlarged when the box would need more than
+/// max(4 #P, 2^20) cells, which changes no query result). The grid keeps a
+/// reference to nothing: it copies the points it needs.
 class PointGrid {
  public:
   /// Builds the grid. Throws ParameterError for a non-positive cell size.
@@ -26,14 +29,16 @@ class PointGrid {
   int size() const { return static_cast<int>(m_points.size()); }
 
  private:
-  long long key(long long i, long long j, long long k) const;
+  size_t linear(int i, int j, int k) const;
+  /// Cell of p, each coordinate clamped to [-1, dims].
   Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const;
 
   double m_cell;
   std::vector<Eigen::Vector3d> m_points;
-  std::vector<Eigen::Vector3i> m_point_cells;  // cell of each point (hash-collision check)
-  std::unordered_map<long long, std::vector<int>> m_cells;
-  Eigen::Vector3i m_min_cell{0, 0, 0}, m_max_cell{0, 0, 0};
+  Eigen::Vector3d m_origin = Eigen::Vector3d::Zero();  // lowest corner of cell (0, 0, 0)
+  int m_dims[3] = {0, 0, 0};                           // cells per axis
+  std::vector<int> m_start;  // points of cell c: m_index[m_start[c] .. m_start[c + 1])
+  std::vector<int> m_index;
 };
 
 }  // namespace icd::mesh

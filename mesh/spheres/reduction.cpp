@@ -207,10 +207,29 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
 
   double best = kInf;
   int best_idx = -1;
+  // A candidate is dropped as soon as one hull point shows that its cost
+  // cannot beat the best so far (with a relative safety of 1e-9, so that the
+  // same candidate wins as with the full maximum); the hull point that
+  // dropped the last candidate is tried first.
+  size_t lead = 0;
   for (size_t i = 0; i < cands.size(); i += stride) {
     const int m = cands[i];
     const Eigen::Vector3d c = problem.medial.centers.row(m);
-    const double cost = max_distance(hull, c) - problem.medial.radii[m];
+    const double depth = problem.medial.radii[m];
+    if (best < kInf) {
+      const double cutoff = best + depth;
+      const double limit2 = cutoff > 0 ? cutoff * cutoff * (1 + 1e-9) : 0.0;
+      if ((hull[lead] - c).squaredNorm() > limit2) continue;
+      bool dropped = false;
+      for (size_t h = 0; h < hull.size(); ++h) {
+        if ((hull[h] - c).squaredNorm() > limit2) {
+          lead = h, dropped = true;
+          break;
+        }
+      }
+      if (dropped) continue;
+    }
+    const double cost = max_distance(hull, c) - depth;
     if (cost < best) best = cost, best_idx = m;
   }
   if (hint != nullptr && hint->depth > 0) {
