@@ -82,7 +82,18 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
       }
     }
   }
-  std::sort(out.begin(), out.end());
+  // Increasing order: a sort for small results, a scan of flags over all
+  // points for large ones (same output, linear time).
+  if (out.size() * 16 < m_points.size()) {
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  std::vector<char> hit(m_points.size(), 0);
+  for (int idx : out) hit[static_cast<size_t>(idx)] = 1;
+  size_t k = 0;
+  for (size_t i = 0; i < hit.size(); ++i) {
+    if (hit[i]) out[k++] = static_cast<int>(i);
+  }
   return out;
 }
 

@@ -87,16 +87,24 @@ std::vector<int> prefilter(const MatX3d& points, const std::vector<int>& members
   return out;
 }
 
-/// Extreme points (convex hull vertices) of the member samples, as rows.
+/// Extreme points (convex hull vertices) of the member samples, as rows;
+/// without `hull_only`, sets of over 1000 members give a superset of them
+/// (the prefilter's survivors: the same farthest distance from any point,
+/// without the exact hull's cost).
 std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points,
-                                            const std::vector<int>& all_members) {
+                                            const std::vector<int>& all_members, bool hull_only) {
   std::vector<Eigen::Vector3d> out;
   if (all_members.size() <= 64) {
     for (int s : all_members) out.emplace_back(points.row(s));
     return out;
   }
-  const std::vector<int> members =
-      all_members.size() > 1000 ? prefilter(points, all_members) : all_members;
+  if (!hull_only && all_members.size() > 1000) {
+    // The prefilter keeps every hull vertex: the farthest member from any
+    // point is among its survivors.
+    for (int s : prefilter(points, all_members)) out.emplace_back(points.row(s));
+    return out;
+  }
+  const std::vector<int>& members = all_members;
   std::vector<Point> in;
   in.reserve(members.size());
   for (int s : members) in.emplace_back(points(s, 0), points(s, 1), points(s, 2));
@@ -187,7 +195,7 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
   out.tag = hint != nullptr ? hint->tag : -1;
   out.members = members;
   std::sort(out.members.begin(), out.members.end());
-  const std::vector<Eigen::Vector3d> hull = extreme_points(problem.points, members);
+  const std::vector<Eigen::Vector3d> hull = extreme_points(problem.points, members, true);
   double gmax = 0;
   for (int s : members) gmax = std::max(gmax, problem.gap[s]);
 
@@ -258,7 +266,7 @@ void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, Fi
   // is refitted exactly and kept only when it beats the exact starting point.
   const std::vector<Eigen::Vector3d> hull = sphere.members.size() > 20000
                                                 ? support_points(problem.points, sphere.members)
-                                                : extreme_points(problem.points, sphere.members);
+                                                : extreme_points(problem.points, sphere.members, false);
   FittedSphere start = sphere;
   refit_radius(problem, start);
   double gmax = 0;
