@@ -220,6 +220,35 @@ inline bool choose_split_b(const Trees& t, const WorkPair& p) {
   return p.split_b ? eb : !t.expandable_a(p.a) && eb;
 }
 
+// Tests the children [first, end) of p's split node against p's other node
+// one at a time, each under the budget: an overlapping pair that can be split
+// further goes to `queue(a, b)`, one that cannot is settled. `pending()` is
+// the current size of the work list (for the budget's list cap). Returns false
+// when the budget stopped it (the untested children are then reported).
+template <class PendingSize, class Queue>
+bool test_children_one_by_one(const Trees& t, const WorkPair& p, bool split_b, int32_t first, int32_t end,
+                              Budget& budget, bool record_front, CollisionResult& res, PendingSize pending,
+                              Queue queue) {
+  StopReason reason = StopReason::Completed;
+  for (int32_t c = first; c < end; ++c) {
+    const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
+    if (!budget.allow(res.tests, pending(), reason)) {
+      for (int32_t r = c; r < end; ++r) res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
+      res.interrupted = true;
+      res.stop_reason = reason;
+      return false;
+    }
+    ++res.tests;
+    if (!t.overlaps(a, b)) {
+      if (record_front) res.front.push_back({a, b});
+      continue;
+    }
+    if (t.expandable_a(a) || t.expandable_b(b)) queue(a, b);
+    else settle(t, a, b, res);
+  }
+  return true;
+}
+
 // Literal Fig. 7 (and Fig. 4 with a stack): pairs are tested when popped.
 template <class List>
 void run_literal(const Trees& t, List& list, Budget& budget, bool record_front, CollisionResult& res) {
@@ -279,7 +308,6 @@ inline void expand_batch(const Trees& t, const WorkPair& p, int32_t first, int32
 // overlapping pairs that still need splitting.
 template <class List>
 void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, CollisionResult& res) {
-  StopReason reason = StopReason::Completed;
   bool stopped = false;
   while (!list.empty() && !stopped) {
     const WorkPair p = list.pop();
@@ -297,23 +325,9 @@ void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, Col
       res.peak_list_size = std::max(res.peak_list_size, list.size());
       continue;
     }
-    for (int32_t c = first; c < end; ++c) {
-      const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
-      if (!budget.allow(res.tests, list.size(), reason)) {
-        for (int32_t r = c; r < end; ++r) res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
-        res.interrupted = true;
-        res.stop_reason = reason;
-        stopped = true;
-        break;
-      }
-      ++res.tests;
-      if (!t.overlaps(a, b)) {
-        if (record_front) res.front.push_back({a, b});
-        continue;
-      }
-      if (t.expandable_a(a) || t.expandable_b(b)) list.push({a, b, next_flag});
-      else settle(t, a, b, res);
-    }
+    stopped = !test_children_one_by_one(
+        t, p, split_b, first, end, budget, record_front, res, [&] { return list.size(); },
+        [&](int32_t a, int32_t b) { list.push({a, b, next_flag}); });
     res.peak_list_size = std::max(res.peak_list_size, list.size());
   }
   res.untested.reserve(res.untested.size() + list.size());
@@ -333,7 +347,6 @@ inline double priority_of(PriorityKey key, const Sphere& p, const Sphere& q) {
 
 void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, PriorityKey key, Budget& budget,
                   bool record_front, CollisionResult& res) {
-  StopReason reason = StopReason::Completed;
   bool stopped = false;
   while (!heap.empty() && !stopped) {
     std::pop_heap(heap.begin(), heap.end());
@@ -351,27 +364,12 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
       std::make_heap(heap.begin(), heap.end());
     }
     const int32_t next_flag = split_b ? 0 : 1;
-    for (int32_t c = first; c < first + count; ++c) {
-      const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
-      if (!budget.allow(res.tests, heap.size(), reason)) {
-        for (int32_t r = c; r < first + count; ++r) res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
-        res.interrupted = true;
-        res.stop_reason = reason;
-        stopped = true;
-        break;
-      }
-      ++res.tests;
-      if (!t.overlaps(a, b)) {
-        if (record_front) res.front.push_back({a, b});
-        continue;
-      }
-      if (t.expandable_a(a) || t.expandable_b(b)) {
-        heap.push_back({priority_of(key, t.sa[a], t.sb[b]), {a, b, next_flag}});
-        std::push_heap(heap.begin(), heap.end());
-      } else {
-        settle(t, a, b, res);
-      }
-    }
+    stopped = !test_children_one_by_one(
+        t, p, split_b, first, first + count, budget, record_front, res, [&] { return heap.size(); },
+        [&](int32_t a, int32_t b) {
+          heap.push_back({priority_of(key, t.sa[a], t.sb[b]), {a, b, next_flag}});
+          std::push_heap(heap.begin(), heap.end());
+        });
     res.peak_list_size = std::max(res.peak_list_size, heap.size());
   }
   res.untested.reserve(res.untested.size() + heap.size());

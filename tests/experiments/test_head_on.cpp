@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "experiments/runner/world.hpp"
+#include "tests/experiments/head_on_scene.hpp"
 
 namespace icd::runner {
 namespace {
@@ -20,20 +21,8 @@ Eigen::Vector3d centre(const RuntimeObject& o) { return o.positions.colwise().me
 // on the x axis (y, z momentum negligible), spheres do not interpenetrate
 // deeply, and no energy is created.
 TEST(HeadOn, SoftSpheresBounceApartSymmetrically) {
-  const char* text = R"({
-    "frames": 40, "frame_rate": 60,
-    "objects": [
-      {"name": "left", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 5},
-       "position": [-0.12, 0, 0], "velocity": [0.6, 0, 0],
-       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_depth": 3}},
-      {"name": "right", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 5},
-       "position": [0.12, 0, 0], "velocity": [-0.6, 0, 0],
-       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_depth": 3}}
-    ],
-    "collision": {"budget_tests": 1000000, "stiffness": 2000, "layered": true},
-    "output": {"csv": false}
-  })";
-  const Scene scene = parse_scene(parse_json(text, "head_on"), "head_on", ".");
+  Scene scene = head_on_scene(R"("budget_tests": 1000000, "layered": true)");
+  scene.frames = 40;
   World world(scene, "", "");
   auto& objs = world.objects();
   const double mass = objs[0].sim->model().mass().sum();

@@ -8,28 +8,10 @@
 
 #include "experiments/runner/run.hpp"
 #include "experiments/runner/world.hpp"
+#include "tests/experiments/head_on_scene.hpp"
 
 namespace icd::runner {
 namespace {
-
-// Two soft spheres meeting head-on (as in test_head_on.cpp); `collision` is
-// spliced into the scene's collision block.
-Scene head_on_scene(const std::string& collision) {
-  const std::string text = R"({
-    "frames": 30, "frame_rate": 60,
-    "objects": [
-      {"name": "left", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 5},
-       "position": [-0.12, 0, 0], "velocity": [0.6, 0, 0],
-       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_depth": 3}},
-      {"name": "right", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 5},
-       "position": [0.12, 0, 0], "velocity": [-0.6, 0, 0],
-       "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_depth": 3}}
-    ],
-    "collision": {)" + (collision.find("stiffness") == std::string::npos ? std::string(R"("stiffness": 2000, )") : std::string()) + collision + R"(},
-    "output": {"csv": false}
-  })";
-  return parse_scene(parse_json(text, "head_on"), "head_on", ".");
-}
 
 double mean_velocity_x(const RuntimeObject& o) {
   const Eigen::VectorXd& m = o.sim->model().mass();
