@@ -4,13 +4,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <set>
 #include <string>
 
-#include "collision/node_association.hpp"
 #include "coupling/asset_bundle.hpp"
 #include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include "tests/coupling/small_bundle.hpp"
 
 namespace icd::coupling {
 namespace {
@@ -33,32 +31,8 @@ void spit(const fs::path& p, const std::string& bytes) {
   out << bytes;
 }
 
-// A small but complete bundle: an icosphere steered by a box tet mesh, and a
-// two-level sphere tree (root + 4 children) associated with the surface nodes.
-AssetBundle make_bundle(double radius = 0.5) {
-  AssetBundle b;
-  b.dense = make_icosphere(2, radius);
-  b.dense.V.rowwise() += Eigen::RowVector3d(0.5, 0.5, 0.5);
-  BoxMeshOptions o;
-  o.size = {1, 1, 1};
-  o.nx = o.ny = o.nz = 2;
-  b.coarse = make_box_tet_mesh(o);
-  const std::set<int> s(b.coarse.F.data(), b.coarse.F.data() + b.coarse.F.size());
-  b.surface_nodes.resize(static_cast<Eigen::Index>(s.size()));
-  int i = 0;
-  for (int v : s) b.surface_nodes[i++] = v;
-  b.links = build_rigid_links(b.dense.V, b.coarse.V, b.surface_nodes);
-  collision::SphereTree& t = b.spheres;
-  t.spheres = {{0.5, 0.5, 0.5, 0.9},
-               {0.25, 0.5, 0.5, 0.5},
-               {0.75, 0.5, 0.5, 0.5},
-               {0.5, 0.25, 0.5, 0.5},
-               {0.5, 0.75, 0.5, 0.5}};
-  collision::build_topology(t, {-1, 0, 0, 0, 0});
-  std::vector<int> cand(b.surface_nodes.data(), b.surface_nodes.data() + b.surface_nodes.size());
-  collision::associate_nearest_nodes(t, b.coarse.V, {}, cand);
-  return b;
-}
+// The bundle of small_bundle.hpp with a twice-subdivided icosphere.
+AssetBundle make_bundle(double radius = 0.5) { return make_small_bundle(2, radius); }
 
 void expect_same(const AssetBundle& a, const AssetBundle& b) {
   EXPECT_TRUE(a.dense.V == b.dense.V);  // bitwise: the VTU doubles read back exactly

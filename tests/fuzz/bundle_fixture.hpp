@@ -11,34 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "collision/node_association.hpp"
 #include "coupling/asset_bundle.hpp"
-#include "mesh/io/primitives.hpp"
+#include "tests/coupling/small_bundle.hpp"
 
 namespace icd::fuzz {
 
 /// Writes the fixture bundle into `folder` (dense_surface.vtu, coarse_tets.vtu,
 /// bundle.icdb).
 inline void write_fixture_bundle(const std::filesystem::path& folder) {
-  coupling::AssetBundle b;
-  b.dense = make_icosphere(1, 0.5);
-  b.dense.V.rowwise() += Eigen::RowVector3d(0.5, 0.5, 0.5);
-  BoxMeshOptions o;
-  o.size = {1, 1, 1};
-  o.nx = o.ny = o.nz = 2;
-  b.coarse = make_box_tet_mesh(o);
-  const std::set<int> s(b.coarse.F.data(), b.coarse.F.data() + b.coarse.F.size());
-  b.surface_nodes.resize(static_cast<Eigen::Index>(s.size()));
-  int i = 0;
-  for (int v : s) b.surface_nodes[i++] = v;
-  b.links = coupling::build_rigid_links(b.dense.V, b.coarse.V, b.surface_nodes);
-  collision::SphereTree& t = b.spheres;
-  t.spheres = {{0.5, 0.5, 0.5, 0.9}, {0.25, 0.5, 0.5, 0.5}, {0.75, 0.5, 0.5, 0.5},
-               {0.5, 0.25, 0.5, 0.5}, {0.5, 0.75, 0.5, 0.5}};
-  collision::build_topology(t, {-1, 0, 0, 0, 0});
-  std::vector<int> cand(b.surface_nodes.data(), b.surface_nodes.data() + b.surface_nodes.size());
-  collision::associate_nearest_nodes(t, b.coarse.V, {}, cand);
-  coupling::write_asset_bundle(folder, b);
+  coupling::write_asset_bundle(folder, coupling::make_small_bundle(1, 0.5));
 }
 
 /// Recomputes the total-size field and every checksum of bundle.icdb bytes
