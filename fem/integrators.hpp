@@ -23,8 +23,9 @@ struct State {
 
 /// Kinetic energy 1/2 sum m |v|^2 and potential of the conservative loads
 /// -sum (f_ext + m g) . x of a state, J (Model::kinetic_energy and
-/// Model::load_potential, summed node by node in increasing node order: equal
-/// to them up to rounding). Not finite if any entry of x or v is not.
+/// Model::load_potential in a fixed order of their own, dof k = 3i + c into
+/// the partial sum k % 4: equal to them up to rounding, deterministic). Not
+/// finite if any entry of x or v is not.
 struct StateEnergies {
   double kinetic = 0;
   double load = 0;

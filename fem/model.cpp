@@ -17,6 +17,7 @@ Model::Model(const Eigen::Ref<const MatX3d>& rest_positions, const Eigen::Ref<co
   m_inv_mass = m_mass.cwiseInverse();
   m_external = MatX3d::Zero(num_nodes(), 3);
   m_scratch.resize(num_nodes(), 3);
+  update_dofs();
   set_gravity(options.gravity);
   set_damping(options.damping);
   set_strain_rate_damping(options.strain_rate_damping);
@@ -36,7 +37,21 @@ void Model::set_fixed_nodes(const std::vector<int>& nodes) {
     fixed[i] = 1;
   }
   m_fixed = std::move(fixed);
+  update_dofs();
   update_load();
+}
+
+void Model::update_dofs() {
+  const int n = num_nodes();
+  m_dof_mass.resize(3 * n);
+  m_dof_inv_mass.resize(3 * n);
+  m_dof_free.resize(3 * static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      m_dof_mass[3 * i + c] = m_mass[i];
+      m_dof_inv_mass[3 * i + c] = m_inv_mass[i];
+      m_dof_free[3 * i + c] = m_fixed[i] ? std::uint64_t{0} : ~std::uint64_t{0};
+    }
 }
 
 void Model::update_load() {

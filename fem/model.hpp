@@ -2,6 +2,7 @@
 /// The physical model of one deformable object: elastic forces, lumped mass,
 /// Rayleigh damping and boundary conditions (fixed nodes, external nodal
 /// forces, gravity). Integrators and solvers act on it.
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -85,6 +86,14 @@ class Model {
   const MatX3d& loads() const { return m_load; }
   /// 1 / lumped mass per node (#V), 1/kg.
   const Eigen::VectorXd& inverse_mass() const { return m_inv_mass; }
+  /// Per dof 3i+c (3#V), for flat node passes that the compiler vectorises:
+  /// the lumped mass of node i (kg), its inverse (1/kg), and a bit mask, all
+  /// ones at the dofs of free nodes and 0 at those of fixed ones (AND-ing a
+  /// double's bits with it zeroes fixed dofs exactly, also a NaN, without a
+  /// branch).
+  const Eigen::VectorXd& dof_mass() const { return m_dof_mass; }
+  const Eigen::VectorXd& dof_inverse_mass() const { return m_dof_inv_mass; }
+  const std::vector<std::uint64_t>& dof_free_mask() const { return m_dof_free; }
   /// Kinetic energy 1/2 sum m |v|^2, J; not finite if any entry of v is not.
   double kinetic_energy(const Eigen::Ref<const MatX3d>& v) const;
   /// Potential of the conservative loads: -sum (f_ext + m g) . x over the free
@@ -96,7 +105,10 @@ class Model {
   Eigen::VectorXd m_mass;
   Eigen::VectorXd m_inv_mass;  ///< 1/m (#V)
   std::vector<char> m_fixed;
+  Eigen::VectorXd m_dof_mass, m_dof_inv_mass;  ///< 3#V each
+  std::vector<std::uint64_t> m_dof_free;      ///< 3#V
   void update_load();
+  void update_dofs();
   MatX3d m_external;
   MatX3d m_load;  ///< f_ext + m g at free nodes, 0 at fixed ones (#V x 3), N
   Eigen::Vector3d m_gravity;
