@@ -8,6 +8,8 @@
 //                   [--sum-passes N] [--sum-cap F] [--sum-share F]   (lower_error_sum)
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
+//                   [--perturb E]  (build for the mesh scaled by 1 + E, evaluate on the
+//                                   mesh: E ~ 1e-12 shows the build's sensitivity to rounding)
 //
 // Builds the wrapped sphere tree (adaptive medial axis, branching 8, depth 3,
 // at most 1/8/64/445 spheres per level as the reference toolkit's dragon tree)
@@ -163,7 +165,7 @@ void print_usage(std::ostream& os) {
         " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
-        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F]\n"
+        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E]\n"
         "       sphere_tree_table --help\n";
 }
 
@@ -191,6 +193,7 @@ int main(int argc, char** argv) {
   bool with_octree = true;
   int diagnose = 0;
   bool fit_probes = false;
+  double perturb = 0;
   icd::mesh::EvaluationOptions evaluation;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
@@ -217,6 +220,8 @@ int main(int argc, char** argv) {
       options.exchange_rounds = std::atoi(value);
     else if (key == "--relieve-moves")
       options.relieve_moves = std::atoi(value);
+    else if (key == "--perturb")
+      perturb = std::atof(value);
     else if (key == "--fit-probes")
       fit_probes = std::atoi(value) != 0;
     else if (key == "--polish")
@@ -282,7 +287,12 @@ int main(int argc, char** argv) {
     const icd::SurfaceMesh mesh = icd::read_surface_mesh(path);
 
     const std::clock_t cpu0 = std::clock();
-    const icd::mesh::SphereTreeBuild ours = icd::mesh::build_sphere_tree(mesh, options);
+    // --perturb E: the tree is built for the mesh scaled by 1 + E (E ~ 1e-12
+    // changes coordinates in their last bits only) and evaluated on the mesh:
+    // how much the result depends on rounding.
+    icd::SurfaceMesh build_mesh = mesh;
+    build_mesh.V *= 1.0 + perturb;
+    const icd::mesh::SphereTreeBuild ours = icd::mesh::build_sphere_tree(build_mesh, options);
     const double build_cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
     icd::collision::validate(ours.tree);
 
