@@ -49,16 +49,16 @@ struct SimulatorOptions {
   /// detection/response cycles); the health checks still guard every step.
   double frequency_reuse_time = 0;
   /// Sub-steps between health checks (>= 1; default: every step). With the
-  /// explicit integrators a check rides on the element pass of the next
-  /// step's first force evaluation (energy, det F and finiteness of state n
-  /// computed while evaluating f(x_n)) plus O(#V) passes: ~3 ns/tet in the
-  /// element loop (StVK, AVX2 lane loops; a force evaluation is ~20), i.e.
-  /// +5% per simulated second with RK4 and +13-17% with symplectic Euler
-  /// (4: +1-2.5% for both; measured in experiments/fem/results/README.md).
-  /// Only the last state of an
-  /// advance()/step() call needs a separate element pass. A blow-up is
-  /// caught at most this many steps late and rolled back to the last
-  /// checked state.
+  /// explicit integrators a check rides on the next step: energy, det F and
+  /// finiteness of state n in the element pass of its first force
+  /// evaluation (at x_n), kinetic energy and load potential in its first
+  /// node pass; ~2-4 ns/tet in the element loop (StVK, AVX2 lane loops; a
+  /// force evaluation is ~20), i.e. +4% per simulated second with RK4 and
+  /// +10-12% with symplectic Euler (4: +0-4%; measured in
+  /// experiments/fem/results/README.md). Only the last state of an
+  /// advance()/step() call needs a separate element pass (which also
+  /// computes the forces there for the next call). A blow-up is caught at
+  /// most this many steps late and rolled back to the last checked state.
   int check_interval = 1;
   /// A check fails when KE + W grows by more than this fraction of
   /// (KE + W + |work of the loads|) since the last check (explicit blow-up).
