@@ -8,6 +8,7 @@
 //                   [--sum-passes N] [--sum-cap F] [--sum-share F]   (lower_error_sum)
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
+//                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
 //                   [--perturb E]  (build for the mesh scaled by 1 + E, evaluate on the
 //                                   mesh: E ~ 1e-12 shows the build's sensitivity to rounding)
 //
@@ -165,7 +166,7 @@ void print_usage(std::ostream& os) {
         " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
-        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E]\n"
+        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]\n"
         "       sphere_tree_table --help\n";
 }
 
@@ -220,6 +221,8 @@ int main(int argc, char** argv) {
       options.exchange_rounds = std::atoi(value);
     else if (key == "--relieve-moves")
       options.relieve_moves = std::atoi(value);
+    else if (key == "--fill")
+      options.fill_leaf_budget = std::atoi(value) != 0;
     else if (key == "--perturb")
       perturb = std::atof(value);
     else if (key == "--fit-probes")

@@ -279,6 +279,67 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
   refit_inner_nodes(dense, levels, parent_of);
 }
 
+/// Spends leaf spheres that the top-down pass lost (a child of a chosen
+/// configuration that receives no coverage sample is dropped): while the leaf
+/// level holds fewer than `cap` spheres, the leaf with the largest error bound
+/// whose parent has fewer than `branching` children is split in two (the
+/// two-sphere configuration of its medial samples, its coverage samples
+/// divided between them, centres polished), if both halves have a smaller
+/// error bound than it. The halves divide the leaf's samples, so every
+/// ancestor still covers them, and they stay next to each other (siblings
+/// contiguous). Returns the number of splits.
+int fill_leaf_budget(const ReductionProblem& coarse, const ReductionProblem& dense,
+                     const MeshOracle& oracle, const ReductionOptions& reduction,
+                     std::vector<std::vector<Node>>& levels,
+                     std::vector<std::vector<int>>& parent_of, long long cap, int branching) {
+  if (levels.size() < 2) return 0;
+  std::vector<Node>& leaves = levels.back();
+  std::vector<int>& parent = parent_of.back();
+  std::vector<int> children(levels[levels.size() - 2].size(), 0);
+  for (int p : parent) children[static_cast<size_t>(p)] += 1;
+  std::vector<char> tried(leaves.size(), 0);
+  int splits = 0;
+  while (static_cast<long long>(leaves.size()) < cap) {
+    int pick = -1;
+    for (size_t i = 0; i < leaves.size(); ++i) {
+      if (tried[i] || children[static_cast<size_t>(parent[i])] >= branching) continue;
+      if (leaves[i].medial.size() < 2 || leaves[i].sphere.members.size() < 2) continue;
+      if (pick < 0 || leaves[i].sphere.error > leaves[static_cast<size_t>(pick)].sphere.error)
+        pick = static_cast<int>(i);
+    }
+    if (pick < 0) break;
+    tried[static_cast<size_t>(pick)] = 1;
+    const Node& leaf = leaves[static_cast<size_t>(pick)];
+    std::vector<FittedSphere> halves = reduce_to_spheres(coarse, leaf.medial, 2, reduction)[1];
+    if (halves.size() < 2) continue;
+    std::vector<std::vector<int>> medial;
+    for (size_t k = 0; k < halves.size(); ++k) {
+      halves[k].tag = static_cast<int>(k);
+      medial.push_back(halves[k].members);
+    }
+    assign_and_refit(dense, leaf.sphere.members, halves);
+    for (auto& h : halves) polish_sphere(dense, oracle, h);
+    assign_and_refit(dense, leaf.sphere.members, halves);
+    if (halves.size() < 2) continue;
+    shrink_by_exchange(dense, halves);
+    if (!(halves[0].error < leaf.sphere.error && halves[1].error < leaf.sphere.error)) continue;
+    Node a, b;
+    a.sphere = std::move(halves[0]);
+    b.sphere = std::move(halves[1]);
+    a.medial = a.sphere.tag >= 0 ? medial[static_cast<size_t>(a.sphere.tag)] : leaf.medial;
+    b.medial = b.sphere.tag >= 0 ? medial[static_cast<size_t>(b.sphere.tag)] : leaf.medial;
+    const int p = parent[static_cast<size_t>(pick)];
+    leaves[static_cast<size_t>(pick)] = std::move(a);
+    leaves.insert(leaves.begin() + pick + 1, std::move(b));
+    parent.insert(parent.begin() + pick + 1, p);
+    tried.insert(tried.begin() + pick + 1, 0);
+    tried[static_cast<size_t>(pick)] = 0;
+    children[static_cast<size_t>(p)] += 1;
+    ++splits;
+  }
+  return splits;
+}
+
 /// The protrusion polish of every node (polish_protrusion), leaves first;
 /// then `exchange_rounds` times the leaves hand boundary samples to
 /// neighbours whose ancestors all cover them (shrink_by_exchange) and the
@@ -458,6 +519,18 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     levels.push_back(std::move(children));
     parent_of.push_back(std::move(parent_index));
     end_step(l == 1 ? "level 1" : l == 2 ? "level 2" : l == 3 ? "level 3" : "level > 3");
+  }
+  if (options.fill_leaf_budget && options.depth >= 1) {
+    long long cap = 1;
+    for (int i = 0; i < options.depth; ++i) cap *= options.branching;
+    if (static_cast<int>(options.max_spheres_per_level.size()) > options.depth &&
+        options.max_spheres_per_level[static_cast<size_t>(options.depth)] > 0) {
+      cap = std::min<long long>(cap,
+                                options.max_spheres_per_level[static_cast<size_t>(options.depth)]);
+    }
+    out.num_budget_splits = fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
+                                             cap, options.branching);
+    end_step("leaf budget");
   }
   if (options.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);

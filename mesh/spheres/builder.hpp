@@ -66,6 +66,11 @@ struct SphereTreeOptions {
   /// leaf grows below the worst leaf error; its ancestors may grow, each within
   /// its level's worst error bound before the moves.
   int relieve_moves = 200000;
+  /// After the top-down pass, spend the leaf spheres it lost (a child that
+  /// received no coverage sample is dropped, so the leaf level can hold fewer
+  /// than its cap): the leaf with the largest error bound whose parent has
+  /// room is split in two, while that lowers both halves' bound below it.
+  bool fill_leaf_budget = false;
   /// After the top-down pass, optimise the leaves jointly (a leaf may take
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.
@@ -113,6 +118,7 @@ struct SphereTreeBuild {
   double polish_cpu_seconds = 0;   ///< CPU time of the protrusion polish
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
+  int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget
   /// Process CPU seconds of each build step, in order (step name, seconds).
   std::vector<std::pair<std::string, double>> step_cpu_seconds;
 };

@@ -229,6 +229,57 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
   }
 }
 
+TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
+  // Splitting leaves to spend the lost budget. On this sphere (coarse medial
+  // samples, branching 8) the top-down pass loses leaves and the fill splits
+  // some: the leaf level never exceeds its cap nor a parent its branching,
+  // every node covers its samples with margin, children divide their
+  // parent's samples (so each parent covers the union of its children's
+  // patches), and every level covers a dense random sampling (brute force).
+  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
+  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  o.branching = 8;
+  o.medial_spacing = 1.0 / 6;
+  const SphereTreeBuild plain = build_sphere_tree(sphere, o);
+  o.fill_leaf_budget = true;
+  const SphereTreeBuild build = build_sphere_tree(sphere, o);
+  const auto& tree = build.tree;
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  ASSERT_EQ(tree.num_levels(), 3);
+  EXPECT_GT(build.num_budget_splits, 0) << "the case must exercise the fill";
+  const int leaves = tree.level_offset[3] - tree.level_offset[2];
+  EXPECT_EQ(leaves, plain.tree.level_offset[3] - plain.tree.level_offset[2] +
+                        build.num_budget_splits);
+  EXPECT_LE(leaves, 64);
+  const auto& P = build.samples.points;
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    for (int m : build.node_samples[i]) {
+      ASSERT_LE((P.row(m).transpose() - tree.spheres[i].center()).norm() + build.samples.gap[m],
+                tree.spheres[i].r * (1 + 1e-12) + 1e-12);
+    }
+    if (tree.child_count[i] == 0) continue;
+    EXPECT_LE(tree.child_count[i], o.branching);
+    std::vector<int> joined;
+    for (int k = 0; k < tree.child_count[i]; ++k) {
+      const auto& cs = build.node_samples[tree.first_child[i] + k];
+      EXPECT_FALSE(cs.empty());
+      joined.insert(joined.end(), cs.begin(), cs.end());
+    }
+    std::sort(joined.begin(), joined.end());
+    EXPECT_EQ(joined, build.node_samples[i]) << "node " << i;
+  }
+  const icd::MatX3d D = dense_random_points(sphere, 5000, 13);
+  for (int l = 0; l < tree.num_levels(); ++l) {
+    for (Eigen::Index p = 0; p < D.rows(); ++p) {
+      bool covered = false;
+      for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
+        covered = (D.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
+      }
+      ASSERT_TRUE(covered) << "level " << l << " point " << p;
+    }
+  }
+}
+
 TEST(SphereTreeBuilder, ProtrusionPolishNeverRaisesANodesError) {
   // The polish is the last step: the same build without it has the same
   // nodes; each polished node protrudes no more (measured on the polish's
