@@ -85,14 +85,12 @@ void ExplicitStepper::symplectic_euler(Model& model, const State& in, State& out
 
 namespace {
 
-// The node pass of a symplectic Euler step (see ExplicitStepper::symplectic_euler);
-// kEnergies: also the StateEnergies of (x, v), summed as in state_energies().
-// Dofs k0 .. k0 + count - 1 (count <= 4, k0 a multiple of 4; kCount > 0: count = kCount) of the node pass
-// (Model::acceleration's formula, exactly zero at fixed nodes even where the
-// elastic force is not finite: a bit mask, not a product with 0, and no
-// branch, which kept the compiler from vectorising); dof k0 + j
-// into the partial sums j. Restrict-qualified so that the compiler vectorises
-// the 4 dofs.
+// Dofs k0 .. k0 + count - 1 of a symplectic Euler node pass (count <= 4, k0
+// a multiple of 4; kCount > 0: count = kCount, known to the compiler), dof
+// k0 + j into the partial sums j. The acceleration is Model::acceleration's
+// formula, exactly zero at fixed dofs even where the elastic force is not
+// finite: a bit mask, not a product with 0, and not a branch (with a select,
+// GCC emitted a branch and did not vectorise). Restrict-qualified pointers.
 template <bool kEnergies, int kCount>
 [[gnu::always_inline]] inline void symplectic_euler_dofs(
     int count, double alpha, double h, const double* __restrict m, const double* __restrict w,
@@ -109,6 +107,8 @@ template <bool kEnergies, int kCount>
   }
 }
 
+// The node pass of a symplectic Euler step (see ExplicitStepper::symplectic_euler);
+// kEnergies: also the StateEnergies of (x, v), summed as in state_energies().
 template <bool kEnergies>
 StateEnergies symplectic_euler_nodes(const Model& model, const double* x, const double* v, const double* f,
                                      double h, double* x1, double* v1) {
