@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/fem/clamped_bar.hpp"
 #include "fem/simulator.hpp"
 #include "mesh/io/primitives.hpp"
 
@@ -23,21 +24,6 @@ namespace {
 
 using namespace icd;
 using namespace icd::fem;
-
-Model bar_model(const TetMesh& m) {
-  Material mat;
-  mat.model = MaterialModel::StVK;
-  mat.young = 1e6;
-  ModelOptions mo;
-  mo.gravity = {0, 0, -9.81};
-  mo.damping = {1.0, 0.0};
-  Model model(m.V, m.T, mat, mo);
-  std::vector<int> fixed;
-  for (int i = 0; i < m.V.rows(); ++i)
-    if (m.V(i, 0) < 1e-12) fixed.push_back(i);
-  model.set_fixed_nodes(fixed);
-  return model;
-}
 
 }  // namespace
 
@@ -59,12 +45,12 @@ int main() {
   std::printf("bar 3840 tets, RK4, %d frames of 1/60 s; omega bound of the per-frame re-estimate vs converged\n",
               frames);
   for (const Config& c : configs) {
-    Model reference = bar_model(m);
+    Model reference = clamped_stvk_model(m);
     SimulatorOptions so;
     so.frequency.warm_modes = c.warm_modes;
     so.frequency_refresh_iterations = c.iterations;
     so.frequency_refresh_tolerance = c.tolerance;
-    Simulator sim(bar_model(m), so);
+    Simulator sim(clamped_stvk_model(m), so);
     FrequencyOptions converged;
     converged.max_iterations = 300;
     converged.tolerance = 1e-9;
@@ -93,7 +79,7 @@ int main() {
       SimulatorOptions so;
       so.integrator = integ;
       so.safety_factor = safety;
-      Simulator sim(bar_model(m), so);
+      Simulator sim(clamped_stvk_model(m), so);
       long substeps = 0;
       int retries = 0;
       std::string outcome = "completed";

@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/fem/clamped_bar.hpp"
 #include "fem/lane_loops.hpp"
 #include "fem/simulator.hpp"
 #include "mesh/io/primitives.hpp"
@@ -64,29 +65,13 @@ struct Run {
   long first_products = 0, products = 0;  // Lanczos products: first (cold) estimate, later frames
 };
 
-Model bar_model(const TetMesh& m, int threads) {
-  Material mat;
-  mat.model = MaterialModel::StVK;
-  mat.young = 1e6;
-  ModelOptions mo;
-  mo.gravity = {0, 0, -9.81};
-  mo.damping = {1.0, 0.0};
-  mo.forces.num_threads = threads;
-  Model model(m.V, m.T, mat, mo);
-  std::vector<int> fixed;
-  for (int i = 0; i < m.V.rows(); ++i)
-    if (m.V(i, 0) < 1e-12) fixed.push_back(i);
-  model.set_fixed_nodes(fixed);
-  return model;
-}
-
 std::unique_ptr<Simulator> make_simulator(const TetMesh& m, Integrator integ, int check_interval,
                                           bool fd_products, int threads) {
   SimulatorOptions so;
   so.integrator = integ;
   so.check_interval = check_interval;
   so.frequency_refresh_finite_differences = fd_products;
-  return std::make_unique<Simulator>(bar_model(m, threads), so);
+  return std::make_unique<Simulator>(clamped_stvk_model(m, threads), so);
 }
 
 double median(std::vector<double> v) {
@@ -143,7 +128,7 @@ int main(int argc, char** argv) {
   // Unit costs: one force evaluation with and without the fused health
   // check, and one force differential, at a sagged state; measured once per
   // repetition (interleaved with the runs) with the best lane loops.
-  Simulator sagged(bar_model(m, threads));
+  Simulator sagged(clamped_stvk_model(m, threads));
   for (int f = 0; f < 30; ++f) sagged.advance(1.0 / 60);
   const MatX3d x = sagged.positions();
   const MatX3d dx = MatX3d::Constant(x.rows(), 3, 1e-3);

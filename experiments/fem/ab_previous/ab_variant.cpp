@@ -9,6 +9,7 @@
 
 #include "fem/simulator.hpp"
 #include "mesh/io/primitives.hpp"
+#include "../clamped_bar.hpp"
 
 #define ICD_AB_CAT2(a, b) a##b
 #define ICD_AB_CAT(a, b) ICD_AB_CAT2(a, b)
@@ -24,17 +25,7 @@ void* ICD_AB_NAME(make_sim)(int integrator, int mesh, int check_interval) {
   bo.nz = block ? 8 : 4;
   bo.size = block ? Eigen::Vector3d(1.0, 0.8, 0.8) : Eigen::Vector3d(1.0, 0.1, 0.1);
   const TetMesh m = make_box_tet_mesh(bo);
-  Material mat;
-  mat.model = MaterialModel::StVK;
-  mat.young = 1e6;
-  ModelOptions mo;
-  mo.gravity = {0, 0, -9.81};
-  mo.damping = {1.0, 0.0};
-  Model model(m.V, m.T, mat, mo);
-  std::vector<int> fixed;
-  for (int i = 0; i < m.V.rows(); ++i)
-    if (m.V(i, 0) < 1e-12) fixed.push_back(i);
-  model.set_fixed_nodes(fixed);
+  Model model = clamped_stvk_model(m);
   SimulatorOptions so;
   so.integrator = integrator ? Integrator::SymplecticEuler : Integrator::RK4;
   so.check_interval = check_interval;
