@@ -85,6 +85,44 @@ icd::MatX3d dense_random_points(const icd::SurfaceMesh& m, int count, unsigned s
   return P;
 }
 
+/// Every node of `build` covers its samples with their margins, and the
+/// children of every inner node divide its samples among them (none empty),
+/// so each node covers the union of its children's patches.
+void expect_nodes_cover_and_children_divide(const SphereTreeBuild& build) {
+  const auto& tree = build.tree;
+  const auto& P = build.samples.points;
+  ASSERT_EQ(static_cast<int>(build.node_samples.size()), tree.num_nodes());
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    const auto& s = tree.spheres[i];
+    for (int m : build.node_samples[i]) {
+      ASSERT_LE((P.row(m).transpose() - s.center()).norm() + build.samples.gap[m],
+                s.r * (1 + 1e-12) + 1e-12);
+    }
+    if (tree.child_count[i] == 0) continue;
+    std::vector<int> joined;
+    for (int k = 0; k < tree.child_count[i]; ++k) {
+      const auto& cs = build.node_samples[tree.first_child[i] + k];
+      EXPECT_FALSE(cs.empty());
+      joined.insert(joined.end(), cs.begin(), cs.end());
+    }
+    std::sort(joined.begin(), joined.end());
+    EXPECT_EQ(joined, build.node_samples[i]) << "children must divide the samples of node " << i;
+  }
+}
+
+/// How many points of `P` no sphere of level `l` of `tree` contains (brute force).
+int uncovered_on_level(const icd::collision::SphereTree& tree, int l, const icd::MatX3d& P) {
+  int uncovered = 0;
+  for (Eigen::Index p = 0; p < P.rows(); ++p) {
+    bool covered = false;
+    for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
+      covered = (P.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
+    }
+    uncovered += covered ? 0 : 1;
+  }
+  return uncovered;
+}
+
 TEST(SphereTreeBuilder, LayoutIsBreadthFirstWithContiguousChildren) {
   for (const auto& c : cases()) {
     SCOPED_TRACE(c.name);
@@ -122,27 +160,9 @@ TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem
     for (const auto& c : cases()) {
       SCOPED_TRACE(c.name + " " + method_name);
       const SphereTreeBuild& build = cached_build(c, method);
-      const auto& tree = build.tree;
-      const auto& P = build.samples.points;
-      ASSERT_EQ(static_cast<int>(build.node_samples.size()), tree.num_nodes());
-      EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), P.rows());
-      for (int i = 0; i < tree.num_nodes(); ++i) {
-        const auto& s = tree.spheres[i];
-        for (int m : build.node_samples[i]) {
-          ASSERT_LE((P.row(m).transpose() - s.center()).norm() + build.samples.gap[m],
-                    s.r * (1 + 1e-12) + 1e-12);
-        }
-        if (tree.child_count[i] == 0) continue;
-        std::vector<int> joined;
-        for (int k = 0; k < tree.child_count[i]; ++k) {
-          const auto& cs = build.node_samples[tree.first_child[i] + k];
-          EXPECT_FALSE(cs.empty());
-          joined.insert(joined.end(), cs.begin(), cs.end());
-        }
-        std::sort(joined.begin(), joined.end());
-        EXPECT_EQ(joined, build.node_samples[i])
-            << "children must divide the samples of node " << i;
-      }
+      expect_nodes_cover_and_children_divide(build);
+      ASSERT_FALSE(build.node_samples.empty());
+      EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), build.samples.points.rows());
     }
 }
 
@@ -153,17 +173,7 @@ TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
       const SphereTreeBuild& build = cached_build(c, method);
       const auto& tree = build.tree;
       const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
-      for (int l = 0; l < tree.num_levels(); ++l) {
-        int uncovered = 0;
-        for (Eigen::Index p = 0; p < P.rows(); ++p) {
-          bool covered = false;
-          for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
-            covered = (P.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
-          }
-          uncovered += covered ? 0 : 1;
-        }
-        EXPECT_EQ(uncovered, 0) << "level " << l;
-      }
+      for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, P), 0) << "level " << l;
     }
 }
 
@@ -202,31 +212,9 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
   const SphereTreeBuild build = build_sphere_tree(torus.mesh, o);
   const auto& tree = build.tree;
   EXPECT_NO_THROW(icd::collision::validate(tree));
-  const auto& P = build.samples.points;
-  for (int i = 0; i < tree.num_nodes(); ++i) {
-    for (int m : build.node_samples[i]) {
-      ASSERT_LE((P.row(m).transpose() - tree.spheres[i].center()).norm() + build.samples.gap[m],
-                tree.spheres[i].r * (1 + 1e-12) + 1e-12);
-    }
-    if (tree.child_count[i] == 0) continue;
-    std::vector<int> joined;
-    for (int k = 0; k < tree.child_count[i]; ++k) {
-      const auto& cs = build.node_samples[tree.first_child[i] + k];
-      joined.insert(joined.end(), cs.begin(), cs.end());
-    }
-    std::sort(joined.begin(), joined.end());
-    EXPECT_EQ(joined, build.node_samples[i]) << "node " << i;
-  }
+  expect_nodes_cover_and_children_divide(build);
   const icd::MatX3d D = dense_random_points(torus.mesh, 5000, 11);
-  for (int l = 0; l < tree.num_levels(); ++l) {
-    for (Eigen::Index p = 0; p < D.rows(); ++p) {
-      bool covered = false;
-      for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
-        covered = (D.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
-      }
-      ASSERT_TRUE(covered) << "level " << l << " point " << p;
-    }
-  }
+  for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
 }
 
 TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
@@ -251,33 +239,10 @@ TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   EXPECT_EQ(leaves, plain.tree.level_offset[3] - plain.tree.level_offset[2] +
                         build.num_budget_splits);
   EXPECT_LE(leaves, 64);
-  const auto& P = build.samples.points;
-  for (int i = 0; i < tree.num_nodes(); ++i) {
-    for (int m : build.node_samples[i]) {
-      ASSERT_LE((P.row(m).transpose() - tree.spheres[i].center()).norm() + build.samples.gap[m],
-                tree.spheres[i].r * (1 + 1e-12) + 1e-12);
-    }
-    if (tree.child_count[i] == 0) continue;
-    EXPECT_LE(tree.child_count[i], o.branching);
-    std::vector<int> joined;
-    for (int k = 0; k < tree.child_count[i]; ++k) {
-      const auto& cs = build.node_samples[tree.first_child[i] + k];
-      EXPECT_FALSE(cs.empty());
-      joined.insert(joined.end(), cs.begin(), cs.end());
-    }
-    std::sort(joined.begin(), joined.end());
-    EXPECT_EQ(joined, build.node_samples[i]) << "node " << i;
-  }
+  expect_nodes_cover_and_children_divide(build);
+  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
   const icd::MatX3d D = dense_random_points(sphere, 5000, 13);
-  for (int l = 0; l < tree.num_levels(); ++l) {
-    for (Eigen::Index p = 0; p < D.rows(); ++p) {
-      bool covered = false;
-      for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i) {
-        covered = (D.row(p).transpose() - tree.spheres[i].center()).norm() <= tree.spheres[i].r;
-      }
-      ASSERT_TRUE(covered) << "level " << l << " point " << p;
-    }
-  }
+  for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
 }
 
 TEST(SphereTreeBuilder, ProtrusionPolishNeverRaisesANodesError) {
