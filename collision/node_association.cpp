@@ -6,6 +6,7 @@
 #include <string>
 
 #include "mesh/io/error.hpp"
+#include "mesh/io/triangle_geometry.hpp"
 
 namespace icd::collision {
 namespace {
@@ -44,33 +45,6 @@ void store(SphereTree& tree, const Eigen::Ref<const MatX3d>& P, const std::vecto
     }
     tree.assoc_offset.push_back(static_cast<int32_t>(tree.assoc_nodes.size()));
   }
-}
-
-// Squared distance from point p to triangle (a, b, c) (Ericson's closest point).
-double point_triangle_sq(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - (d1 / (d1 - d3)) * ab).squaredNorm();
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - (d2 / (d2 - d6)) * ac).squaredNorm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return (bp - ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b)).squaredNorm();
-  const double denom = va + vb + vc;
-  if (!(std::abs(denom) > 0)) {  // degenerate triangle: closest of its edges' endpoints is enough here
-    return std::min({ap.squaredNorm(), bp.squaredNorm(), cp.squaredNorm()});
-  }
-  const double v = vb / denom, w = vc / denom;
-  return (ap - v * ab - w * ac).squaredNorm();
 }
 
 }  // namespace
@@ -140,7 +114,7 @@ void associate_steering_nodes(SphereTree& tree, const Eigen::Ref<const MatX3d>& 
       if ((lo[f] - c).maxCoeff() > s.r || (c - hi[f]).maxCoeff() > s.r) continue;
       const Eigen::Vector3d a = dense_V.row(dense_F(f, 0)).transpose(), b = dense_V.row(dense_F(f, 1)).transpose(),
                             cc = dense_V.row(dense_F(f, 2)).transpose();
-      if (point_triangle_sq(c, a, b, cc) > s.r * s.r * (1.0 + 1e-12)) continue;
+      if ((closest_point_on_triangle(c, a, b, cc) - c).squaredNorm() > s.r * s.r * (1.0 + 1e-12)) continue;
       for (int k = 0; k < 3; ++k) {
         const int v = dense_F(f, k);
         for (int32_t j = steer_offset[v]; j < steer_offset[v + 1]; ++j) add(steer_nodes[j]);

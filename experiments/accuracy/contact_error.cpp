@@ -37,6 +37,7 @@
 #include "icd/config.hpp"
 #include "mesh/io/atomic_write.hpp"
 #include "mesh/io/error.hpp"
+#include "mesh/io/triangle_geometry.hpp"
 
 namespace fs = std::filesystem;
 using namespace icd;
@@ -48,27 +49,6 @@ using collision::SphereTree;
 using Eigen::Vector3d;
 
 namespace {
-
-// Closest point to p on triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
-Vector3d closest_on_triangle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  const Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
-  const Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
-  const double denom = 1 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
 
 // A triangle with a bounding ball for cheap rejection.
 struct Tri {
@@ -86,7 +66,7 @@ Tri make_tri(const MatX3d& V, const MatX3i& F, int f) {
 bool meets(const collision::Sphere& s, const Tri& t) {
   const Vector3d c(s.x, s.y, s.z);
   if ((c - t.centre).norm() > s.r + t.radius) return false;
-  return (closest_on_triangle(c, t.a, t.b, t.c) - c).norm() <= s.r;
+  return (closest_point_on_triangle(c, t.a, t.b, t.c) - c).norm() <= s.r;
 }
 
 bool is_ancestor_or_self(const std::vector<int32_t>& parent, int anc, int node) {

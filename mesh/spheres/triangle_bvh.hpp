@@ -9,12 +9,6 @@
 
 namespace icd::mesh {
 
-/// Closest point of the triangle (a, b, c) to p (Ericson, Real-Time
-/// Collision Detection, sec. 5.1.5: Voronoi regions of the vertices, edges
-/// and face). Degenerate triangles are handled (the result lies on them).
-Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c);
-
 /// Static BVH over the triangles F (#F x 3) of V (#V x 3): median splits
 /// along the longest box axis, at most 4 triangles per leaf. Queries visit
 /// the nearer child first and skip boxes farther than the best distance so

@@ -8,11 +8,12 @@
 
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
+#include "mesh/io/triangle_geometry.hpp"
 #include "mesh/spheres/triangle_bvh.hpp"
 
 namespace {
 
-using icd::mesh::closest_point_on_triangle;
+using icd::closest_point_on_triangle;
 using icd::mesh::TriangleBvh;
 
 /// Nearest of a dense barycentric lattice on the triangle (brute force).
