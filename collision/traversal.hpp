@@ -82,7 +82,9 @@ struct CollisionResult {
   std::vector<NodePair> colliding;  ///< COLLISIONLIST: overlapping leaf pairs
   /// Pairs not refined to leaves, assumed colliding: PAIRLIST at interruption
   /// (in the fast path these were found overlapping but not yet split; in the
-  /// literal mode they are untested), plus pairs held back by depth_cap or
+  /// literal mode they are untested), the children pairs of a node whose
+  /// children were being tested one by one when the budget ran out (not
+  /// tested: they need not overlap), plus pairs held back by depth_cap or
   /// max_list_size.
   std::vector<NodePair> untested;
   /// If requested: a cut of the pair tree (pruned pairs + colliding + untested)

@@ -30,17 +30,10 @@
 namespace fs = std::filesystem;
 using namespace icd;
 using namespace icd::runner;
+using experiments::median;
+using experiments::seconds_since;
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
 
 double bbox_diagonal(const MatX3d& V) {
   return (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
@@ -143,7 +136,7 @@ int main(int argc, char** argv) {
     else if (a == "--resolution-scene" && i + 1 < argc) res_path = argv[++i];
     else if (a == "--cells" && i + 1 < argc) cells_text = argv[++i];
     else if (a == "--fine" && i + 1 < argc) fine = std::stoi(argv[++i]);
-    else if (a == "--frames" && i + 1 < argc) frames = std::stoi(argv[++i]);
+    else if (a == "--frames" && i + 1 < argc) frames = std::max(1, std::stoi(argv[++i]));
     else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::stoi(argv[++i]));
     else {
       usage();

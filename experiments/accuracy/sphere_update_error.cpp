@@ -32,17 +32,10 @@
 namespace fs = std::filesystem;
 using namespace icd;
 using namespace icd::runner;
+using experiments::median;
+using experiments::seconds_since;
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 // Volume enclosed by a closed, outward-oriented triangle mesh (divergence theorem).
 double enclosed_volume(const MatX3d& V, const MatX3i& F) {
@@ -75,7 +68,7 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc) out = argv[++i];
     else if (a == "--scene" && i + 1 < argc) scene_path = argv[++i];
-    else if (a == "--frames" && i + 1 < argc) frames = std::stoi(argv[++i]);
+    else if (a == "--frames" && i + 1 < argc) frames = std::max(1, std::stoi(argv[++i]));
     else if (a == "--every" && i + 1 < argc) every = std::max(1, std::stoi(argv[++i]));
     else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::stoi(argv[++i]));
     else {

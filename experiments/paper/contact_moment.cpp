@@ -1,5 +1,7 @@
 #include "experiments/paper/contact_moment.hpp"
 
+#include <algorithm>
+#include <cassert>
 #include <sstream>
 
 #include "coupling/rigid_links.hpp"
@@ -22,6 +24,17 @@ MatX3d dense_positions(const runner::RuntimeObject& o) {
   MatX3d dense(o.asset.dense.V.rows(), 3);
   coupling::apply(o.asset.links, o.positions, dense);
   return dense;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double median(std::vector<double> v) {
+  assert(!v.empty());
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
 }
 
 std::vector<double> parse_list(const std::string& text, const char* what) {

@@ -1,7 +1,9 @@
 #pragma once
 /// Helpers shared by the paper and accuracy experiments: taking a scene run
 /// to "the same moment of contact" (as table1 does), dense positions through
-/// the rigid links, and small command-line parsing helpers.
+/// the rigid links, small command-line parsing helpers, and
+/// the timing helpers of the error-against-run-time experiments.
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -25,6 +27,13 @@ ContactMoment run_to_contact(runner::World& world, int max_frames, int after, do
 /// Dense positions of object `o` (#N x 3) from its current coarse positions
 /// through the rigid links (Eqs. 1, 9, 10).
 MatX3d dense_positions(const runner::RuntimeObject& o);
+
+/// Wall seconds elapsed since `t0` (steady clock).
+double seconds_since(std::chrono::steady_clock::time_point t0);
+
+/// The upper median of `v` (the element at index size/2 once sorted).
+/// Precondition: `v` is not empty.
+double median(std::vector<double> v);
 
 /// Parses "a,b,c" into doubles; throws ParameterError naming `what` on a bad entry.
 std::vector<double> parse_list(const std::string& text, const char* what);

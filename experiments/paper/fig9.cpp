@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "experiments/paper/contact_moment.hpp"
+#include "experiments/runner/run.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/atomic_write.hpp"
 #include "mesh/io/error.hpp"
@@ -29,33 +30,6 @@ void usage() {
       "usage: fig9 [--out DIR] [--scene FILE] [--budgets a,b,...] [--max-frames N] [--after N]\n"
       "  Default: experiments/scenes/bunny_dragon.json, critical times 1e-4,1e-3,1e-2,1e-1 s,\n"
       "  3 frames after first contact (uninterrupted run). Writes DIR/budget_<t>/*.vtu and DIR/manifest.csv.\n");
-}
-
-// The spheres of one side (0: object i, 1: object j) of pair p used for the response.
-void write_contact_spheres(World& world, size_t p, int side, const fs::path& path) {
-  const auto [i, j] = world.plan().pairs[p];
-  const collision::CollisionResult& r = world.results()[p];
-  const collision::SphereTree& tree = world.objects()[side ? j : i].asset.spheres;
-  std::vector<int> ids;
-  std::vector<double> leaf;
-  for (const auto* list : {&r.colliding, &r.untested})
-    for (const collision::NodePair& np : *list) {
-      ids.push_back(side ? np.b : np.a);
-      leaf.push_back(list == &r.colliding ? 1.0 : 0.0);
-    }
-  const auto n = static_cast<Eigen::Index>(ids.size());
-  SphereSet set{MatX3d(n, 3), Eigen::VectorXd(n)};
-  PointDataArray level{"level", Eigen::MatrixXd(n, 1)};
-  PointDataArray colliding{"colliding_leaf", Eigen::MatrixXd(n, 1)};
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const collision::Sphere& sp = tree.spheres[ids[k]];
-    set.centers.row(k) << sp.x, sp.y, sp.z;
-    set.radii[k] = sp.r;
-    level.values(k, 0) = tree.level[ids[k]];
-    colliding.values(k, 0) = leaf[k];
-  }
-  const PointDataArray arrays[] = {level, colliding};
-  write_vtu_sphere_set(path, set, arrays);
 }
 
 }  // namespace

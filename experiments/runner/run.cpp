@@ -41,32 +41,10 @@ void write_frame_vtu(World& world, int frame, const std::filesystem::path& dir,
     // The spheres used for the contact response: colliding and untested pairs.
     for (size_t p = 0; p < world.plan().pairs.size(); ++p) {
       const auto [i, j] = world.plan().pairs[p];
-      const collision::CollisionResult& r = world.results()[p];
       for (int side = 0; side < 2; ++side) {
-        const collision::SphereTree& tree = objects[side ? j : i].asset.spheres;
-        std::vector<int> ids;
-        std::vector<double> leaf;
-        for (const auto* list : {&r.colliding, &r.untested})
-          for (const collision::NodePair& np : *list) {
-            ids.push_back(side ? np.b : np.a);
-            leaf.push_back(list == &r.colliding ? 1.0 : 0.0);
-          }
-        SphereSet set;
-        set.centers.resize(static_cast<Eigen::Index>(ids.size()), 3);
-        set.radii.resize(static_cast<Eigen::Index>(ids.size()));
-        PointDataArray level{"level", Eigen::MatrixXd(ids.size(), 1)};
-        PointDataArray colliding{"colliding_leaf", Eigen::MatrixXd(ids.size(), 1)};
-        for (size_t k = 0; k < ids.size(); ++k) {
-          const collision::Sphere& sp = tree.spheres[ids[k]];
-          set.centers.row(k) << sp.x, sp.y, sp.z;
-          set.radii[k] = sp.r;
-          level.values(k, 0) = tree.level[ids[k]];
-          colliding.values(k, 0) = leaf[k];
-        }
         const std::string name = objects[side ? j : i].spec.name + "_contact_spheres_pair" +
                                  std::to_string(p) + suffix;
-        const PointDataArray arrays[] = {level, colliding};
-        write_vtu_sphere_set(dir / name, set, arrays);
+        write_contact_spheres(world, p, side, dir / name);
         series[s].push_back({t, name});
         ++s;
       }
@@ -81,6 +59,32 @@ std::string format_duration(double s) {
 }
 
 }  // namespace
+
+void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path) {
+  const auto [i, j] = world.plan().pairs[pair];
+  const collision::CollisionResult& r = world.results()[pair];
+  const collision::SphereTree& tree = world.objects()[side ? j : i].asset.spheres;
+  std::vector<int> ids;
+  std::vector<double> leaf;
+  for (const auto* list : {&r.colliding, &r.untested})
+    for (const collision::NodePair& np : *list) {
+      ids.push_back(side ? np.b : np.a);
+      leaf.push_back(list == &r.colliding ? 1.0 : 0.0);
+    }
+  const auto n = static_cast<Eigen::Index>(ids.size());
+  SphereSet set{MatX3d(n, 3), Eigen::VectorXd(n)};
+  PointDataArray level{"level", Eigen::MatrixXd(n, 1)};
+  PointDataArray colliding{"colliding_leaf", Eigen::MatrixXd(n, 1)};
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const collision::Sphere& sp = tree.spheres[ids[static_cast<size_t>(k)]];
+    set.centers.row(k) << sp.x, sp.y, sp.z;
+    set.radii[k] = sp.r;
+    level.values(k, 0) = tree.level[ids[static_cast<size_t>(k)]];
+    colliding.values(k, 0) = leaf[static_cast<size_t>(k)];
+  }
+  const PointDataArray arrays[] = {level, colliding};
+  write_vtu_sphere_set(path, set, arrays);
+}
 
 std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
   std::ostringstream csv;

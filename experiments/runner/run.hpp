@@ -27,6 +27,14 @@ struct RunOptions {
 /// metrics of every frame. Throws on any error (after removing partial files).
 std::vector<FrameMetrics> run_scene(const Scene& scene, const RunOptions& options);
 
+/// Writes, as a VTU sphere set at `path`, the spheres of one side of
+/// collision pair `pair` (side 0: the pair's first object, 1: its second)
+/// that the last query used for the contact response: the colliding leaf
+/// pairs' spheres and the untested pairs' spheres (paper 4.3, Fig. 9), with
+/// point arrays "level" (tree level) and "colliding_leaf" (1: from a
+/// colliding leaf pair, 0: from an untested pair).
+void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path);
+
 /// The per-frame CSV (header + one row per frame).
 std::string metrics_csv(const std::vector<FrameMetrics>& frames);
 
