@@ -249,7 +249,7 @@ void ElasticForces::compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d
     compute_impl<false>(x, f);
     return;
   }
-  compute_fast<false>(x, f, nullptr);
+  compute_fast<lanes::LaneCheck::None>(x, f, nullptr);
 }
 
 ElementHealth ElasticForces::compute_with_health(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
@@ -260,13 +260,28 @@ ElementHealth ElasticForces::compute_with_health(const Eigen::Ref<const MatX3d>&
     return health(x);
   }
   ElementHealth h;
-  compute_fast<true>(x, f, &h);
+  compute_fast<lanes::LaneCheck::Full>(x, f, &h);
   return h;
 }
 
+bool ElasticForces::compute_with_orientation_check(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
+  check_shape(x, "positions");
+  check_shape(f, "forces");
+  if (x.outerStride() != 3 || f.outerStride() != 3) {
+    compute_impl<false>(x, f);
+    const ElementHealth h = health(x);
+    return h.min_det_f > 0;  // NaN compares false
+  }
+  bool oriented = true;
+  compute_fast<lanes::LaneCheck::Orientation>(x, f, nullptr, &oriented);
+  return oriented;
+}
 
-template <bool kHealth>
-void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health) {
+template <lanes::LaneCheck kCheck>
+void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health,
+                                 bool* oriented) {
+  constexpr bool kHealth = kCheck == lanes::LaneCheck::Full;
+  constexpr bool kOrientation = kCheck == lanes::LaneCheck::Orientation;
   // The hot path: 8-lane SoA kernels (lane_kernels.hpp) or, for corotational,
   // scalar kernels (element_kernels.hpp); one instantiation per model.
   const double* xp = x.data();
@@ -301,7 +316,7 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
       const lanes::LaneLoopInput in = lane_input(xp, fp);
       for_chunks([&](int begin, int end) {
         lanes::LaneRangeHealth rh;
-        lanes::force_range<kModel, kHealth>(in, begin, end, &rh);
+        lanes::force_range<kModel, kCheck>(in, begin, end, &rh);
         if constexpr (kHealth) {
           ChunkHealth ch;
           ch.min_det = rh.min_det;
@@ -309,6 +324,7 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
           ch.nonfinite = std::isfinite(rh.energy) ? -1 : begin;  // located by health() on failure
           chunk_health[begin / kChunk] = ch;
         }
+        if constexpr (kOrientation) chunk_health[begin / kChunk].oriented = rh.oriented;
         return rh.energy;
       });
       return;
@@ -330,6 +346,7 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
           }
           sum += vol[e] * kernels::corotational_energy(F, R, mu, lambda);
         }
+        if constexpr (kOrientation) ch.oriented = ch.oriented && kernels::determinant(F) > 0;
         kernels::nodal_forces(P, D, vol[e], H);
         double out[12];
         for (int r = 0; r < 3; ++r) {
@@ -344,6 +361,7 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
         ch.nonfinite = std::isfinite(sum) ? -1 : begin;
         chunk_health[begin / kChunk] = ch;
       }
+      if constexpr (kOrientation) chunk_health[begin / kChunk].oriented = ch.oriented;
       return sum;
     });
   };
@@ -373,6 +391,11 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
     }
     // A NaN/Inf somewhere (a failing state): the separate pass names the first element exactly.
     if (nonfinite || !std::isfinite(h.energy)) h = this->health(x);
+  }
+  if constexpr (kOrientation) {
+    bool all = true;
+    for (size_t c = 0; c < m_chunk_sum.size(); ++c) all = all && m_chunk_health[c].oriented;
+    *oriented = all;
   }
 }
 

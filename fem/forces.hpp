@@ -15,6 +15,7 @@
 namespace icd::fem {
 namespace lanes {
 struct LaneLoopInput;
+enum class LaneCheck;
 }
 
 /// Options of the element loops.
@@ -58,6 +59,12 @@ class ElasticForces {
   /// count); where an energy is not finite, health(x) itself (naming the first
   /// such element). Costs a fraction of a second pass.
   ElementHealth compute_with_health(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
+  /// Same as compute() and, from the same pass over the elements, whether
+  /// every element keeps its orientation: true iff det F > 0 for all elements
+  /// (false where one is <= 0 or not finite, i.e. NaN). The cheap part of
+  /// compute_with_health() (no energy, no smallest det F or its element):
+  /// ~1 ns/tet with the AVX2 lane loops; the element is named by health().
+  bool compute_with_orientation_check(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
   /// Same as compute() and returns the elastic energy W(x) = sum_e V_e psi(F_e), J.
   double compute_with_energy(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
   /// Elastic energy W(x), J.
@@ -82,12 +89,15 @@ class ElasticForces {
   /// Lane-loop input at positions x: element forces go to `forces` directly
   /// with one thread, else to the per-element scratch for gather().
   lanes::LaneLoopInput lane_input(const double* x, double* forces);
-  template <bool kHealth>
-  void compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health);
+  /// kCheck None: forces only; Full: *health; Orientation: *oriented.
+  template <lanes::LaneCheck kCheck>
+  void compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health,
+                    bool* oriented = nullptr);
   struct ChunkHealth {
     double min_det = std::numeric_limits<double>::infinity();
     int min_element = -1;
     int nonfinite = -1;
+    bool oriented = true;  ///< every det F > 0 (Orientation checks)
   };
 
   TetMeshData m_mesh;

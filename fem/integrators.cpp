@@ -136,7 +136,7 @@ void ExplicitStepper::symplectic_euler(Model& model, const State& in, State& out
   const int n = model.num_nodes();
   resize(n);
   fit(out, n);
-  model.element_forces(in.x, in.v, m_a, extras.health, extras.elastic);
+  model.element_forces(in.x, in.v, m_a, extras.health, extras.elastic, extras.oriented);
   if (extras.energies)
     *extras.energies =
         symplectic_euler_nodes<true>(model, in.x.data(), in.v.data(), m_a.data(), h, out.x.data(), out.v.data());
@@ -168,7 +168,7 @@ void ExplicitStepper::rk4(Model& model, const State& in, State& out, double h, c
   double *X = m_x.data(), *V = m_v.data(), *dx = m_dx.data(), *dv = m_dv.data();
   const double hh = 0.5 * h;
   // k1 at y; stage point y + h/2 k1.
-  model.acceleration(in.x, in.v, m_a, extras.health, extras.elastic);
+  model.acceleration(in.x, in.v, m_a, extras.health, extras.elastic, extras.oriented);
   if (extras.energies) *extras.energies = state_energies(model, in);
   for (long k = 0; k < m; ++k) {
     dx[k] = v[k];

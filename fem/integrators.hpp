@@ -45,6 +45,10 @@ struct StepExtras {
   /// In: f_int(in.x) (#V x 3, N) computed before (a health check at in.x):
   /// used instead of the first force evaluation. Not with `health`.
   const MatX3d* elastic = nullptr;
+  /// Out: whether every element of in.x has det F > 0 (false where one is
+  /// <= 0 or NaN), from the element pass of the first force evaluation: the
+  /// cheap alternative to `health` (not with `health` or `elastic`).
+  bool* oriented = nullptr;
 };
 
 /// Explicit steppers with their scratch buffers (no allocation per step once

@@ -18,13 +18,21 @@ struct Block {
   double volume[kLanes];
 };
 
+/// What a block's force evaluation also computes for a health check.
+enum class LaneCheck {
+  None,
+  Full,        ///< energy density psi and det F of every lane
+  Orientation  ///< det F of every lane only (inversion and NaN test)
+};
+
 /// Forces of the elements of one block. x: positions (#V x 3 row-major);
 /// tets: the block's first tet (4 indices each); count <= 8 valid lanes.
 /// Writes out[e][12] (nodal forces of node 0..3) for the valid lanes.
-/// kHealth: also writes the energy density psi[l] (J/m^3) and det F det[l] of
-/// every lane, with the same operations as kernels::*_energy and
-/// kernels::determinant (bitwise equal to ElasticForces::health()).
-template <MaterialModel kModel, bool kHealth = false>
+/// kCheck Full: also writes the energy density psi[l] (J/m^3) and det F det[l]
+/// of every lane, with the same operations as kernels::*_energy and
+/// kernels::determinant (bitwise equal to ElasticForces::health());
+/// Orientation: det[l] only (psi untouched, may be null).
+template <MaterialModel kModel, LaneCheck kCheck = LaneCheck::None>
 [[gnu::always_inline]] inline void block_forces(const double* x, const int* tets, int count, const Block& b, double mu, double lambda,
                          double (*out)[12], double* psi = nullptr, double* det = nullptr) {
   double d[9][kLanes];
@@ -49,7 +57,8 @@ template <MaterialModel kModel, bool kHealth = false>
       for (int l = 0; l < kLanes; ++l)
         F[3 * r + c][l] = d[3 * r][l] * b.dinv[3 * c][l] + d[3 * r + 1][l] * b.dinv[1 + 3 * c][l] +
                           d[3 * r + 2][l] * b.dinv[2 + 3 * c][l];
-  if constexpr (kHealth) {
+  constexpr bool kHealth = kCheck == LaneCheck::Full;
+  if constexpr (kCheck != LaneCheck::None) {
     // det F: here for linear and stable Neo-Hookean; StVK computes
     // it in its strain loop below, where F is already in registers (measured
     // ~2.5 ns/tet cheaper with AVX2 than this separate pass).
@@ -57,7 +66,7 @@ template <MaterialModel kModel, bool kHealth = false>
       for (int l = 0; l < kLanes; ++l)
         det[l] = F[0][l] * (F[4][l] * F[8][l] - F[5][l] * F[7][l]) -
                  F[1][l] * (F[3][l] * F[8][l] - F[5][l] * F[6][l]) + F[2][l] * (F[3][l] * F[7][l] - F[4][l] * F[6][l]);
-    if constexpr (kModel == MaterialModel::Linear) {
+    if constexpr (kModel == MaterialModel::Linear && kHealth) {
       for (int l = 0; l < kLanes; ++l) {
         double sq = 0;
         for (int r = 0; r < 3; ++r)
@@ -68,7 +77,7 @@ template <MaterialModel kModel, bool kHealth = false>
         const double tr = F[0][l] + F[4][l] + F[8][l] - 3.0;
         psi[l] = mu * sq + 0.5 * lambda * tr * tr;
       }
-    } else if constexpr (kModel == MaterialModel::StableNeoHookean) {
+    } else if constexpr (kModel == MaterialModel::StableNeoHookean && kHealth) {
       for (int l = 0; l < kLanes; ++l) {
         double ic = 0;
         for (int k = 0; k < 9; ++k) ic += F[k][l] * F[k][l];
@@ -104,6 +113,8 @@ template <MaterialModel kModel, bool kHealth = false>
         const double sq = (E[0] * E[0] + E[4] * E[4] + E[8] * E[8]) + 2.0 * (E[1] * E[1] + E[2] * E[2] + E[5] * E[5]);
         const double tr = E[0] + E[4] + E[8];
         psi[l] = mu * sq + 0.5 * lambda * tr * tr;
+      }
+      if constexpr (kCheck != LaneCheck::None) {
         det[l] = F[0][l] * (F[4][l] * F[8][l] - F[5][l] * F[7][l]) -
                  F[1][l] * (F[3][l] * F[8][l] - F[5][l] * F[6][l]) + F[2][l] * (F[3][l] * F[7][l] - F[4][l] * F[6][l]);
       }

@@ -100,24 +100,60 @@ struct LaneHealth {
   }
 };
 
-template <MaterialModel kModel, bool kHealth>
+// The orientation test of a range of elements: per lane, a mask that stays
+// all ones while every det F seen is > 0 (a compare and an AND per block, no
+// branch, no minimum, no element index; NaN compares false).
+struct LaneOrientation {
+  typedef double Vec2 __attribute__((vector_size(16)));
+  typedef long long Mask2 __attribute__((vector_size(16)));
+  static constexpr int kVectors = kLanes / 2;
+  Mask2 ok[kVectors];
+
+  LaneOrientation() {
+    for (int k = 0; k < kVectors; ++k) ok[k] = Mask2{-1, -1};
+  }
+  [[gnu::always_inline]] void add_full(const double* det) {
+    const Vec2 zero{0.0, 0.0};
+    for (int k = 0; k < kVectors; ++k) {
+      Vec2 d;
+      std::memcpy(&d, det + 2 * k, sizeof d);
+      ok[k] &= d > zero;
+    }
+  }
+  // The first `count` lanes of a block (padding lanes have det F = 0).
+  void add_partial(int count, const double* det) {
+    for (int l = 0; l < count; ++l)
+      if (!(det[l] > 0.0)) ok[l / 2][l % 2] = 0;
+  }
+  bool result() const {
+    bool all = true;
+    for (int k = 0; k < kVectors; ++k) all = all && ok[k][0] != 0 && ok[k][1] != 0;
+    return all;
+  }
+};
+
+template <MaterialModel kModel, LaneCheck kCheck>
 [[gnu::always_inline]] inline void force_body(const LaneLoopInput& in, int begin, int end,
                                               LaneRangeHealth* health) {
   LaneHealth lane_health;
+  LaneOrientation lane_orientation;
   for (int e0 = begin; e0 < end; e0 += kLanes) {
     const int count = end - e0 < kLanes ? end - e0 : kLanes;
     const Block& block = in.blocks[e0 / kLanes];
     double out[kLanes][12];
     double psi[kLanes], det[kLanes];
-    block_forces<kModel, kHealth>(in.x, in.tets + 4 * e0, count, block, in.mu, in.lambda, out, psi,
-                                  det);
-    if constexpr (kHealth) {
+    block_forces<kModel, kCheck>(in.x, in.tets + 4 * e0, count, block, in.mu, in.lambda, out, psi, det);
+    if constexpr (kCheck == LaneCheck::Full) {
       if (count == kLanes) lane_health.add_full(e0, block.volume, psi, det);
       else lane_health.add_partial(e0, count, block.volume, psi, det);
+    } else if constexpr (kCheck == LaneCheck::Orientation) {
+      if (count == kLanes) lane_orientation.add_full(det);
+      else lane_orientation.add_partial(count, det);
     }
     for (int l = 0; l < count; ++l) scatter(in, e0 + l, out[l]);
   }
-  if constexpr (kHealth) *health = lane_health.result();
+  if constexpr (kCheck == LaneCheck::Full) *health = lane_health.result();
+  if constexpr (kCheck == LaneCheck::Orientation) health->oriented = lane_orientation.result();
 }
 
 template <MaterialModel kModel>
@@ -132,9 +168,9 @@ template <MaterialModel kModel>
   }
 }
 
-template <MaterialModel kModel, bool kHealth>
+template <MaterialModel kModel, LaneCheck kCheck>
 void force_baseline(const LaneLoopInput& in, int begin, int end, LaneRangeHealth* health) {
-  force_body<kModel, kHealth>(in, begin, end, health);
+  force_body<kModel, kCheck>(in, begin, end, health);
 }
 template <MaterialModel kModel>
 void differential_baseline(const LaneLoopInput& in, const double* dx, int begin, int end) {
@@ -142,10 +178,10 @@ void differential_baseline(const LaneLoopInput& in, const double* dx, int begin,
 }
 
 #if ICD_FEM_HAVE_AVX2_LOOPS
-template <MaterialModel kModel, bool kHealth>
+template <MaterialModel kModel, LaneCheck kCheck>
 __attribute__((target("avx2"))) void force_avx2(const LaneLoopInput& in, int begin, int end,
                                                 LaneRangeHealth* health) {
-  force_body<kModel, kHealth>(in, begin, end, health);
+  force_body<kModel, kCheck>(in, begin, end, health);
 }
 template <MaterialModel kModel>
 __attribute__((target("avx2"))) void differential_avx2(const LaneLoopInput& in, const double* dx,
@@ -166,12 +202,12 @@ bool set_lane_isa(LaneIsa isa) {
 
 const char* to_string(LaneIsa isa) { return isa == LaneIsa::AVX2 ? "avx2" : "baseline"; }
 
-template <MaterialModel kModel, bool kHealth>
+template <MaterialModel kModel, LaneCheck kCheck>
 void force_range(const LaneLoopInput& in, int begin, int end, LaneRangeHealth* health) {
 #if ICD_FEM_HAVE_AVX2_LOOPS
-  if (g_isa == LaneIsa::AVX2) return force_avx2<kModel, kHealth>(in, begin, end, health);
+  if (g_isa == LaneIsa::AVX2) return force_avx2<kModel, kCheck>(in, begin, end, health);
 #endif
-  force_baseline<kModel, kHealth>(in, begin, end, health);
+  force_baseline<kModel, kCheck>(in, begin, end, health);
 }
 
 template <MaterialModel kModel>
@@ -182,11 +218,11 @@ void differential_range(const LaneLoopInput& in, const double* dx, int begin, in
   differential_baseline<kModel>(in, dx, begin, end);
 }
 
-#define ICD_FEM_LANE_INSTANTIATE(M)                                                  \
-  template void force_range<MaterialModel::M, false>(const LaneLoopInput&, int, int, \
-                                                     LaneRangeHealth*);              \
-  template void force_range<MaterialModel::M, true>(const LaneLoopInput&, int, int,  \
-                                                    LaneRangeHealth*);               \
+#define ICD_FEM_LANE_INSTANTIATE(M)                                                                           \
+  template void force_range<MaterialModel::M, LaneCheck::None>(const LaneLoopInput&, int, int, LaneRangeHealth*); \
+  template void force_range<MaterialModel::M, LaneCheck::Full>(const LaneLoopInput&, int, int, LaneRangeHealth*); \
+  template void force_range<MaterialModel::M, LaneCheck::Orientation>(const LaneLoopInput&, int, int,             \
+                                                                       LaneRangeHealth*);                         \
   template void differential_range<MaterialModel::M>(const LaneLoopInput&, const double*, int, int);
 ICD_FEM_LANE_INSTANTIATE(Linear)
 ICD_FEM_LANE_INSTANTIATE(StVK)

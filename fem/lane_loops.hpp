@@ -35,17 +35,21 @@ struct LaneLoopInput {
   double* element_forces = nullptr;
 };
 
-/// Energy and smallest det F of a range of elements (kHealth loops).
+/// Health of a range of elements from the force loops (LaneCheck Full:
+/// energy, min_det and min_element; Orientation: oriented only).
 struct LaneRangeHealth {
   double energy = 0;     ///< sum V_e psi_e, in lane order (deterministic), J
   double min_det = 0;    ///< smallest det F (+inf for an empty range)
   int min_element = -1;  ///< its element (the smallest index on ties)
+  /// Orientation: true iff det F > 0 for every element of the range (false
+  /// where one is <= 0 or NaN).
+  bool oriented = true;
 };
 
 /// Elastic forces of elements [begin, end) (begin a multiple of kLanes) of a
-/// Linear, StVK or StableNeoHookean mesh; with kHealth also their energy and
-/// smallest det F. Bitwise equal for either LaneIsa.
-template <MaterialModel kModel, bool kHealth>
+/// Linear, StVK or StableNeoHookean mesh; with kCheck also their health
+/// (LaneRangeHealth). Bitwise equal for either LaneIsa.
+template <MaterialModel kModel, LaneCheck kCheck>
 void force_range(const LaneLoopInput& in, int begin, int end, LaneRangeHealth* health);
 
 /// Force differentials -K(x) dx of elements [begin, end) (dx #V x 3 row-major), written like

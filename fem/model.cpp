@@ -113,12 +113,15 @@ void Model::total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<cons
 }
 
 void Model::element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                           Eigen::Ref<MatX3d> f, ElementHealth* health, const MatX3d* elastic) {
+                           Eigen::Ref<MatX3d> f, ElementHealth* health, const MatX3d* elastic, bool* oriented) {
   if (elastic) {
-    assert(!health && elastic->rows() == num_nodes());
+    assert(!health && !oriented && elastic->rows() == num_nodes());
     f = *elastic;
   } else if (health) {
+    assert(!oriented);
     *health = m_forces.compute_with_health(x, f);
+  } else if (oriented) {
+    *oriented = m_forces.compute_with_orientation_check(x, f);
   } else {
     m_forces.compute(x, f);
   }
@@ -130,8 +133,8 @@ void Model::element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<c
 }
 
 void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                         Eigen::Ref<MatX3d> a, ElementHealth* health, const MatX3d* elastic) {
-  element_forces(x, v, a, health, elastic);
+                         Eigen::Ref<MatX3d> a, ElementHealth* health, const MatX3d* elastic, bool* oriented) {
+  element_forces(x, v, a, health, elastic, oriented);
   const int n = num_nodes();
   const double alpha = m_damping.alpha;
   const double* load = m_load.data();

@@ -72,16 +72,22 @@ class Model {
   /// one pass over the nodes after the element loop. health (optional): the
   /// health of x from the same element pass (ElasticForces::compute_with_health).
   /// elastic (optional): f_int(x) already computed, see element_forces().
+  /// oriented (optional): see element_forces().
   void acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                    Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr);
+                    Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr,
+                    bool* oriented = nullptr);
   /// The element part of total_force (#V x 3, N, overwritten): f_int(x) - beta
   /// K(x) v + the strain-rate damping force, at every node (fixed ones
   /// included); the nodal part, loads() - alpha m v at free nodes, is left to
   /// the caller's node pass (acceleration() and the fused integrator passes).
   /// elastic (optional): f_int(x) already computed (e.g. by a health check at
   /// x), used instead of a force evaluation. health: as in acceleration().
+  /// oriented (optional, not with health or elastic): whether every det F of
+  /// x is > 0, from the same element pass
+  /// (ElasticForces::compute_with_orientation_check).
   void element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                      Eigen::Ref<MatX3d> f, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr);
+                      Eigen::Ref<MatX3d> f, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr,
+                      bool* oriented = nullptr);
   /// Conservative nodal loads f_ext + m g at free nodes, 0 at fixed ones (#V x 3), N.
   const MatX3d& loads() const { return m_load; }
   /// 1 / lumped mass per node (#V), 1/kg.

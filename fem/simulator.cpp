@@ -122,26 +122,75 @@ std::string Simulator::integrate(double h, const StepExtras& extras) {
   return {};
 }
 
+Simulator::Check Simulator::nonfinite_state(const State& s) const {
+  Check c;
+  c.ok = false;
+  const int n = m_model.num_nodes();
+  for (int i = 0; i < n; ++i)
+    if (!s.x.row(i).allFinite() || !s.v.row(i).allFinite()) {
+      std::ostringstream os;
+      os << "node " << i << " has a non-finite state: x = (" << s.x.row(i) << "), v = (" << s.v.row(i) << ")";
+      c.message = os.str();
+      return c;
+    }
+  c.message = "the kinetic energy or the load potential overflows";
+  return c;
+}
+
+bool Simulator::bound_checks() const {
+  if (m_options.integrator == Integrator::BackwardEuler || m_options.energy_check == EnergyCheck::Full) return false;
+  const MaterialModel mm = m_model.material().model;
+  const bool nonnegative_energy =
+      mm == MaterialModel::Linear || mm == MaterialModel::Corotational || mm == MaterialModel::StVK;
+  return nonnegative_energy && m_options.inversion != InversionPolicy::Allow;  // Auto: inversion checked for these
+}
+
+Simulator::Check Simulator::evaluate_bound(const Check& before, const State& s, const StateEnergies& energies,
+                                           bool oriented) {
+  // Every entry of x and v enters the energy sums (0 * NaN = NaN): finite sums, finite state.
+  if (!std::isfinite(energies.kinetic) || !std::isfinite(energies.load)) return nonfinite_state(s);
+  Check c;
+  c.kinetic = energies.kinetic;
+  c.load = energies.load;
+  if (!oriented) {
+    // Rare (a failing state): the separate health pass names the element.
+    const ElementHealth h = m_model.elastic().health(s.x);
+    const int e = h.first_nonfinite_element >= 0 ? h.first_nonfinite_element : h.min_det_f_element;
+    std::ostringstream os;
+    if (e >= 0)
+      os << "element " << e << " (nodes " << m_model.mesh().tets.row(e) << ") "
+         << (h.first_nonfinite_element >= 0 ? "has a non-finite energy" : "is inverted")
+         << ": det F = " << m_model.mesh().deformation_gradient(s.x, e).determinant();
+    else
+      os << "an element has det F <= 0 or NaN";
+    c.ok = false;
+    c.message = os.str();
+    return c;
+  }
+  // The elastic energy of s is >= 0 (bound_checks()): KE + load potential
+  // alone growing past the allowance fails the full check too.
+  const double growth = c.kinetic - (before.kinetic + before.elastic) + (c.load - before.load);
+  const double allowed = m_options.max_energy_growth *
+                             (before.kinetic + before.elastic + std::abs(c.load - before.load)) +
+                         m_energy_floor;
+  if (!(growth <= allowed)) {
+    std::ostringstream os;
+    os << "total energy grew by at least " << growth << " J (allowed " << allowed << " J): kinetic "
+       << before.kinetic << " -> " << c.kinetic << " J, elastic " << before.elastic
+       << " -> >= 0 J, load potential " << before.load << " -> " << c.load << " J";
+    c.ok = false;
+    c.message = os.str();
+  }
+  return c;
+}
+
 Simulator::Check Simulator::evaluate(const Check& before, const State& s, const StateEnergies& energies,
                                      const ElementHealth& h) const {
   Check c;
   c.kinetic = energies.kinetic;
   c.load = energies.load;
   // Every entry of x and v enters these sums (0 * NaN = NaN): finite sums, finite state.
-  if (!std::isfinite(c.kinetic) || !std::isfinite(c.load)) {
-    const int n = m_model.num_nodes();
-    for (int i = 0; i < n; ++i)
-      if (!s.x.row(i).allFinite() || !s.v.row(i).allFinite()) {
-        std::ostringstream os;
-        os << "node " << i << " has a non-finite state: x = (" << s.x.row(i) << "), v = (" << s.v.row(i) << ")";
-        c.ok = false;
-        c.message = os.str();
-        return c;
-      }
-    c.ok = false;
-    c.message = "the kinetic energy or the load potential overflows";
-    return c;
-  }
+  if (!std::isfinite(c.kinetic) || !std::isfinite(c.load)) return nonfinite_state(s);
   const bool allow_inversion =
       m_options.inversion == InversionPolicy::Allow ||
       (m_options.inversion == InversionPolicy::Auto && m_model.material().model == MaterialModel::StableNeoHookean);
@@ -189,6 +238,10 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
   // call's estimate and first step use. Buffers rotate: m_good (last checked
   // state), m_state (current), m_next (step output).
   const bool fused = m_options.integrator != Integrator::BackwardEuler;
+  // EnergyCheck::Bound: the checks inside the frame compare against the
+  // last full check (`before` and m_good stay at that state) and a failure
+  // rolls back to it; the full check at the call's end updates both.
+  const bool bound = bound_checks();
   m_good = m_state;
   double t_good = 0, t = 0;
   Check before;
@@ -261,10 +314,12 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
     hh = (total - t) / std::max(remaining, 1);
     ElementHealth health;
     StateEnergies energies;
+    bool oriented = true;
     const bool check_now = pending;
     StepExtras extras;
     if (check_now) {
-      extras.health = &health;
+      if (bound) extras.oriented = &oriented;
+      else extras.health = &health;
       extras.energies = &energies;
     } else if (start_force) {
       extras.elastic = start_force;  // only at the call's start state, never due a check
@@ -273,15 +328,18 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
     const std::string step_failure = integrate(hh, extras);
     if (check_now) {
       pending = false;
-      const Check c = evaluate(before, m_state, energies, health);
+      const Check c = bound ? evaluate_bound(before, m_state, energies, oriented)
+                            : evaluate(before, m_state, energies, health);
       if (!c.ok) {
         reject(c);  // the step just taken from the bad state is discarded
         continue;
       }
-      before = c;
-      swap_states(m_good, m_state);
-      t_good = t;
-      steps_good = steps;
+      if (!bound) {
+        before = c;
+        swap_states(m_good, m_state);
+        t_good = t;
+        steps_good = steps;
+      }
     }
     swap_states(m_state, m_next);
     ++steps;

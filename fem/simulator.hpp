@@ -17,6 +17,23 @@ enum class InversionPolicy {
   Fail
 };
 
+/// How the health checks inside a frame test the energy growth (the last
+/// state of every advance()/step() call always takes the full check).
+enum class EnergyCheck {
+  /// The bound where it is sound, else Full. Sound where the elastic energy
+  /// density is >= 0 (Linear, Corotational, StVK: psi >= 0 for any F) and
+  /// det F is checked (inversion not allowed), with an explicit integrator.
+  Auto,
+  /// Kinetic energy + load potential - (total energy of the last full check)
+  /// may not exceed the growth allowed (W >= 0 dropped: a necessary
+  /// condition of the full check against that state), plus det F > 0 and a
+  /// finite state: no energy sum and no smallest det F in the element loop.
+  /// A failure rolls back to the last fully checked state (the frame start).
+  Bound,
+  /// KE + W + load potential against the last check, W summed in the element loop.
+  Full
+};
+
 /// Options of a Simulator.
 struct SimulatorOptions {
   Integrator integrator = Integrator::RK4;
@@ -49,20 +66,25 @@ struct SimulatorOptions {
   /// detection/response cycles); the health checks still guard every step.
   double frequency_reuse_time = 0;
   /// Sub-steps between health checks (>= 1; default: every step). With the
-  /// explicit integrators a check rides on the next step: energy, det F and
-  /// finiteness of state n in the element pass of its first force
-  /// evaluation (at x_n), kinetic energy and load potential in its first
-  /// node pass; ~2-4 ns/tet in the element loop (StVK, AVX2 lane loops; a
-  /// force evaluation is ~20), i.e. +4% per simulated second with RK4 and
-  /// +10-12% with symplectic Euler (4: +0-4%; measured in
-  /// experiments/fem/results/README.md). Only the last state of an
-  /// advance()/step() call needs a separate element pass (which also
-  /// computes the forces there for the next call). A blow-up is caught at
-  /// most this many steps late and rolled back to the last checked state.
+  /// explicit integrators a check rides on the next step: det F (and, with
+  /// EnergyCheck::Full, the elastic energy) of state n in the element pass
+  /// of its first force evaluation (at x_n), kinetic energy and load
+  /// potential in its first node pass. Cost per simulated second on the
+  /// fem_realtime bar (StVK, AVX2 lane loops; measured in
+  /// experiments/fem/results/README.md): EnergyCheck::Bound (the default
+  /// here) ~1 ns/tet of a ~20 ns/tet force evaluation; Full ~3 ns/tet, +4%
+  /// with RK4 and +10-12% with symplectic Euler. Only the last state of an
+  /// advance()/step() call needs a separate element pass, always with the
+  /// full check (which also computes the forces there for the next call).
+  /// A blow-up is caught at most this many steps late and rolled back to the
+  /// last checked state (with EnergyCheck::Bound: the last fully checked one).
   int check_interval = 1;
   /// A check fails when KE + W grows by more than this fraction of
   /// (KE + W + |work of the loads|) since the last check (explicit blow-up).
   double max_energy_growth = 1.0;
+  /// Energy test of the checks inside a frame (see EnergyCheck); Bound is
+  /// taken as Full where it is not sound.
+  EnergyCheck energy_check = EnergyCheck::Auto;
   InversionPolicy inversion = InversionPolicy::Auto;
   int max_retries = 6;  ///< halvings of the step before giving up
   NewtonOptions newton; ///< backward Euler
@@ -125,6 +147,15 @@ class Simulator {
   /// Health check of state s with its energies and the element health h of
   /// s.x, against the last accepted check.
   Check evaluate(const Check& before, const State& s, const StateEnergies& energies, const ElementHealth& h) const;
+  /// The EnergyCheck::Bound check of state s (energies and the orientation
+  /// test of s.x) against the last full check; names the element by a
+  /// separate health pass when the orientation test fails.
+  Check evaluate_bound(const Check& before, const State& s, const StateEnergies& energies, bool oriented);
+  /// Whether the checks inside a frame use EnergyCheck::Bound.
+  bool bound_checks() const;
+  /// Check failure naming the first node of s with a non-finite x or v
+  /// (called when the kinetic energy or the load potential is not finite).
+  Check nonfinite_state(const State& s) const;
   /// One step from m_state into m_next; returns an empty string, or why the
   /// step failed (Newton). extras: explicit integrators only.
   std::string integrate(double h, const StepExtras& extras = {});

@@ -15,7 +15,10 @@
 //     integrator ratio);
 //   - the default configuration with exact (force-differential) Lanczos
 //     products in the per-frame re-estimates instead of forward differences,
-//     with the baseline x86-64 lane loops instead of AVX2, and with both.
+//     with the baseline x86-64 lane loops instead of AVX2, and with both;
+//   - checks every step with EnergyCheck::Full (the elastic energy and the
+//     smallest det F summed in every check) instead of the default Auto
+//     (for StVK: EnergyCheck::Bound, det F > 0 and a kinetic + load bound).
 // All configurations are interleaved frame by frame (one Simulator each, a
 // frame of each in turn), so that load changes on a shared machine hit all
 // of them alike. Then it splits the
@@ -66,10 +69,11 @@ struct Run {
 };
 
 std::unique_ptr<Simulator> make_simulator(const TetMesh& m, Integrator integ, int check_interval,
-                                          bool fd_products, int threads) {
+                                          bool fd_products, EnergyCheck energy, int threads) {
   SimulatorOptions so;
   so.integrator = integ;
   so.check_interval = check_interval;
+  so.energy_check = energy;
   so.frequency_refresh_finite_differences = fd_products;
   return std::make_unique<Simulator>(clamped_stvk_model(m, threads), so);
 }
@@ -111,18 +115,22 @@ int main(int argc, char** argv) {
     int check_interval;
     bool fd_products;
     lanes::LaneIsa isa;
+    EnergyCheck energy;
     const char* name;
   };
+  const EnergyCheck autom = EnergyCheck::Auto;
   const lanes::LaneIsa base = lanes::LaneIsa::Baseline;
   const Config configs[] = {
-      {1, true, best, "checks every step (default)"},
-      {2, true, best, "checks every 2nd step"},
-      {4, true, best, "checks every 4th step"},
-      {1 << 30, true, best, "checks at frame ends only"},
-      {1, false, best,
+      {1, true, best, autom, "checks every step (default)"},
+      {2, true, best, autom, "checks every 2nd step"},
+      {4, true, best, autom, "checks every 4th step"},
+      {1 << 30, true, best, autom, "checks at frame ends only"},
+      {1, false, best, autom,
        "checks every step, exact Lanczos products (force differentials) in the re-estimates"},
-      {1, true, base, "checks every step, baseline x86-64 lane loops"},
-      {1, false, base, "checks every step, baseline lane loops and exact products"}};
+      {1, true, base, autom, "checks every step, baseline x86-64 lane loops"},
+      {1, false, base, autom, "checks every step, baseline lane loops and exact products"},
+      {1, true, best, EnergyCheck::Full,
+       "checks every step, EnergyCheck::Full (elastic energy and smallest det F summed in every check)"}};
   const int nconfigs = sizeof(configs) / sizeof(configs[0]);
   const Integrator integs[2] = {Integrator::RK4, Integrator::SymplecticEuler};
   // Unit costs: one force evaluation with and without the fused health
@@ -135,7 +143,7 @@ int main(int argc, char** argv) {
   MatX3d out(x.rows(), 3);
   ElasticForces& forces = sagged.model().elastic();
   const int reps = 11;
-  std::vector<double> cpu[2][nconfigs], wall[2][nconfigs], u_eval, u_health, u_product;
+  std::vector<double> cpu[2][nconfigs], wall[2][nconfigs], u_eval, u_health, u_orient, u_product;
   Run last[2][nconfigs];
   // Per configuration and frame, the CPU and wall time of each repetition.
   std::vector<std::vector<double>> frame_cpu[2][nconfigs], frame_wall[2][nconfigs];
@@ -151,7 +159,7 @@ int main(int argc, char** argv) {
     for (int k = 0; k < 2; ++k)
       for (int c = 0; c < nconfigs; ++c)
         sims.push_back(make_simulator(m, integs[k], configs[c].check_interval,
-                                      configs[c].fd_products, threads));
+                                      configs[c].fd_products, configs[c].energy, threads));
     Run run[2][nconfigs];
     for (int f = 0; f < 60; ++f)
       for (int k = 0; k < 2; ++k)
@@ -180,14 +188,17 @@ int main(int argc, char** argv) {
     lanes::set_lane_isa(best);
     u_eval.push_back(cpu_per_call([&] { forces.compute(x, out); }));
     u_health.push_back(cpu_per_call([&] { forces.compute_with_health(x, out); }));
+    u_orient.push_back(cpu_per_call([&] { forces.compute_with_orientation_check(x, out); }));
     u_product.push_back(cpu_per_call([&] { forces.differential(x, dx, out); }));
   }
-  const double t_eval = median(u_eval), t_health = median(u_health), t_product = median(u_product);
+  const double t_eval = median(u_eval), t_health = median(u_health), t_orient = median(u_orient),
+               t_product = median(u_product);
   const double ntets = static_cast<double>(m.T.rows());
   std::printf(
       "unit CPU costs (medians over the repetitions of 3 x 100 calls): force evaluation %.1f "
-      "ns/tet, with the fused health check %.1f ns/tet, force differential %.1f ns/tet\n",
-      t_eval / ntets * 1e9, t_health / ntets * 1e9, t_product / ntets * 1e9);
+      "ns/tet, with the fused health check %.1f ns/tet, with the orientation check only %.1f ns/tet, "
+      "force differential %.1f ns/tet\n",
+      t_eval / ntets * 1e9, t_health / ntets * 1e9, t_orient / ntets * 1e9, t_product / ntets * 1e9);
   // Per simulated second: the sum over the 60 frames of each frame's median
   // over the repetitions; and the smallest per-second total of a repetition.
   double cpu_med[2][nconfigs], wall_med[2][nconfigs], cpu_min[2][nconfigs];
@@ -250,12 +261,13 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 2; ++k) {
     // Per frame: the first step reuses f_int of the check that ended the
     // frame before (frame 1: of the check at the start), every later step
-    // carries the check of its start state in its first force evaluation,
-    // and the frame's end state gets a force evaluation with the check.
+    // carries the check of its start state in its first force evaluation
+    // (EnergyCheck::Bound for StVK: the orientation check only), and the
+    // frame's end state gets a force evaluation with the full check.
     const Run& t = last[k][0];
     const int per_step = integs[k] == Integrator::RK4 ? 4 : 1;
     const long fused = t.substeps - 60, plain = t.substeps * (per_step - 1), end_checks = 61;
-    const double evals = plain * t_eval + (fused + end_checks) * t_health;
+    const double evals = plain * t_eval + fused * t_orient + end_checks * t_health;
     const double lanczos = t.first_products * t_product + t.products * t_eval;
     const double total = cpu_med[k][0];
     std::printf(
@@ -264,7 +276,7 @@ int main(int argc, char** argv) {
         "products, then %ld warm ones in 59 frames), rest %.3f s (%.0f%%: node passes, step control, "
         "in-situ kernel slowdown)\n",
         to_string(integs[k]), total, evals, 100 * evals / total, plain, fused, end_checks,
-        (fused + end_checks) * (t_health - t_eval), lanczos, 100 * lanczos / total, t.first_products,
+        fused * (t_orient - t_eval) + end_checks * (t_health - t_eval), lanczos, 100 * lanczos / total, t.first_products,
         t.products, total - evals - lanczos, 100 * (total - evals - lanczos) / total);
   }
   std::printf("load average after: %s\n", load_average().c_str());

@@ -203,6 +203,39 @@ TEST_P(ForcesPerModel, FusedHealthMatchesTheSeparatePassForAnyThreadCount) {
 INSTANTIATE_TEST_SUITE_P(AllModels, ForcesPerModel, ::testing::ValuesIn(test::all_models()),
                          test::model_name);
 
+TEST_P(ForcesPerModel, OrientationCheckMatchesABruteForceDeterminantScan) {
+  // compute_with_orientation_check(): the forces of compute() bitwise, and
+  // true iff every element's det F (Eigen's determinant of the deformation
+  // gradient, element by element) is > 0; with an element inverted in the
+  // last, partial lane block and in a full one, and with a NaN coordinate.
+  // 630 tets: two 512-element chunks, 78 whole 8-lane blocks and a partial one.
+  const TetMeshData d = test::box_data(7, 5, 3, {0.7, 0.5, 0.3});
+  ASSERT_NE(d.num_tets() % 8, 0);
+  for (int threads : {1, 2}) {
+    ForceOptions fo;
+    fo.num_threads = threads;
+    for (int variant = 0; variant < 4; ++variant) {
+      // Fresh objects: corotational's warm-start rotations are state.
+      ElasticForces forces(d, test::material(GetParam()), fo), plain(d, test::material(GetParam()), fo);
+      MatX3d x = deformed(d, 23, 0.01);
+      auto invert = [&](int e) { x.row(d.tets(e, 0)) = x.row(d.tets(e, 1)) + (x.row(d.tets(e, 1)) - x.row(d.tets(e, 0))); };
+      if (variant == 1) invert(d.num_tets() - 1);
+      if (variant == 2) invert(200);
+      if (variant == 3) x(d.tets(300, 2), 1) = std::numeric_limits<double>::quiet_NaN();
+      bool expected = true;
+      for (int e = 0; e < d.num_tets(); ++e) expected = expected && d.deformation_gradient(x, e).determinant() > 0;
+      MatX3d f(d.num_nodes, 3), g(d.num_nodes, 3);
+      const bool oriented = forces.compute_with_orientation_check(x, f);
+      plain.compute(x, g);
+      EXPECT_EQ(oriented, expected) << "threads " << threads << " variant " << variant;
+      EXPECT_EQ(expected, variant == 0) << "variant " << variant;  // the cases are what they claim
+      if (variant < 3) {
+        EXPECT_TRUE(f.cwiseEqual(g).all()) << "threads " << threads << " variant " << variant;
+      }
+    }
+  }
+}
+
 TEST(Forces, LaneKernelsMatchTheScalarKernelsPerElement) {
   // The 8-lane kernels (forces, fused health, force differential) against the
   // scalar per-element kernels of element_kernels.hpp: forces, det F and
@@ -220,8 +253,16 @@ TEST(Forces, LaneKernelsMatchTheScalarKernelsPerElement) {
   auto check = [&](auto tag, auto stress, auto energy, auto dstress) {
     constexpr MaterialModel kModel = decltype(tag)::value;
     double out[8][12], psi[8], det[8], dout[8][12];
-    lanes::block_forces<kModel, true>(x.data(), d.tets.data(), count, block, mu, lambda, out, psi, det);
+    lanes::block_forces<kModel, lanes::LaneCheck::Full>(x.data(), d.tets.data(), count, block, mu, lambda, out, psi, det);
     lanes::block_differential<kModel>(x.data(), dx.data(), d.tets.data(), count, block, mu, lambda, dout);
+    // The orientation check: the same forces and det F, no energy density.
+    double out_o[8][12], det_o[8];
+    lanes::block_forces<kModel, lanes::LaneCheck::Orientation>(x.data(), d.tets.data(), count, block, mu, lambda,
+                                                               out_o, nullptr, det_o);
+    for (int e = 0; e < count; ++e) {
+      EXPECT_EQ(det_o[e], det[e]) << to_string(kModel) << " element " << e;
+      for (int k = 0; k < 12; ++k) EXPECT_EQ(out_o[e][k], out[e][k]) << to_string(kModel) << " element " << e;
+    }
     for (int e = 0; e < count; ++e) {
       const int* t = d.tets.data() + 4 * e;
       const double* D = d.dm_inv[e].data();

@@ -2,6 +2,8 @@
 // extreme cases, health checks with rollback, retries and diagnostics.
 #include "fem/simulator.hpp"
 
+#include <memory>
+
 #include <gtest/gtest.h>
 
 #include "fem_test_utils.hpp"
@@ -214,6 +216,134 @@ TEST(Simulator, FrameEndForcesReusedGiveTheTrajectoryOfPlainSteps) {
       EXPECT_TRUE(sim.velocities().cwiseEqual(s.v).all()) << to_string(integ) << " frame " << f;
     }
     EXPECT_LT(test::tip_deflection(model, s.x), 0.0);
+  }
+}
+
+TEST(Simulator, BoundChecksGiveTheTrajectoryOfFullChecks) {
+  // EnergyCheck::Bound (the default for StVK) and Full check different
+  // quantities, never the state: on a run that passes both, the trajectory
+  // and the sub-step counts are bitwise equal.
+  for (Integrator integ : {Integrator::RK4, Integrator::SymplecticEuler}) {
+    const Material mat = test::material(MaterialModel::StVK, 1e6, 0.3);
+    MatX3d x[2];
+    int substeps[2], retries[2];
+    for (int k = 0; k < 2; ++k) {
+      SimulatorOptions o;
+      o.integrator = integ;
+      o.energy_check = k == 0 ? EnergyCheck::Bound : EnergyCheck::Full;
+      Simulator sim(test::cantilever(1, mat), o);
+      substeps[k] = retries[k] = 0;
+      for (int f = 0; f < 5; ++f) {
+        const AdvanceReport r = sim.advance(1.0 / 60);
+        substeps[k] += r.substeps;
+        retries[k] += r.retries;
+      }
+      x[k] = sim.positions();
+    }
+    EXPECT_TRUE(x[0].cwiseEqual(x[1]).all()) << to_string(integ);
+    EXPECT_EQ(substeps[0], substeps[1]);
+    EXPECT_EQ(retries[0], 0);
+    EXPECT_EQ(retries[1], 0);
+    EXPECT_LT(test::tip_deflection(test::cantilever(1, mat), x[0]), 0.0);
+  }
+}
+
+// A symplectic Euler run whose steps exceed the stable limit: the limit is
+// estimated without damping and kept (frequency_reuse_time), then stiffness
+// damping beta = q / omega_max is switched on, which lowers the limit of the
+// top mode to r = (sqrt(q^2 + 4) - q) / 2 of the undamped one (the Jury
+// condition; q = (1 - r^2) / r), so that the automatic steps, 0.9 x the
+// undamped limit, are `overshoot` x the damped one.
+struct UnstableRun {
+  std::unique_ptr<Simulator> sim;
+  double h = 0;  ///< the automatic step, s
+};
+UnstableRun unstable_run(EnergyCheck check, double overshoot, int max_retries) {
+  SimulatorOptions o;
+  o.integrator = Integrator::SymplecticEuler;
+  o.energy_check = check;
+  o.max_retries = max_retries;
+  o.frequency_reuse_time = 1e9;
+  UnstableRun u{
+      std::make_unique<Simulator>(test::cantilever(1, test::material(MaterialModel::StVK, 1e7, 0.3), 0.0), o)};
+  const int n = u.sim->model().num_nodes();
+  u.sim->set_velocities(1e-3 * test::random_field(n, 7));  // all modes excited
+  const double limit = u.sim->stable_step_limit();
+  const double omega = u.sim->last_frequency().omega_bound;
+  const double r = 0.9 / overshoot;
+  const RayleighDamping damping{0.0, (1 - r * r) / r / omega};
+  EXPECT_NEAR(stable_step_limit(Integrator::SymplecticEuler, omega, damping), r * limit, 1e-6 * limit);
+  u.sim->model().set_damping(damping);
+  u.h = 0.9 * limit;
+  return u;
+}
+
+// Simulated time of the state a NumericalError rejected ("... at t = T s").
+double failure_time(const std::string& message) {
+  const size_t at = message.find("at t = ");
+  return at == std::string::npos ? -1.0 : std::stod(message.substr(at + 7));
+}
+
+TEST(Simulator, BoundCheckCatchesAnUnstableStepWithinAFewStepsOfTheFullCheck) {
+  // Steps 1.3x above the (damped) limit; no retries, so the first failed
+  // check throws. The bound (kinetic energy + load potential against the
+  // frame start's total energy, det F > 0) must catch the blow-up no more
+  // than 3 steps after the full check (total energy against the previous
+  // step) does, and both must leave the last good, finite state.
+  double t[2];
+  for (int k = 0; k < 2; ++k) {
+    UnstableRun u = unstable_run(k == 0 ? EnergyCheck::Bound : EnergyCheck::Full, 1.3, 0);
+    const double e0 = u.sim->total_energy();
+    t[k] = -1;
+    for (int f = 0; f < 30 && t[k] < 0; ++f) {
+      try {
+        u.sim->advance(1.0 / 60);
+      } catch (const NumericalError& e) {
+        t[k] = failure_time(e.what());
+        EXPECT_NE(std::string(e.what()).find("energy grew"), std::string::npos) << e.what();
+      }
+    }
+    ASSERT_GT(t[k], 0.0) << "no failure, k = " << k;
+    // Inside the first frame, well before its end (where the full check
+    // runs in either mode): the check inside the frame caught it.
+    EXPECT_LT(t[k], 1.0 / 60 - 5 * u.h) << "k = " << k;
+    EXPECT_TRUE(u.sim->positions().allFinite());
+    EXPECT_TRUE(u.sim->velocities().allFinite());
+    EXPECT_LT(u.sim->total_energy(), 10 * e0);  // rolled back before the blow-up
+    if (k == 1) {
+      EXPECT_LE(t[0], t[1] + 3 * u.h) << "bound at " << t[0] << " s, full at " << t[1] << " s";
+    }
+  }
+}
+
+TEST(Simulator, BoundCheckRetriesWithHalvedStepsThroughAnUnstableRun) {
+  // The same run with retries: every frame's first try blows up and is
+  // caught; halving the step makes it stable (0.65x the damped limit).
+  UnstableRun u = unstable_run(EnergyCheck::Bound, 1.3, 6);
+  const double e0 = u.sim->total_energy();
+  int retries = 0;
+  for (int f = 0; f < 4; ++f) retries += u.sim->advance(1.0 / 60).retries;
+  EXPECT_GE(retries, 1);
+  EXPECT_TRUE(u.sim->positions().allFinite());
+  EXPECT_LE(u.sim->total_energy(), 1.0001 * e0);  // damped: no energy is created
+}
+
+TEST(Simulator, OverflowingStateStopsBothChecksWithAFiniteState) {
+  // A node shot at 1e150 m/s: within a step or two the positions, forces and
+  // velocities overflow to Inf/NaN. Both checks must stop with a
+  // NumericalError and leave a finite state (never NaN positions).
+  for (EnergyCheck check : {EnergyCheck::Bound, EnergyCheck::Full}) {
+    SimulatorOptions o;
+    o.integrator = Integrator::SymplecticEuler;
+    o.energy_check = check;
+    o.max_retries = 2;
+    Simulator sim(test::cantilever(1, test::material(MaterialModel::StVK, 1e6, 0.3), 0.0), o);
+    MatX3d v = MatX3d::Zero(sim.model().num_nodes(), 3);
+    v(sim.model().num_nodes() - 1, 2) = 1e150;
+    sim.set_velocities(v);
+    EXPECT_THROW(sim.advance(1.0 / 60), NumericalError);
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_TRUE(sim.velocities().allFinite());
   }
 }
 
