@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <utility>
 
+#include "fem/lane_loops.hpp"
+
 namespace icd::fem {
 
 const char* to_string(Integrator integrator) {
@@ -109,23 +111,52 @@ template <bool kEnergies, int kCount>
 
 // The node pass of a symplectic Euler step (see ExplicitStepper::symplectic_euler);
 // kEnergies: also the StateEnergies of (x, v), summed as in state_energies().
+struct NodePass {
+  long nd;
+  double alpha, h;
+  const double *m, *w;
+  const std::uint64_t* free_mask;
+  const double *load, *x, *v, *f;
+  double *x1, *v1;
+};
+
+template <bool kEnergies>
+[[gnu::always_inline]] inline StateEnergies symplectic_euler_nodes_body(const NodePass& p) {
+  EnergySums sums;
+  long k = 0;
+  for (; k + 4 <= p.nd; k += 4)
+    symplectic_euler_dofs<kEnergies, 4>(4, p.alpha, p.h, p.m + k, p.w + k, p.free_mask + k, p.load + k, p.x + k,
+                                        p.v + k, p.f + k, p.x1 + k, p.v1 + k, sums);
+  symplectic_euler_dofs<kEnergies, 0>(static_cast<int>(p.nd - k), p.alpha, p.h, p.m + k, p.w + k, p.free_mask + k,
+                                      p.load + k, p.x + k, p.v + k, p.f + k, p.x1 + k, p.v1 + k, sums);
+  return sums.result();
+}
+
+// The pass compiled for the baseline instruction set and for AVX2 (without
+// FMA: the same operations, bitwise the same results), chosen like the lane
+// loops (lanes::lane_isa()); measured ~2x faster with AVX2 (perf: 6.7% of a
+// symplectic Euler run on the fem_realtime bar with the baseline build).
+template <bool kEnergies>
+StateEnergies symplectic_euler_nodes_baseline(const NodePass& p) {
+  return symplectic_euler_nodes_body<kEnergies>(p);
+}
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+template <bool kEnergies>
+__attribute__((target("avx2"))) StateEnergies symplectic_euler_nodes_avx2(const NodePass& p) {
+  return symplectic_euler_nodes_body<kEnergies>(p);
+}
+#endif
+
 template <bool kEnergies>
 StateEnergies symplectic_euler_nodes(const Model& model, const double* x, const double* v, const double* f,
                                      double h, double* x1, double* v1) {
-  const long nd = 3L * model.num_nodes();
-  const double alpha = model.damping().alpha;
-  const double* m = model.dof_mass().data();
-  const double* w = model.dof_inverse_mass().data();
-  const std::uint64_t* free_mask = model.dof_free_mask().data();
-  const double* load = model.loads().data();
-  EnergySums sums;
-  long k = 0;
-  for (; k + 4 <= nd; k += 4)
-    symplectic_euler_dofs<kEnergies, 4>(4, alpha, h, m + k, w + k, free_mask + k, load + k, x + k, v + k, f + k,
-                                        x1 + k, v1 + k, sums);
-  symplectic_euler_dofs<kEnergies, 0>(static_cast<int>(nd - k), alpha, h, m + k, w + k, free_mask + k, load + k,
-                                      x + k, v + k, f + k, x1 + k, v1 + k, sums);
-  return sums.result();
+  const NodePass p{3L * model.num_nodes(), model.damping().alpha, h, model.dof_mass().data(),
+                   model.dof_inverse_mass().data(), model.dof_free_mask().data(), model.loads().data(), x, v, f, x1,
+                   v1};
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  if (lanes::lane_isa() == lanes::LaneIsa::AVX2) return symplectic_euler_nodes_avx2<kEnergies>(p);
+#endif
+  return symplectic_euler_nodes_baseline<kEnergies>(p);
 }
 
 }  // namespace
