@@ -2,7 +2,8 @@
 // and one step per integrator, on ~1k, ~4k and ~30k-tet structured bars and
 // on the coarse tet meshes of the pipeline's asset bundles (bunny, dragon;
 // nodes reordered by reverse Cuthill-McKee), plus the force evaluation with
-// the fused health check, the separate health pass and the force differential
+// the fused health check, with the fused orientation test only, the separate
+// health pass and the force differential
 // (the Lanczos product) on the ~4k-tet bar.
 // Reported as time per tet (counter "per_tet", seconds; shown with an SI
 // prefix, e.g. 30n = 30 ns/tet). Single thread unless the name says threads:2.
@@ -183,7 +184,8 @@ void BM_ForcesAsset(benchmark::State& state) {
 }
 BENCHMARK(BM_ForcesAsset)->ArgsProduct({{0, 1, 2, 3}, {0, 1}})->ArgNames({"model", "asset"})->MinTime(0.2);
 
-// Args: kind (0 compute, 1 compute_with_health, 2 health, 3 differential), model; the ~4k-tet bar.
+// Args: kind (0 compute, 1 compute_with_health, 2 health, 3 differential, 4
+// compute_with_orientation_check), model; the ~4k-tet bar.
 void BM_Kernels(benchmark::State& state) {
   const int kind = static_cast<int>(state.range(0));
   // isa 1: the lane loops' AVX2 build (the default where the CPU has it), 0: baseline x86-64.
@@ -205,18 +207,19 @@ void BM_Kernels(benchmark::State& state) {
       case 1: benchmark::DoNotOptimize(forces.compute_with_health(x, f)); break;
       case 2: benchmark::DoNotOptimize(forces.health(x)); break;
       case 3: forces.differential(x, dx, f); break;
+      case 4: benchmark::DoNotOptimize(forces.compute_with_orientation_check(x, f)); break;
     }
     benchmark::DoNotOptimize(f.data());
     benchmark::ClobberMemory();
   }
-  const char* names[4] = {"forces", "forces + health", "health", "differential"};
+  const char* names[5] = {"forces", "forces + health", "health", "differential", "forces + orientation"};
   state.SetLabel(std::string(names[kind]) + " " + to_string(forces.material().model) + " " +
                  lanes::to_string(isa));
   lanes::set_lane_isa(before);
   set_per_tet(state, m.T.rows());
 }
 BENCHMARK(BM_Kernels)
-    ->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2, 3, 4}, {0, 1, 2, 3}, {0, 1}})
     ->ArgNames({"kind", "model", "isa"})
     ->MinTime(0.2);
 
