@@ -9,6 +9,7 @@
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
 //                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
+//                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]  (split_worst)
 //                   [--perturb E]  (build for the mesh scaled by 1 + E, evaluate on the
 //                                   mesh: E ~ 1e-12 shows the build's sensitivity to rounding)
 //
@@ -166,7 +167,8 @@ void print_usage(std::ostream& os) {
         " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
-        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]\n"
+        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]"
+        " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]\n"
         "       sphere_tree_table --help\n";
 }
 
@@ -223,6 +225,14 @@ int main(int argc, char** argv) {
       options.relieve_moves = std::atoi(value);
     else if (key == "--fill")
       options.fill_leaf_budget = std::atoi(value) != 0;
+    else if (key == "--split-worst")
+      options.split_worst = std::atoi(value) != 0;
+    else if (key == "--split-relief")
+      options.worst_split.relief_fraction = std::atof(value);
+    else if (key == "--split-mean-rise")
+      options.worst_split.mean_rise_limit = std::atof(value);
+    else if (key == "--split-tries")
+      options.worst_split.max_tries = std::atoi(value);
     else if (key == "--perturb")
       perturb = std::atof(value);
     else if (key == "--fit-probes")
@@ -318,6 +328,15 @@ int main(int argc, char** argv) {
         model.name.c_str(), static_cast<long long>(ours.samples.points.rows()),
         ours.num_medial_spheres, ours.num_refinement_points, ours.medial_seconds, build_cpu_s,
         ours.polish_cpu_seconds, ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+    if (options.split_worst) {
+      const auto& w = ours.worst_split;
+      const double unit = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+      std::printf(
+          "# %s worst split: %d splits in %d tries (%d merges; %d worst leaves with a full parent), %d "
+          "spheres measured, true worst (%d dirs) %.1f -> %.1f\n",
+          model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent, w.measured,
+          options.worst_split.measure_directions, unit * w.worst_before, unit * w.worst_after);
+    }
     std::printf("# %s build steps (CPU s):", model.name.c_str());
     for (const auto& [step, seconds] : ours.step_cpu_seconds)
       std::printf(" %s %.1f;", step.c_str(), seconds);

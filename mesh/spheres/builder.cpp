@@ -38,6 +38,11 @@ void check_options(const SphereTreeOptions& o) {
     fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
   }
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
+  if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
+      o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
+      !(o.worst_split.mean_rise_limit >= 0)) {
+    fail("worst_split: measure/choice directions must be >= 1, max_tries >= 0, relief_fraction >= 0");
+  }
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
   if (o.protrusion.search_directions < 1 || o.protrusion.check_directions < 1 ||
       o.protrusion.max_evaluations < 0 || !(o.protrusion.initial_step > 0) ||
@@ -108,6 +113,17 @@ std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, in
   run(extra - by_worst, false);
   run(by_worst, true);
   return count;
+}
+
+/// The sphere cap of level l: branching^l, lowered by max_spheres_per_level[l] when positive.
+long long level_cap(const SphereTreeOptions& options, int l) {
+  long long cap = 1;
+  for (int i = 0; i < l; ++i) cap = std::min<long long>(cap * options.branching, 1LL << 30);
+  if (static_cast<int>(options.max_spheres_per_level.size()) > l &&
+      options.max_spheres_per_level[static_cast<size_t>(l)] > 0) {
+    cap = std::min<long long>(cap, options.max_spheres_per_level[static_cast<size_t>(l)]);
+  }
+  return cap;
 }
 
 /// Jointly re-optimises the leaf level across sibling groups (a leaf may take
@@ -569,6 +585,28 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     out.polish_cpu_seconds = std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }
   end_step("protrusion polish");
+  if (options.split_worst && levels.size() > 1) {
+    LeafLevel leaf_level;
+    for (Node& n : levels.back()) {
+      leaf_level.spheres.push_back(std::move(n.sphere));
+      leaf_level.medial.push_back(std::move(n.medial));
+    }
+    leaf_level.parent = parent_of.back();
+    WorstSplitOptions split = options.worst_split;
+    split.deadline = std::min(split.deadline, deadline);
+    out.worst_split = split_worst_leaves(coarse, dense, oracle, reduction, leaf_level,
+                                         static_cast<int>(level_cap(options, options.depth)),
+                                         options.branching, split);
+    levels.back().clear();
+    for (size_t i = 0; i < leaf_level.spheres.size(); ++i) {
+      Node n;
+      n.sphere = std::move(leaf_level.spheres[i]);
+      n.medial = std::move(leaf_level.medial[i]);
+      levels.back().push_back(std::move(n));
+    }
+    parent_of.back() = std::move(leaf_level.parent);
+    end_step("worst split");
+  }
 
   // Flatten breadth-first: level by level, children of a node contiguous.
   collision::SphereTree& tree = out.tree;

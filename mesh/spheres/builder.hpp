@@ -12,6 +12,7 @@
 #include "mesh/spheres/protrusion.hpp"
 #include "mesh/spheres/reduction.hpp"
 #include "mesh/spheres/surface_sampling.hpp"
+#include "mesh/spheres/worst_split.hpp"
 
 namespace icd::mesh {
 
@@ -95,6 +96,15 @@ struct SphereTreeOptions {
   /// leaves that changed (>= 0).
   int protrusion_exchange_rounds = 1;
   ProtrusionPolishOptions protrusion;  ///< see polish_protrusion
+  /// Very last step (split_worst_leaves): the leaves with the largest true
+  /// error, measured on worst_split.measure_directions (a set neither the
+  /// polish nor the evaluation uses), are split in two, in the leaf slots the
+  /// top-down pass lost, when both halves have a lower true error; near the
+  /// worst (worst_split.relief_fraction) even when the mean rises and, in a
+  /// full parent, after merging two siblings; below it only when the mean
+  /// does not rise. Coverage is kept; the true worst never rises.
+  bool split_worst = false;
+  WorstSplitOptions worst_split;  ///< see split_worst_leaves (its deadline is time_limit's)
   /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),
   /// not wall-clock time, so a loaded machine does not change the tree; > 0).
   /// Past it the optimisation stops early (no more Lloyd rounds or polish
@@ -119,6 +129,7 @@ struct SphereTreeBuild {
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
   int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget
+  WorstSplitResult worst_split;    ///< what split_worst_leaves did (with split_worst)
   /// Process CPU seconds of each build step, in order (step name, seconds).
   std::vector<std::pair<std::string, double>> step_cpu_seconds;
 };

@@ -228,6 +228,7 @@ TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
   o.branching = 8;
   o.medial_spacing = 1.0 / 6;
+  o.split_worst = false;  // counts the fill's splits alone
   const SphereTreeBuild plain = build_sphere_tree(sphere, o);
   o.fill_leaf_budget = true;
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
@@ -245,6 +246,77 @@ TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
 }
 
+/// Largest protrusion of the leaves of `tree` on `directions` (recomputed
+/// here with sphere_protrusion, independently of the builder's bookkeeping).
+double leaf_worst_protrusion(const icd::collision::SphereTree& tree, const MeshOracle& oracle,
+                             const icd::MatX3d& directions) {
+  double worst = 0;
+  for (int i = tree.level_offset[tree.num_levels() - 1]; i < tree.num_nodes(); ++i)
+    worst = std::max(worst, sphere_protrusion(oracle, tree.spheres[i].center(), tree.spheres[i].r,
+                                              directions));
+  return worst;
+}
+
+TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst) {
+  // The worst-leaf split is the last step, so the build without it is the
+  // tree it starts from. On this sphere (coarse medial samples, branching 8)
+  // the top-down pass loses leaves, so there is room for splits. Checked:
+  // leaf count within the cap and each parent within its branching, the
+  // leaf count bookkeeping (+1 per split, -1 per merge), every node covers
+  // its samples with margin and children divide their parent's samples,
+  // every level covers a dense random sampling (brute force), and the
+  // largest leaf protrusion on the measuring directions, recomputed here,
+  // equals the reported one and is not above the start's.
+  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
+  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  o.branching = 8;
+  o.medial_spacing = 1.0 / 6;
+  o.worst_split.measure_directions = 300;
+  o.worst_split.choice_directions = 100;
+  o.split_worst = false;
+  const SphereTreeBuild plain = build_sphere_tree(sphere, o);
+  o.split_worst = true;
+  const SphereTreeBuild build = build_sphere_tree(sphere, o);
+  const auto& tree = build.tree;
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  ASSERT_EQ(tree.num_levels(), 3);
+  const auto& result = build.worst_split;
+  EXPECT_GT(result.splits, 0) << "the case must exercise the split";
+  const int leaves = tree.level_offset[3] - tree.level_offset[2];
+  const int plain_leaves = plain.tree.level_offset[3] - plain.tree.level_offset[2];
+  EXPECT_LT(plain_leaves, 64);
+  EXPECT_EQ(leaves, plain_leaves + result.splits - result.merges);
+  EXPECT_LE(leaves, 64);
+  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+  expect_nodes_cover_and_children_divide(build);
+  const icd::MatX3d D = dense_random_points(sphere, 5000, 17);
+  for (int l = 0; l < tree.num_levels(); ++l)
+    EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+  // Inner levels are untouched: the split divides a leaf's samples.
+  for (int i = 0; i < tree.level_offset[2]; ++i) {
+    EXPECT_EQ(tree.spheres[i].r, plain.tree.spheres[i].r);
+    EXPECT_EQ(build.node_samples[i], plain.node_samples[i]);
+  }
+  const MeshOracle oracle(sphere);
+  const icd::MatX3d dirs = spiral_directions(o.worst_split.measure_directions);
+  const double before = leaf_worst_protrusion(plain.tree, oracle, dirs);
+  const double after = leaf_worst_protrusion(tree, oracle, dirs);
+  EXPECT_NEAR(result.worst_before, before, 1e-12);
+  EXPECT_NEAR(result.worst_after, after, 1e-12);
+  EXPECT_LE(after, before);
+}
+
+TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
+  const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
+  SphereTreeOptions o = small_options();
+  o.split_worst = true;
+  o.worst_split.measure_directions = 0;
+  EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
+  o.worst_split.measure_directions = 10;
+  o.worst_split.max_tries = -1;
+  EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
+}
+
 TEST(SphereTreeBuilder, ProtrusionPolishNeverRaisesANodesError) {
   // The polish is the last step: the same build without it has the same
   // nodes; each polished node protrudes no more (measured on the polish's
@@ -252,8 +324,9 @@ TEST(SphereTreeBuilder, ProtrusionPolishNeverRaisesANodesError) {
   // it, and the exchange between its leaf passes only shrinks radii), and
   // some protrude less.
   const Case torus = cases()[2];
-  const SphereTreeBuild& polished = cached_build(torus);
   SphereTreeOptions o = small_options();
+  o.split_worst = false;  // the polish is then the last step
+  const SphereTreeBuild polished = build_sphere_tree(torus.mesh, o);
   o.protrusion_polish = false;
   const SphereTreeBuild plain = build_sphere_tree(torus.mesh, o);
   ASSERT_EQ(plain.tree.num_nodes(), polished.tree.num_nodes());

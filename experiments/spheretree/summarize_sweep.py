@@ -1,0 +1,36 @@
+"""Leaf-level summary of a perturb_sweep.sh log: one row per build, then the
+median and range of each column, and how many builds have worst42 <= 80."""
+import re
+import statistics
+import sys
+
+rows = []
+current = None
+for line in open(sys.argv[1]):
+    if line.startswith("## perturb"):
+        current = {"E": line.split()[2]}
+        rows.append(current)
+        continue
+    f = line.split()
+    if current is None:
+        continue
+    if len(f) > 10 and f[1] == "medial" and f[2] == "3":
+        current.update(leaves=int(f[3]), worst42=float(f[4]), mean42=float(f[5]),
+                       worst162=float(f[6]), mean162=float(f[7]), uncovered=int(f[9]))
+    m = re.match(r"# \w+ level 3: error on 2562 directions: worst ([\d.]+) mean ([\d.]+)", line)
+    if m and "fit42" not in line:
+        current.update(worst2562=float(m.group(1)), mean2562=float(m.group(2)))
+    m = re.search(r"build CPU time ([\d.]+) s", line)
+    if m:
+        current["cpu"] = float(m.group(1))
+
+cols = ["leaves", "worst42", "mean42", "mean162", "mean2562", "worst2562", "uncovered", "cpu"]
+print("E".ljust(8) + "".join(c.rjust(10) for c in cols))
+for r in rows:
+    print(r["E"].ljust(8) + "".join(str(r.get(c, "-")).rjust(10) for c in cols))
+done = [r for r in rows if all(c in r for c in cols)]
+if done:
+    print("median".ljust(8) + "".join(str(round(statistics.median(r[c] for r in done), 2)).rjust(10) for c in cols))
+    print("min".ljust(8) + "".join(str(min(r[c] for r in done)).rjust(10) for c in cols))
+    print("max".ljust(8) + "".join(str(max(r[c] for r in done)).rjust(10) for c in cols))
+    print(f"worst42 <= 80 in {sum(r['worst42'] <= 80 for r in done)} of {len(done)} builds")
