@@ -71,9 +71,11 @@ struct SimulatorOptions {
   /// of its first force evaluation (at x_n), kinetic energy and load
   /// potential in its first node pass. Cost per simulated second on the
   /// fem_realtime bar (StVK, AVX2 lane loops; measured in
-  /// experiments/fem/results/README.md): EnergyCheck::Bound (the default
-  /// here) ~1 ns/tet of a ~20 ns/tet force evaluation; Full ~3 ns/tet, +4%
-  /// with RK4 and +10-12% with symplectic Euler. Only the last state of an
+  /// experiments/fem/results/README.md): the kernel part of
+  /// EnergyCheck::Bound (the default here) is 0-2 ns/tet of a ~23 ns/tet
+  /// force evaluation, of Full ~3; every step against frame ends only costs
+  /// RK4 +2-3% and symplectic Euler +4-7% with Bound (+2% / +7-8% with
+  /// Full, +4% / +12% in the previous session's run). Only the last state of an
   /// advance()/step() call needs a separate element pass, always with the
   /// full check (which also computes the forces there for the next call).
   /// A blow-up is caught at most this many steps late and rolled back to the
