@@ -10,6 +10,8 @@
 //                                        evaluation directions, to show what that fit does)
 //                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
 //                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]  (split_worst)
+//                   [--flat N]  (diagnostic: one level of at most N spheres under the root,
+//                                every other step as usual: the cost of the nested partition)
 //                   [--perturb E]  (build for the mesh scaled by 1 + E, evaluate on the
 //                                   mesh: E ~ 1e-12 shows the build's sensitivity to rounding)
 //
@@ -51,7 +53,9 @@ struct Model {
 
 void write_tree(const fs::path& dir, const std::string& stem,
                 const icd::collision::SphereTree& tree) {
-  icd::collision::write_sph((dir / (stem + ".sph")).string(), tree, 8);
+  int branch = 8;  // the .sph header's branching: 8, or more for a --flat tree
+  for (int count : tree.child_count) branch = std::max(branch, count);
+  icd::collision::write_sph((dir / (stem + ".sph")).string(), tree, branch);
   for (int l = 0; l < tree.num_levels(); ++l) {
     const int begin = tree.level_offset[static_cast<size_t>(l)],
               end = tree.level_offset[static_cast<size_t>(l) + 1];
@@ -168,7 +172,8 @@ void print_usage(std::ostream& os) {
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
         " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]"
-        " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]\n"
+        " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]"
+        " [--flat N]\n"
         "       sphere_tree_table --help\n";
 }
 
@@ -233,7 +238,12 @@ int main(int argc, char** argv) {
       options.worst_split.mean_rise_limit = std::atof(value);
     else if (key == "--split-tries")
       options.worst_split.max_tries = std::atoi(value);
-    else if (key == "--perturb")
+    else if (key == "--flat") {
+      const int n = std::atoi(value);
+      options.depth = 1;
+      options.branching = std::max(2, n);
+      options.max_spheres_per_level = {1, n};
+    } else if (key == "--perturb")
       perturb = std::atof(value);
     else if (key == "--fit-probes")
       fit_probes = std::atoi(value) != 0;
@@ -333,9 +343,10 @@ int main(int argc, char** argv) {
       const double unit = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
       std::printf(
           "# %s worst split: %d splits in %d tries (%d merges; %d worst leaves with a full parent), %d "
-          "spheres measured, true worst (%d dirs) %.1f -> %.1f\n",
+          "spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d dirs) %.2f\n",
           model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent, w.measured,
-          options.worst_split.measure_directions, unit * w.worst_before, unit * w.worst_after);
+          options.worst_split.measure_directions, unit * w.worst_before, unit * w.worst_after,
+          options.worst_split.choice_directions, unit * w.mean_before);
     }
     std::printf("# %s build steps (CPU s):", model.name.c_str());
     for (const auto& [step, seconds] : ours.step_cpu_seconds)

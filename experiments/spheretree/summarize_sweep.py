@@ -1,28 +1,39 @@
 """Leaf-level summary of a perturb_sweep.sh log: one row per build, then the
-median and range of each column, and how many builds have worst42 <= 80."""
+median and range of each column, and how many builds have worst42 <= 80.
+The leaf level is the deepest level printed for the build (3 for the
+default tree, 1 for --flat)."""
 import re
 import statistics
 import sys
 
-rows = []
-current = None
+builds = []  # (E, {level: metrics})
 for line in open(sys.argv[1]):
     if line.startswith("## perturb"):
-        current = {"E": line.split()[2]}
-        rows.append(current)
+        builds.append((line.split()[2], {}, {}))
         continue
+    if not builds:
+        continue
+    _, per_level, extra = builds[-1]
     f = line.split()
-    if current is None:
-        continue
-    if len(f) > 10 and f[1] == "medial" and f[2] == "3":
-        current.update(leaves=int(f[3]), worst42=float(f[4]), mean42=float(f[5]),
-                       worst162=float(f[6]), mean162=float(f[7]), uncovered=int(f[9]))
-    m = re.match(r"# \w+ level 3: error on 2562 directions: worst ([\d.]+) mean ([\d.]+)", line)
+    if len(f) > 10 and f[1] == "medial":
+        per_level.setdefault(int(f[2]), {}).update(
+            leaves=int(f[3]), worst42=float(f[4]), mean42=float(f[5]), worst162=float(f[6]),
+            mean162=float(f[7]), uncovered=int(f[9]))
+    m = re.match(r"# \w+ level (\d+): error on 2562 directions: worst ([\d.]+) mean ([\d.]+)", line)
     if m and "fit42" not in line:
-        current.update(worst2562=float(m.group(1)), mean2562=float(m.group(2)))
+        per_level.setdefault(int(m.group(1)), {}).update(
+            worst2562=float(m.group(2)), mean2562=float(m.group(3)))
     m = re.search(r"build CPU time ([\d.]+) s", line)
     if m:
-        current["cpu"] = float(m.group(1))
+        extra["cpu"] = float(m.group(1))
+
+rows = []
+for e, per_level, extra in builds:
+    row = {"E": e}
+    if per_level:
+        row.update(per_level[max(per_level)])
+    row.update(extra)
+    rows.append(row)
 
 cols = ["leaves", "worst42", "mean42", "mean162", "mean2562", "worst2562", "uncovered", "cpu"]
 print("E".ljust(8) + "".join(c.rjust(10) for c in cols))

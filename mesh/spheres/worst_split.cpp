@@ -200,9 +200,13 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     return w < 0 ? 0.0 : value[static_cast<size_t>(w)];
   };
   result.worst_before = level_worst();
-  double mean_bound = 0;
-  for (const auto& s : level.spheres) mean_bound += s.radius - s.depth;
-  mean_bound /= static_cast<double>(std::max<size_t>(level.spheres.size(), 1));
+  // The level's mean true error at the start, on the choice directions (a
+  // subset's worth of the measuring ones: slightly below the mean on those,
+  // so the rule below errs on the side of not raising the mean).
+  double mean_error = 0;
+  for (const auto& s : level.spheres) mean_error += sphere_protrusion(oracle, s.center, s.radius, choice);
+  mean_error /= static_cast<double>(std::max<size_t>(level.spheres.size(), 1));
+  result.mean_before = mean_error;
 
   // The best merge of two siblings of leaf i (other than i), or none with an
   // error below `limit`: the pair whose fitted sphere has the lowest error
@@ -265,10 +269,9 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     const double e1 = halves.error[1];
     if (!(e0 < worst && e1 < worst)) continue;
     // Below the relief band the level's mean error must not rise:
-    // e0 + e1 - E <= mean (estimated by the mean error bound at the start,
-    // which is above the true mean).
+    // e0 + e1 - E <= mean (the mean true error at the start).
     const bool relief = worst >= options.relief_fraction * result.worst_before;
-    if (!relief && e0 + e1 - worst > options.mean_rise_limit * mean_bound) continue;
+    if (!relief && e0 + e1 - worst > options.mean_rise_limit * mean_error) continue;
     if (!free_slot) {
       std::optional<Merge> merge = best_merge(i, worst);
       if (!merge) continue;
@@ -276,7 +279,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
         if (!exact[j]) value[j] = measure(level.spheres[j]), exact[j] = 1;
       }
       const double rise = merge->error - value[merge->first] - value[merge->second];
-      if (!relief && e0 + e1 - worst + rise > options.mean_rise_limit * mean_bound) continue;
+      if (!relief && e0 + e1 - worst + rise > options.mean_rise_limit * mean_error) continue;
       // The merged sphere replaces the first of the pair, the second goes.
       level.spheres[merge->first] = std::move(merge->sphere);
       level.medial[merge->first] = std::move(merge->medial);

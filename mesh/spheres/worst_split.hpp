@@ -42,9 +42,9 @@ struct WorstSplitOptions {
   /// sphere's true error is below the leaf's too (>= 0; above 1: no band).
   double relief_fraction = 0.85;
   /// Below the relief band a split is kept only when it raises the summed
-  /// true error by at most this multiple of the level's mean error bound at
-  /// the start (radius - depth, above the mean true error), so that the
-  /// level's mean error does not rise with its sphere count (>= 0).
+  /// true error by at most this multiple of the level's mean true error at
+  /// the start (measured on choice_directions), so that with the default 1
+  /// the level's mean error does not rise with its sphere count (>= 0).
   double mean_rise_limit = 1.0;
   ProtrusionPolishOptions polish;  ///< polish of the two halves (see polish_protrusion)
   /// Past this process CPU time no more leaf is tried (the level stays valid).
@@ -58,6 +58,7 @@ struct WorstSplitResult {
   int measured = 0;           ///< spheres whose true error was measured
   double worst_before = 0;    ///< largest true error of the level at the start (model units)
   double worst_after = 0;     ///< and at the end (<= worst_before)
+  double mean_before = 0;     ///< mean true error of the level at the start, on choice_directions
   int blocked_by_parent = 0;  ///< times the worst remaining leaf's parent was full
   int merges = 0;             ///< sibling pairs merged to make room for a split
 };
@@ -76,7 +77,7 @@ struct WorstSplitResult {
 /// `branching` children. It is made only when both halves' true errors are
 /// below E and, unless E >= relief_fraction times the starting worst (the
 /// relief band), their sum is below E + mean_rise_limit times the level's
-/// mean error bound. A leaf of the relief band without a free slot makes
+/// mean true error at the start (on choice_directions). A leaf of the relief band without a free slot makes
 /// room by merging the two overlapping siblings whose union fits the sphere
 /// of lowest error bound (fit_sphere on their samples, polish_sphere,
 /// polish_protrusion), when that sphere's true error is below E as well (the

@@ -306,6 +306,46 @@ TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst)
   EXPECT_LE(after, before);
 }
 
+TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondItsBound) {
+  // Without the relief band (relief_fraction > 1) a split is kept only when
+  // it adds at most the level's starting mean true error (on the choice
+  // directions) to the summed true error (on the measuring directions), and
+  // no merge happens. Recomputed here with sphere_protrusion on both leaf
+  // levels: the starting mean, and sum_after <= sum_before + splits * mean.
+  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
+  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  o.branching = 8;
+  o.medial_spacing = 1.0 / 6;
+  o.worst_split.measure_directions = 300;
+  o.worst_split.choice_directions = 100;
+  o.worst_split.relief_fraction = 2.0;
+  const SphereTreeBuild plain = [&] {
+    SphereTreeOptions p = o;
+    p.split_worst = false;
+    return build_sphere_tree(sphere, p);
+  }();
+  o.split_worst = true;
+  const SphereTreeBuild build = build_sphere_tree(sphere, o);
+  const auto& result = build.worst_split;
+  EXPECT_GT(result.splits, 0) << "the case must exercise the split";
+  EXPECT_EQ(result.merges, 0);
+  const MeshOracle oracle(sphere);
+  const icd::MatX3d measure = spiral_directions(o.worst_split.measure_directions);
+  const icd::MatX3d choice = spiral_directions(o.worst_split.choice_directions);
+  auto leaf_sum = [&](const icd::collision::SphereTree& tree, const icd::MatX3d& dirs) {
+    double sum = 0;
+    for (int i = tree.level_offset[tree.num_levels() - 1]; i < tree.num_nodes(); ++i)
+      sum += sphere_protrusion(oracle, tree.spheres[i].center(), tree.spheres[i].r, dirs);
+    return sum;
+  };
+  const int plain_leaves = plain.tree.num_nodes() - plain.tree.level_offset[2];
+  const double mean_before = leaf_sum(plain.tree, choice) / plain_leaves;
+  EXPECT_NEAR(result.mean_before, mean_before, 1e-12 * (1 + mean_before));
+  EXPECT_LE(leaf_sum(build.tree, measure),
+            leaf_sum(plain.tree, measure) + result.splits * mean_before + 1e-9);
+  EXPECT_EQ(build.tree.num_nodes() - build.tree.level_offset[2], plain_leaves + result.splits);
+}
+
 TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   SphereTreeOptions o = small_options();
