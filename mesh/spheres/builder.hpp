@@ -102,8 +102,11 @@ struct SphereTreeOptions {
   /// top-down pass lost, when both halves have a lower true error; near the
   /// worst (worst_split.relief_fraction) even when the mean rises and, in a
   /// full parent, after merging two siblings; below it only when the mean
-  /// does not rise. Coverage is kept; the true worst never rises.
-  bool split_worst = false;
+  /// does not rise. Coverage is kept; the true worst never rises. On by
+  /// default: over 7 perturbed dragon builds it took the leaf worst42 <= 80
+  /// in 6 instead of 3 (median 80.2 -> 73.7) with the mean unchanged within
+  /// the spread (median mean2562 21.07 -> 21.22), for about 10 s CPU.
+  bool split_worst = true;
   WorstSplitOptions worst_split;  ///< see split_worst_leaves (its deadline is time_limit's)
   /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),
   /// not wall-clock time, so a loaded machine does not change the tree; > 0).
