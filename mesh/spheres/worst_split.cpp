@@ -241,6 +241,8 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     return best;
   };
 
+  constexpr double kNoRelief = std::numeric_limits<double>::infinity();
+  double relief_threshold = options.relief_fraction * result.worst_before;
   std::vector<char> tried(value.size(), 0);
   while (result.tries < options.max_tries && CpuClock::now() < options.deadline) {
     for (size_t i = 0; i < done.size(); ++i) done[i] = tried[i];
@@ -254,7 +256,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
                            children[static_cast<size_t>(p)] < branching;
     if (!free_slot) {
       if (children[static_cast<size_t>(p)] >= branching) ++result.blocked_by_parent;
-      if (!(worst >= options.relief_fraction * result.worst_before)) {
+      if (!(worst >= relief_threshold)) {
         if (static_cast<long long>(level.spheres.size()) >= cap) break;  // nothing left to gain
         continue;
       }
@@ -263,18 +265,33 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     Halves halves = split_in_two(coarse, dense, oracle, reduction, level.spheres[i],
                                  level.medial[i], 7919u * static_cast<unsigned>(i) + 17u,
                                  options.polish, choice, directions);
-    if (halves.spheres.size() != 2) continue;
+    const bool relief = worst >= relief_threshold;
+    // A failed relief try: picks come largest true error first and splits
+    // leave smaller halves, so the first failure is at the level's worst
+    // leaf; with stop_relief_when_stuck the band closes there.
+    auto relief_failed = [&]() {
+      if (options.stop_relief_when_stuck) relief_threshold = kNoRelief;
+    };
+    if (halves.spheres.size() != 2) {
+      if (relief) ++result.relief_no_split, relief_failed();
+      continue;
+    }
     result.measured += 2;
     const double e0 = halves.error[0];
     const double e1 = halves.error[1];
-    if (!(e0 < worst && e1 < worst)) continue;
+    if (!(e0 < worst && e1 < worst)) {
+      if (relief) ++result.relief_no_split, relief_failed();
+      continue;
+    }
     // Below the relief band the level's mean error must not rise:
     // e0 + e1 - E <= mean (the mean true error at the start).
-    const bool relief = worst >= options.relief_fraction * result.worst_before;
     if (!relief && e0 + e1 - worst > options.mean_rise_limit * mean_error) continue;
     if (!free_slot) {
       std::optional<Merge> merge = best_merge(i, worst);
-      if (!merge) continue;
+      if (!merge) {
+        if (relief) ++result.relief_no_merge, relief_failed();
+        continue;
+      }
       for (size_t j : {merge->first, merge->second}) {
         if (!exact[j]) value[j] = measure(level.spheres[j]), exact[j] = 1;
       }

@@ -41,6 +41,10 @@ struct WorstSplitOptions {
   /// cap) gets one by merging two of its siblings into one sphere, when that
   /// sphere's true error is below the leaf's too (>= 0; above 1: no band).
   double relief_fraction = 0.85;
+  /// Close the relief band at its first failed try (the level's worst leaf
+  /// then cannot be split or given room, so its true worst is final): saves
+  /// the tries that would only split near-worst leaves.
+  bool stop_relief_when_stuck = false;
   /// Below the relief band a split is kept only when it raises the summed
   /// true error by at most this multiple of the level's mean true error at
   /// the start (measured on choice_directions), so that with the default 1
@@ -61,6 +65,12 @@ struct WorstSplitResult {
   double mean_before = 0;     ///< mean true error of the level at the start, on choice_directions
   int blocked_by_parent = 0;  ///< times the worst remaining leaf's parent was full
   int merges = 0;             ///< sibling pairs merged to make room for a split
+  /// Tries in the relief band that failed because a half's true error was not
+  /// below the leaf's (or the leaf did not divide in two)...
+  int relief_no_split = 0;
+  /// ... and because its parent (or the level) was full and no merge of two
+  /// siblings gave a sphere below the leaf's true error.
+  int relief_no_merge = 0;
 };
 
 /// Repeatedly, the leaf with the largest true error E (sphere_protrusion on

@@ -346,6 +346,37 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
   EXPECT_EQ(build.tree.num_nodes() - build.tree.level_offset[2], plain_leaves + result.splits);
 }
 
+TEST(SphereTreeBuilder, SplitWorstStopReliefWhenStuckClosesTheBandAtItsFirstFailure) {
+  // With stop_relief_when_stuck the relief band closes at its first failed
+  // try: at most one failure is counted, never more tries than without it,
+  // and every guarantee holds. The case must fail in the band at least twice
+  // without the option, so that the option has something to stop.
+  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
+  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  o.branching = 8;
+  o.medial_spacing = 1.0 / 6;
+  o.max_spheres_per_level = {1, 8, 40};
+  o.worst_split.measure_directions = 300;
+  o.worst_split.choice_directions = 100;
+  o.worst_split.relief_fraction = 0.5;
+  const SphereTreeBuild open = build_sphere_tree(sphere, o);
+  const auto& a = open.worst_split;
+  ASSERT_GE(a.relief_no_split + a.relief_no_merge, 2) << "the case must fail in the band twice";
+  o.worst_split.stop_relief_when_stuck = true;
+  const SphereTreeBuild build = build_sphere_tree(sphere, o);
+  const auto& b = build.worst_split;
+  EXPECT_LE(b.relief_no_split + b.relief_no_merge, 1);
+  EXPECT_LE(b.tries, a.tries);
+  EXPECT_LE(b.worst_after, b.worst_before);
+  const auto& tree = build.tree;
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  EXPECT_LE(tree.num_nodes() - tree.level_offset[2], 40);
+  expect_nodes_cover_and_children_divide(build);
+  const icd::MatX3d D = dense_random_points(sphere, 5000, 23);
+  for (int l = 0; l < tree.num_levels(); ++l)
+    EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+}
+
 TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   SphereTreeOptions o = small_options();
