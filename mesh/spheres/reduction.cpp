@@ -189,13 +189,15 @@ void distribute(const std::vector<int>& members, const std::vector<int>& owner,
 }  // namespace
 
 FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>& members,
-                        const FittedSphere* hint, const ReductionOptions& options) {
+                        const FittedSphere* hint, const ReductionOptions& options,
+                        const std::vector<Eigen::Vector3d>* extreme) {
   assert(!members.empty());
   FittedSphere out;
   out.tag = hint != nullptr ? hint->tag : -1;
   out.members = members;
   std::sort(out.members.begin(), out.members.end());
-  const std::vector<Eigen::Vector3d> hull = extreme_points(problem.points, members, true);
+  const std::vector<Eigen::Vector3d> hull =
+      extreme != nullptr ? *extreme : extreme_points(problem.points, members, true);
   double gmax = 0;
   for (int s : members) gmax = std::max(gmax, problem.gap[s]);
 
@@ -255,6 +257,32 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
     out.depth = 0;
   }
   refit_radius(problem, out);
+  return out;
+}
+
+std::vector<Eigen::Vector3d> member_extreme_points(const ReductionProblem& problem,
+                                                   const std::vector<int>& members) {
+  assert(!members.empty());
+  return extreme_points(problem.points, members, true);
+}
+
+std::vector<Eigen::Vector3d> union_extreme_points(const ReductionProblem& problem,
+                                                  const std::vector<int>& members,
+                                                  const std::vector<Eigen::Vector3d>& a,
+                                                  const std::vector<Eigen::Vector3d>& b) {
+  assert(!members.empty());
+  // Small or degenerate unions: member_extreme_points keeps every member.
+  if (members.size() <= 64) return extreme_points(problem.points, members, true);
+  std::vector<Point> in;
+  in.reserve(a.size() + b.size());
+  for (const auto* set : {&a, &b})
+    for (const auto& p : *set) in.emplace_back(p.x(), p.y(), p.z());
+  std::vector<Point> hull;
+  CGAL::extreme_points_3(in, std::back_inserter(hull));
+  if (hull.empty()) return extreme_points(problem.points, members, true);
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(hull.size());
+  for (const Point& p : hull) out.emplace_back(p.x(), p.y(), p.z());
   return out;
 }
 

@@ -52,8 +52,27 @@ struct ReductionOptions {
 /// `hint` (may be null) restricts the candidates to those inside it; without
 /// it the candidates inside the members' bounding ball are tried. Falls back
 /// to the members' bounding ball (depth 0) when no candidate is found.
+/// `extreme` (may be null): the members' extreme points when the caller
+/// knows them (member_extreme_points or union_extreme_points; any order),
+/// which saves the convex hull of all members.
 FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>& members,
-                        const FittedSphere* hint, const ReductionOptions& options);
+                        const FittedSphere* hint, const ReductionOptions& options,
+                        const std::vector<Eigen::Vector3d>* extreme = nullptr);
+
+/// The extreme points (convex hull vertices) of the samples `members`
+/// (non-empty) as fit_sphere() uses them: every member when there are at
+/// most 64, or when the members are coplanar.
+std::vector<Eigen::Vector3d> member_extreme_points(const ReductionProblem& problem,
+                                                   const std::vector<int>& members);
+
+/// member_extreme_points(problem, members) for `members` = the union of two
+/// sample sets whose member_extreme_points are `a` and `b`, computed from
+/// those alone (a hull vertex of the union is one of a or b): the same
+/// points, possibly in another order, at the cost of a hull of a and b.
+std::vector<Eigen::Vector3d> union_extreme_points(const ReductionProblem& problem,
+                                                  const std::vector<int>& members,
+                                                  const std::vector<Eigen::Vector3d>& a,
+                                                  const std::vector<Eigen::Vector3d>& b);
 
 /// Moves the centre of `sphere` (members given) off the medial candidates
 /// to lower its error bound max |s - c| + gap[s] - distance(c, surface):

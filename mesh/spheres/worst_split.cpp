@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <string>
@@ -143,6 +144,17 @@ std::vector<int> merged(const std::vector<int>& a, const std::vector<int>& b) {
   return out;
 }
 
+/// Sorted union of two sorted index lists (as merged(), in linear time).
+std::vector<int> merged_sorted(const std::vector<int>& a, const std::vector<int>& b) {
+  if (!std::is_sorted(a.begin(), a.end()) || !std::is_sorted(b.begin(), b.end()))
+    return merged(a, b);
+  std::vector<int> out;
+  out.reserve(a.size() + b.size());
+  std::merge(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 /// Two siblings replaced by one sphere (fitted to the union of their samples,
 /// centre polished for the bound and then for the true error).
 struct Merge {
@@ -172,6 +184,14 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
   for (const auto& s : level.spheres) value.push_back(s.radius - s.depth);
   exact.assign(value.size(), 0);
   done.assign(value.size(), 0);
+  // extreme[i]: member_extreme_points of leaf i once a merge search needed
+  // them (empty until then); the pair fits of the merge search take their
+  // union's from these instead of a hull of all members.
+  std::vector<std::vector<Eigen::Vector3d>> extreme(value.size());
+  auto extreme_of = [&](size_t i) -> const std::vector<Eigen::Vector3d>& {
+    if (extreme[i].empty()) extreme[i] = member_extreme_points(dense, level.spheres[i].members);
+    return extreme[i];
+  };
   std::vector<int> children;
   for (int p : level.parent) {
     if (p >= static_cast<int>(children.size())) children.resize(static_cast<size_t>(p) + 1, 0);
@@ -223,7 +243,10 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
         const FittedSphere& a = level.spheres[j];
         const FittedSphere& b = level.spheres[k];
         if ((a.center - b.center).norm() > a.radius + b.radius) continue;
-        FittedSphere fit = fit_sphere(dense, merged(a.members, b.members), nullptr, reduction);
+        const std::vector<int> members = merged_sorted(a.members, b.members);
+        const std::vector<Eigen::Vector3d> hull =
+            union_extreme_points(dense, members, extreme_of(j), extreme_of(k));
+        FittedSphere fit = fit_sphere(dense, members, nullptr, reduction, &hull);
         if (!(fit.error < limit) && fit.radius >= limit) continue;
         if (!best || fit.error < best->sphere.error) {
           best = Merge{j, k, std::move(fit), {}, 0.0};
@@ -300,6 +323,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       // The merged sphere replaces the first of the pair, the second goes.
       level.spheres[merge->first] = std::move(merge->sphere);
       level.medial[merge->first] = std::move(merge->medial);
+      extreme[merge->first].clear();
       value[merge->first] = merge->error;
       exact[merge->first] = 1;
       tried[merge->first] = 0;
@@ -307,6 +331,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       level.spheres.erase(level.spheres.begin() + gone);
       level.medial.erase(level.medial.begin() + gone);
       level.parent.erase(level.parent.begin() + gone);
+      extreme.erase(extreme.begin() + gone);
       value.erase(value.begin() + gone);
       exact.erase(exact.begin() + gone);
       done.erase(done.begin() + gone);
@@ -317,12 +342,14 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     }
     level.spheres[i] = std::move(halves.spheres[0]);
     level.medial[i] = std::move(halves.medial[0]);
+    extreme[i].clear();
     value[i] = e0;
     tried[i] = 0;
     const auto at = static_cast<std::ptrdiff_t>(i) + 1;
     level.spheres.insert(level.spheres.begin() + at, std::move(halves.spheres[1]));
     level.medial.insert(level.medial.begin() + at, std::move(halves.medial[1]));
     level.parent.insert(level.parent.begin() + at, p);
+    extreme.insert(extreme.begin() + at, std::vector<Eigen::Vector3d>{});
     value.insert(value.begin() + at, e1);
     exact.insert(exact.begin() + at, 1);
     done.insert(done.begin() + at, 0);
