@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <random>
 
 #include "mesh/io/primitives.hpp"
@@ -47,8 +48,10 @@ TEST(UnionExtreme, SameSetAsTheHullOfAllMembers) {
       const Eigen::Vector3d normal = Eigen::Vector3d::Random().normalized();
       for (int s = 0; s < n; ++s) {
         const double v = normal.dot(t.samples.points.row(s).transpose());
-        if (v < -0.5) a.push_back(s);
-        else if (v < 0.6) b.push_back(s);
+        if (v < -0.5)
+          a.push_back(s);
+        else if (v < 0.6)
+          b.push_back(s);
       }
     } else {
       std::bernoulli_distribution coin(0.5);
