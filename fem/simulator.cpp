@@ -170,9 +170,7 @@ Simulator::Check Simulator::evaluate_bound(const Check& before, const State& s, 
   // The elastic energy of s is >= 0 (bound_checks()): KE + load potential
   // alone growing past the allowance fails the full check too.
   const double growth = c.kinetic - (before.kinetic + before.elastic) + (c.load - before.load);
-  const double allowed = m_options.max_energy_growth *
-                             (before.kinetic + before.elastic + std::abs(c.load - before.load)) +
-                         m_energy_floor;
+  const double allowed = allowed_growth(before, c.load);
   if (!(growth <= allowed)) {
     std::ostringstream os;
     os << "total energy grew by at least " << growth << " J (allowed " << allowed << " J): kinetic "
@@ -182,6 +180,11 @@ Simulator::Check Simulator::evaluate_bound(const Check& before, const State& s, 
     c.message = os.str();
   }
   return c;
+}
+
+double Simulator::allowed_growth(const Check& before, double load) const {
+  return m_options.max_energy_growth * (before.kinetic + before.elastic + std::abs(load - before.load)) +
+         m_energy_floor;
 }
 
 Simulator::Check Simulator::evaluate(const Check& before, const State& s, const StateEnergies& energies,
@@ -206,9 +209,7 @@ Simulator::Check Simulator::evaluate(const Check& before, const State& s, const 
   }
   c.elastic = h.energy;
   const double growth = (c.kinetic + c.elastic) - (before.kinetic + before.elastic) + (c.load - before.load);
-  const double allowed = m_options.max_energy_growth *
-                             (before.kinetic + before.elastic + std::abs(c.load - before.load)) +
-                         m_energy_floor;
+  const double allowed = allowed_growth(before, c.load);
   if (!(growth <= allowed)) {
     std::ostringstream os;
     os << "total energy grew by " << growth << " J (allowed " << allowed << " J): kinetic "

@@ -155,6 +155,10 @@ class Simulator {
   Check evaluate_bound(const Check& before, const State& s, const StateEnergies& energies, bool oriented);
   /// Whether the checks inside a frame use EnergyCheck::Bound.
   bool bound_checks() const;
+  /// The total-energy growth a step may show over the accepted check before
+  /// (max_energy_growth of its energy and of the load potential's change to
+  /// `load`, plus the energy floor), J; shared by both checks.
+  double allowed_growth(const Check& before, double load) const;
   /// Check failure naming the first node of s with a non-finite x or v
   /// (called when the kinetic energy or the load potential is not finite).
   Check nonfinite_state(const State& s) const;
