@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -217,6 +219,42 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
   for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
 }
 
+/// Options of the leaf-budget tests: the icosphere's coarse medial samples
+/// with branching 8 make the top-down pass lose leaves, so the fill and the
+/// worst-leaf split have free slots to use.
+SphereTreeOptions lossy_leaf_options() {
+  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  o.branching = 8;
+  o.medial_spacing = 1.0 / 6;
+  o.worst_split.measure_directions = 300;
+  o.worst_split.choice_directions = 100;
+  return o;
+}
+
+/// Every level of `tree` covers a dense random sampling of `mesh` (brute force).
+void expect_every_level_covers(const icd::collision::SphereTree& tree, const icd::SurfaceMesh& mesh,
+                               unsigned seed) {
+  const icd::MatX3d D = dense_random_points(mesh, 5000, seed);
+  for (int l = 0; l < tree.num_levels(); ++l)
+    EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+}
+
+/// Protrusion of each leaf of `tree` on `directions` (recomputed here with
+/// sphere_protrusion, independently of the builder's bookkeeping).
+std::vector<double> leaf_protrusions(const icd::collision::SphereTree& tree, const MeshOracle& oracle,
+                                     const icd::MatX3d& directions) {
+  std::vector<double> e;
+  for (int i = tree.level_offset[tree.num_levels() - 1]; i < tree.num_nodes(); ++i)
+    e.push_back(sphere_protrusion(oracle, tree.spheres[i].center(), tree.spheres[i].r, directions));
+  return e;
+}
+
+double leaf_worst_protrusion(const icd::collision::SphereTree& tree, const MeshOracle& oracle,
+                             const icd::MatX3d& directions) {
+  const std::vector<double> e = leaf_protrusions(tree, oracle, directions);
+  return e.empty() ? 0.0 : std::max(0.0, *std::max_element(e.begin(), e.end()));
+}
+
 TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   // Splitting leaves to spend the lost budget. On this sphere (coarse medial
   // samples, branching 8) the top-down pass loses leaves and the fill splits
@@ -225,9 +263,7 @@ TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   // parent's samples (so each parent covers the union of its children's
   // patches), and every level covers a dense random sampling (brute force).
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
-  o.branching = 8;
-  o.medial_spacing = 1.0 / 6;
+  SphereTreeOptions o = lossy_leaf_options();
   o.split_worst = false;  // counts the fill's splits alone
   const SphereTreeBuild plain = build_sphere_tree(sphere, o);
   o.fill_leaf_budget = true;
@@ -242,19 +278,7 @@ TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   EXPECT_LE(leaves, 64);
   expect_nodes_cover_and_children_divide(build);
   for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-  const icd::MatX3d D = dense_random_points(sphere, 5000, 13);
-  for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
-}
-
-/// Largest protrusion of the leaves of `tree` on `directions` (recomputed
-/// here with sphere_protrusion, independently of the builder's bookkeeping).
-double leaf_worst_protrusion(const icd::collision::SphereTree& tree, const MeshOracle& oracle,
-                             const icd::MatX3d& directions) {
-  double worst = 0;
-  for (int i = tree.level_offset[tree.num_levels() - 1]; i < tree.num_nodes(); ++i)
-    worst = std::max(worst, sphere_protrusion(oracle, tree.spheres[i].center(), tree.spheres[i].r,
-                                              directions));
-  return worst;
+  expect_every_level_covers(tree, sphere, 13);
 }
 
 TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst) {
@@ -268,11 +292,7 @@ TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst)
   // largest leaf protrusion on the measuring directions, recomputed here,
   // equals the reported one and is not above the start's.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
-  o.branching = 8;
-  o.medial_spacing = 1.0 / 6;
-  o.worst_split.measure_directions = 300;
-  o.worst_split.choice_directions = 100;
+  SphereTreeOptions o = lossy_leaf_options();
   o.split_worst = false;
   const SphereTreeBuild plain = build_sphere_tree(sphere, o);
   o.split_worst = true;
@@ -289,9 +309,7 @@ TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst)
   EXPECT_LE(leaves, 64);
   for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
   expect_nodes_cover_and_children_divide(build);
-  const icd::MatX3d D = dense_random_points(sphere, 5000, 17);
-  for (int l = 0; l < tree.num_levels(); ++l)
-    EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+  expect_every_level_covers(tree, sphere, 17);
   // Inner levels are untouched: the split divides a leaf's samples.
   for (int i = 0; i < tree.level_offset[2]; ++i) {
     EXPECT_EQ(tree.spheres[i].r, plain.tree.spheres[i].r);
@@ -313,11 +331,7 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
   // no merge happens. Recomputed here with sphere_protrusion on both leaf
   // levels: the starting mean, and sum_after <= sum_before + splits * mean.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
-  o.branching = 8;
-  o.medial_spacing = 1.0 / 6;
-  o.worst_split.measure_directions = 300;
-  o.worst_split.choice_directions = 100;
+  SphereTreeOptions o = lossy_leaf_options();
   o.worst_split.relief_fraction = 2.0;
   const SphereTreeBuild plain = [&] {
     SphereTreeOptions p = o;
@@ -333,10 +347,8 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
   const icd::MatX3d measure = spiral_directions(o.worst_split.measure_directions);
   const icd::MatX3d choice = spiral_directions(o.worst_split.choice_directions);
   auto leaf_sum = [&](const icd::collision::SphereTree& tree, const icd::MatX3d& dirs) {
-    double sum = 0;
-    for (int i = tree.level_offset[tree.num_levels() - 1]; i < tree.num_nodes(); ++i)
-      sum += sphere_protrusion(oracle, tree.spheres[i].center(), tree.spheres[i].r, dirs);
-    return sum;
+    const std::vector<double> e = leaf_protrusions(tree, oracle, dirs);
+    return std::accumulate(e.begin(), e.end(), 0.0);
   };
   const int plain_leaves = plain.tree.num_nodes() - plain.tree.level_offset[2];
   const double mean_before = leaf_sum(plain.tree, choice) / plain_leaves;
@@ -352,12 +364,8 @@ TEST(SphereTreeBuilder, SplitWorstStopReliefWhenStuckClosesTheBandAtItsFirstFail
   // and every guarantee holds. The case must fail in the band at least twice
   // without the option, so that the option has something to stop.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
-  o.branching = 8;
-  o.medial_spacing = 1.0 / 6;
+  SphereTreeOptions o = lossy_leaf_options();
   o.max_spheres_per_level = {1, 8, 40};
-  o.worst_split.measure_directions = 300;
-  o.worst_split.choice_directions = 100;
   o.worst_split.relief_fraction = 0.5;
   const SphereTreeBuild open = build_sphere_tree(sphere, o);
   const auto& a = open.worst_split;
@@ -372,9 +380,7 @@ TEST(SphereTreeBuilder, SplitWorstStopReliefWhenStuckClosesTheBandAtItsFirstFail
   EXPECT_NO_THROW(icd::collision::validate(tree));
   EXPECT_LE(tree.num_nodes() - tree.level_offset[2], 40);
   expect_nodes_cover_and_children_divide(build);
-  const icd::MatX3d D = dense_random_points(sphere, 5000, 23);
-  for (int l = 0; l < tree.num_levels(); ++l)
-    EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+  expect_every_level_covers(tree, sphere, 23);
 }
 
 TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
