@@ -1,6 +1,6 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
-//                   [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]
+//                   [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS] [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
 //                   [--polish 0|1] [--polish-rounds N] [--polish-evals N]
@@ -169,7 +169,7 @@ icd::collision::SphereTree fit_leaves_to_probes(const icd::SurfaceMesh& mesh,
 void print_usage(std::ostream& os) {
   os << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
         " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-        " [--worst-share F] [--coverage-spacing UNITS] [--reduction split|merge|both]"
+        " [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS] [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
         " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]"
@@ -220,6 +220,8 @@ int main(int argc, char** argv) {
       options.joint_leaf_refinement = std::atoi(value) != 0;
     else if (key == "--worst-share")
       options.worst_share = std::atof(value);
+    else if (key == "--leaf-worst-target")
+      options.leaf_worst_target = std::atof(value);
     else if (key == "--lloyd")
       options.lloyd_iterations = std::atoi(value);
     else if (key == "--octree")
@@ -354,13 +356,18 @@ int main(int argc, char** argv) {
           options.worst_split.measure_directions, unit * w.worst_before, unit * w.worst_after,
           options.worst_split.choice_directions, unit * w.mean_before);
     }
+    const double to_2000 =
+        2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    std::printf("# %s allocation: largest worst child bound chosen per level (medial samples):",
+                model.name.c_str());
+    for (size_t l = 0; l < ours.allocated_worst_bound.size(); ++l)
+      std::printf(" %zu: %.1f;", l + 1, to_2000 * ours.allocated_worst_bound[l]);
+    std::printf("\n");
     std::printf("# %s build steps (CPU s):", model.name.c_str());
     for (const auto& [step, seconds] : ours.step_cpu_seconds)
       std::printf(" %s %.1f;", step.c_str(), seconds);
     std::printf("\n");
     // The builder's own error bound (radius - centre depth), normalized, per level.
-    const double to_2000 =
-        2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
     for (int l = 0; l < ours.tree.num_levels(); ++l) {
       double worst = 0, sum = 0;
       const int begin = ours.tree.level_offset[static_cast<size_t>(l)],

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "mesh/io/error.hpp"
+#include "mesh/spheres/allocation.hpp"
 #include "mesh/spheres/medial_axis.hpp"
 #include "mesh/spheres/mesh_oracle.hpp"
 #include "mesh/spheres/point_grid.hpp"
@@ -38,6 +39,7 @@ void check_options(const SphereTreeOptions& o) {
     fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
   }
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
+  if (!(o.leaf_worst_target >= 0)) fail("leaf_worst_target must be >= 0");
   if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
       o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
       !(o.worst_split.mean_rise_limit >= 0)) {
@@ -74,45 +76,6 @@ bool better_config(const std::vector<FittedSphere>& a, const std::vector<FittedS
   for (const auto& s : b) wb = std::max(wb, s.error);
   if (wa != wb) return wa < wb;
   return ParentChoices::total_error(a) < ParentChoices::total_error(b);
-}
-
-/// How many children each parent gets under a total cap: start with one
-/// each; give the first (1 - worst_share) of the extra spheres, one at a time,
-/// to the parent whose summed child error drops most, then the rest to the
-/// parent whose worst child error is largest.
-std::vector<int> allocate_children(const std::vector<ParentChoices>& choices, int cap,
-                                   double worst_share) {
-  std::vector<int> count(choices.size(), 1);
-  const long long extra = std::max<long long>(0, cap - static_cast<long long>(choices.size()));
-  const auto by_worst =
-      static_cast<long long>(std::llround(worst_share * static_cast<double>(extra)));
-  auto run = [&](long long n, bool worst_rule) {
-    auto gain = [&](size_t p) {
-      const int k = count[p];
-      const auto& cfg = choices[p].configs;
-      if (k >= static_cast<int>(cfg.size())) return -1.0;
-      if (worst_rule) {
-        double worst = 0;
-        for (const auto& sp : cfg[static_cast<size_t>(k - 1)]) worst = std::max(worst, sp.error);
-        return worst;
-      }
-      return ParentChoices::total_error(cfg[static_cast<size_t>(k - 1)]) -
-             ParentChoices::total_error(cfg[static_cast<size_t>(k)]);
-    };
-    std::priority_queue<std::pair<double, size_t>> heap;
-    for (size_t p = 0; p < choices.size(); ++p) heap.emplace(gain(p), p);
-    while (n > 0 && !heap.empty()) {
-      const size_t p = heap.top().second;
-      heap.pop();
-      if (count[p] >= static_cast<int>(choices[p].configs.size())) continue;
-      count[p] += 1;
-      --n;
-      heap.emplace(gain(p), p);
-    }
-  };
-  run(extra - by_worst, false);
-  run(by_worst, true);
-  return count;
 }
 
 /// The sphere cap of level l: branching^l, lowered by max_spheres_per_level[l] when positive.
@@ -498,8 +461,24 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       cap = std::min<long long>(cap, options.max_spheres_per_level[static_cast<size_t>(l)]);
     }
     cap = std::max<long long>(cap, static_cast<long long>(parents.size()));
-    const std::vector<int> count = allocate_children(
-        choices, static_cast<int>(std::min<long long>(cap, 1LL << 30)), options.worst_share);
+    std::vector<ChildCountCosts> costs(choices.size());
+    for (size_t p = 0; p < choices.size(); ++p) {
+      for (const auto& config : choices[p].configs) {
+        double worst = 0;
+        for (const auto& sp : config) worst = std::max(worst, sp.error);
+        costs[p].worst.push_back(worst);
+        costs[p].sum.push_back(ParentChoices::total_error(config));
+      }
+    }
+    AllocationOptions allocation;
+    allocation.worst_share = options.worst_share;
+    if (l == options.depth) allocation.worst_threshold = options.leaf_worst_target * scale;
+    const std::vector<int> count =
+        allocate_children(costs, std::min<long long>(cap, 1LL << 30), allocation);
+    double allocated_worst = 0;
+    for (size_t p = 0; p < costs.size(); ++p)
+      allocated_worst = std::max(allocated_worst, costs[p].worst[static_cast<size_t>(count[p] - 1)]);
+    out.allocated_worst_bound.push_back(allocated_worst);
 
     std::vector<Node> children;
     std::vector<int> parent_index;

@@ -42,6 +42,12 @@ struct SphereTreeOptions {
   /// mean error), the rest to the parents with the worst child (favours the
   /// worst error). In [0, 1].
   double worst_share = 0.2;
+  /// When > 0 (relative, like the spacings): the leaf level's cap is shared
+  /// by the threshold rule of allocate_children() instead of worst_share:
+  /// first each parent the fewest children whose worst error bound (on the
+  /// medial samples) is <= leaf_worst_target * longest side, then the rest
+  /// where the summed bound drops most. Upper levels keep worst_share.
+  double leaf_worst_target = 0;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;
@@ -136,6 +142,9 @@ struct SphereTreeBuild {
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
   int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget
   WorstSplitResult worst_split;    ///< what split_worst_leaves did (with split_worst)
+  /// For each level l >= 1 (index l - 1): the largest worst child error bound
+  /// (medial samples, model units) of the configurations the allocation chose.
+  std::vector<double> allocated_worst_bound;
   /// Process CPU seconds of each build step, in order (step name, seconds).
   std::vector<std::pair<std::string, double>> step_cpu_seconds;
 };
