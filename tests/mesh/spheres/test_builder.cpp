@@ -447,6 +447,44 @@ TEST(SphereTreeBuilder, RespectsSphereCapsPerLevel) {
   EXPECT_NO_THROW(icd::collision::validate(build.tree));
 }
 
+TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuarantee) {
+  // The threshold rule at the leaf level (leaf_worst_target). The default
+  // rule's leaf allocation within the cap reaches a largest worst child bound
+  // W, so a target of 1.2 W is feasible (every parent's fewest children below
+  // it are at most its count there): the threshold build's largest allocated
+  // bound must be <= the target. Level 1 keeps the default rule (same bound).
+  // Both a feasible and an unreachable target (1e-9) keep every guarantee:
+  // caps, nodes cover their samples with margin, children divide them, every
+  // level covers a dense random sampling (brute force).
+  const icd::SurfaceMesh torus = icd::make_torus(1.0, 0.3, 24, 12);
+  SphereTreeOptions o = small_options();
+  o.max_spheres_per_level = {1, 4, 10};
+  const SphereTreeBuild plain = build_sphere_tree(torus, o);
+  ASSERT_EQ(plain.allocated_worst_bound.size(), 2u);
+  const double scale = (torus.V.colwise().maxCoeff() - torus.V.colwise().minCoeff()).maxCoeff();
+  const double target = 1.2 * plain.allocated_worst_bound[1];
+  ASSERT_GT(target, 0);
+  for (const double relative : {target / scale, 1e-9}) {
+    SCOPED_TRACE(relative);
+    o.leaf_worst_target = relative;
+    const SphereTreeBuild build = build_sphere_tree(torus, o);
+    const auto& tree = build.tree;
+    EXPECT_NO_THROW(icd::collision::validate(tree));
+    ASSERT_EQ(tree.num_levels(), 3);
+    ASSERT_EQ(build.allocated_worst_bound.size(), 2u);
+    EXPECT_EQ(build.allocated_worst_bound[0], plain.allocated_worst_bound[0]);
+    if (relative > 1e-6) {
+      EXPECT_LE(build.allocated_worst_bound[1], target * (1 + 1e-12));
+    }
+    EXPECT_LE(tree.level_offset[3] - tree.level_offset[2], 10);
+    for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+    expect_nodes_cover_and_children_divide(build);
+    expect_every_level_covers(tree, torus, 19);
+  }
+  o.leaf_worst_target = -0.1;
+  EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
+}
+
 TEST(SphereTreeBuilder, RejectsBadOptionsAndMeshes) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   SphereTreeOptions o = small_options();
