@@ -10,7 +10,7 @@
 //                                        evaluation directions, to show what that fit does)
 //                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
 //                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]
-//                   [--split-stop-stuck 0|1]  (split_worst)
+//                   [--split-stop-stuck 0|1] [--split-redivide N]  (split_worst)
 //                   [--flat N]  (diagnostic: one level of at most N spheres under the root,
 //                                every other step as usual: the cost of the nested partition)
 //                   [--perturb E]  (build for the mesh scaled by 1 + E, evaluate on the
@@ -174,7 +174,7 @@ void print_usage(std::ostream& os) {
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
         " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]"
         " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]"
-        " [--split-stop-stuck 0|1]"
+        " [--split-stop-stuck 0|1] [--split-redivide N]"
         " [--flat N]\n"
         "       sphere_tree_table --help\n";
 }
@@ -242,6 +242,8 @@ int main(int argc, char** argv) {
       options.worst_split.mean_rise_limit = std::atof(value);
     else if (key == "--split-stop-stuck")
       options.worst_split.stop_relief_when_stuck = std::atoi(value) != 0;
+    else if (key == "--split-redivide")
+      options.worst_split.redivide_siblings = std::atoi(value);
     else if (key == "--split-tries")
       options.worst_split.max_tries = std::atoi(value);
     else if (key == "--flat") {
@@ -349,10 +351,10 @@ int main(int argc, char** argv) {
       const double unit = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
       std::printf(
           "# %s worst split: %d splits in %d tries (%d merges; %d worst leaves with a full parent; "
-          "relief band: %d without two better halves, %d without a merge), %d "
-          "spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d dirs) %.2f\n",
+          "relief band: %d without two better halves, %d without a merge; %d re-divided with a "
+          "sibling), %d spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d dirs) %.2f\n",
           model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent,
-          w.relief_no_split, w.relief_no_merge, w.measured,
+          w.relief_no_split, w.relief_no_merge, w.redivisions, w.measured,
           options.worst_split.measure_directions, unit * w.worst_before, unit * w.worst_after,
           options.worst_split.choice_directions, unit * w.mean_before);
     }

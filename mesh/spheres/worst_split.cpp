@@ -18,10 +18,10 @@ namespace {
 
 void check_arguments(const WorstSplitOptions& o, int cap, int branching) {
   if (o.measure_directions < 1 || o.choice_directions < 1 || o.max_tries < 0 ||
-      !(o.relief_fraction >= 0) || !(o.mean_rise_limit >= 0))
+      !(o.relief_fraction >= 0) || !(o.mean_rise_limit >= 0) || o.redivide_siblings < 0)
     throw ParameterError(
         "WorstSplitOptions: measure_directions and choice_directions must be >= 1, max_tries >= 0 "
-        "and relief_fraction, mean_rise_limit >= 0");
+        "and relief_fraction, mean_rise_limit, redivide_siblings >= 0");
   if (cap < 0 || branching < 2)
     throw ParameterError("split_worst_leaves: cap must be >= 0 and branching >= 2, got " +
                          std::to_string(cap) + " and " + std::to_string(branching));
@@ -264,9 +264,50 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     return best;
   };
 
+  std::vector<char> tried(value.size(), 0);
+  // Leaf i (true error `worst`) and one of its overlapping siblings, nearest
+  // centre first, re-divided into two spheres whose true errors are both
+  // below `worst`; true when a pair was replaced (indices unchanged).
+  auto redivide = [&](size_t i, double worst) {
+    const int p = level.parent[i];
+    std::vector<std::pair<double, size_t>> near;
+    for (size_t j = 0; j < level.spheres.size(); ++j) {
+      if (j == i || level.parent[j] != p) continue;
+      const double d = (level.spheres[j].center - level.spheres[i].center).norm();
+      if (d <= level.spheres[i].radius + level.spheres[j].radius) near.emplace_back(d, j);
+    }
+    std::sort(near.begin(), near.end());
+    if (near.size() > static_cast<size_t>(options.redivide_siblings))
+      near.resize(static_cast<size_t>(options.redivide_siblings));
+    for (const auto& [d, j] : near) {
+      FittedSphere joint;
+      joint.members = merged_sorted(level.spheres[i].members, level.spheres[j].members);
+      joint.tag = level.spheres[i].tag;
+      const std::vector<int> joint_medial = merged(level.medial[i], level.medial[j]);
+      Halves h = split_in_two(coarse, dense, oracle, reduction, joint, joint_medial,
+                              7919u * static_cast<unsigned>(i) + 31u * static_cast<unsigned>(j) + 5u,
+                              options.polish, choice, directions);
+      if (h.spheres.size() != 2) continue;
+      result.measured += 2;
+      if (!(h.error[0] < worst && h.error[1] < worst)) continue;
+      h.spheres[1].tag = level.spheres[j].tag;
+      for (size_t k = 0; k < 2; ++k) {
+        const size_t at = k == 0 ? i : j;
+        level.spheres[at] = std::move(h.spheres[k]);
+        level.medial[at] = std::move(h.medial[k]);
+        extreme[at].clear();
+        value[at] = h.error[k];
+        exact[at] = 1;
+        tried[at] = 0;
+      }
+      ++result.redivisions;
+      return true;
+    }
+    return false;
+  };
+
   constexpr double kNoRelief = std::numeric_limits<double>::infinity();
   double relief_threshold = options.relief_fraction * result.worst_before;
-  std::vector<char> tried(value.size(), 0);
   while (result.tries < options.max_tries && CpuClock::now() < options.deadline) {
     for (size_t i = 0; i < done.size(); ++i) done[i] = tried[i];
     const int pick = top();
@@ -295,15 +336,20 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     auto relief_failed = [&]() {
       if (options.stop_relief_when_stuck) relief_threshold = kNoRelief;
     };
+    auto no_split = [&]() {
+      if (!relief) return;
+      if (options.redivide_siblings > 0 && redivide(i, worst)) return;
+      ++result.relief_no_split, relief_failed();
+    };
     if (halves.spheres.size() != 2) {
-      if (relief) ++result.relief_no_split, relief_failed();
+      no_split();
       continue;
     }
     result.measured += 2;
     const double e0 = halves.error[0];
     const double e1 = halves.error[1];
     if (!(e0 < worst && e1 < worst)) {
-      if (relief) ++result.relief_no_split, relief_failed();
+      no_split();
       continue;
     }
     // Below the relief band the level's mean error must not rise:
@@ -312,7 +358,8 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     if (!free_slot) {
       std::optional<Merge> merge = best_merge(i, worst);
       if (!merge) {
-        if (relief) ++result.relief_no_merge, relief_failed();
+        if (relief && !(options.redivide_siblings > 0 && redivide(i, worst)))
+          ++result.relief_no_merge, relief_failed();
         continue;
       }
       for (size_t j : {merge->first, merge->second}) {

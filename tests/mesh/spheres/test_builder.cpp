@@ -383,6 +383,43 @@ TEST(SphereTreeBuilder, SplitWorstStopReliefWhenStuckClosesTheBandAtItsFirstFail
   expect_every_level_covers(tree, sphere, 23);
 }
 
+TEST(SphereTreeBuilder, SplitWorstRedivideWithASiblingKeepsEveryGuarantee) {
+  // The case of the test above fails in the relief band: re-dividing the
+  // stuck leaf together with a sibling (redivide_siblings) must happen at
+  // least once and keep every guarantee: the leaf count bookkeeping (a
+  // re-division keeps it: plain + splits - merges), the cap and branching,
+  // the true worst on the measuring directions (recomputed here) equal to the
+  // reported one and not above the start's (recomputed on the build without
+  // the split), coverage with margin, children dividing their parent's
+  // samples, and every level covering a dense random sampling.
+  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
+  SphereTreeOptions o = lossy_leaf_options();
+  o.max_spheres_per_level = {1, 8, 40};
+  o.worst_split.relief_fraction = 0.5;
+  o.worst_split.redivide_siblings = 3;
+  SphereTreeOptions p = o;
+  p.split_worst = false;
+  const SphereTreeBuild plain = build_sphere_tree(sphere, p);
+  const SphereTreeBuild build = build_sphere_tree(sphere, o);
+  const auto& r = build.worst_split;
+  EXPECT_GT(r.redivisions, 0) << "the case must exercise the re-division";
+  const auto& tree = build.tree;
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  const int leaves = tree.num_nodes() - tree.level_offset[2];
+  EXPECT_EQ(leaves, plain.tree.num_nodes() - plain.tree.level_offset[2] + r.splits - r.merges);
+  EXPECT_LE(leaves, 40);
+  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+  const MeshOracle oracle(sphere);
+  const icd::MatX3d dirs = spiral_directions(o.worst_split.measure_directions);
+  EXPECT_NEAR(r.worst_before, leaf_worst_protrusion(plain.tree, oracle, dirs), 1e-12);
+  EXPECT_NEAR(r.worst_after, leaf_worst_protrusion(tree, oracle, dirs), 1e-12);
+  EXPECT_LE(r.worst_after, r.worst_before);
+  expect_nodes_cover_and_children_divide(build);
+  expect_every_level_covers(tree, sphere, 29);
+  o.worst_split.redivide_siblings = -1;
+  EXPECT_THROW(build_sphere_tree(sphere, o), icd::ParameterError);
+}
+
 TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   SphereTreeOptions o = small_options();
