@@ -25,6 +25,26 @@ enum class LaneCheck {
   Orientation  ///< det F of every lane only (inversion and NaN test)
 };
 
+/// Nodal forces from the first Piola-Kirchhoff stress (or its differential)
+/// of the lanes of one block: H = -V P Dm^-T, nodes 1..3 are its columns,
+/// node 0 minus their sum; out[e][12] for the `count` valid lanes.
+[[gnu::always_inline]] inline void scatter_nodal(const double (*P)[kLanes], const Block& b, int count,
+                                                 double (*out)[12]) {
+  double H[9][kLanes];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < kLanes; ++l)
+        H[3 * r + c][l] = -b.volume[l] * (P[3 * r][l] * b.dinv[c][l] + P[3 * r + 1][l] * b.dinv[c + 3][l] +
+                                          P[3 * r + 2][l] * b.dinv[c + 6][l]);
+  for (int l = 0; l < count; ++l)
+    for (int r = 0; r < 3; ++r) {
+      out[l][3 + r] = H[3 * r][l];
+      out[l][6 + r] = H[3 * r + 1][l];
+      out[l][9 + r] = H[3 * r + 2][l];
+      out[l][r] = -(H[3 * r][l] + H[3 * r + 1][l] + H[3 * r + 2][l]);
+    }
+}
+
 /// Forces of the elements of one block. x: positions (#V x 3 row-major);
 /// tets: the block's first tet (4 indices each); count <= 8 valid lanes.
 /// Writes out[e][12] (nodal forces of node 0..3) for the valid lanes.
@@ -149,20 +169,7 @@ template <MaterialModel kModel, LaneCheck kCheck = LaneCheck::None>
       P[8][l] = mu * F[8][l] + s * C8;
     }
   }
-  // H = -V P Dm^-T; nodes 1..3 are its columns, node 0 minus their sum.
-  double H[9][kLanes];
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      for (int l = 0; l < kLanes; ++l)
-        H[3 * r + c][l] = -b.volume[l] * (P[3 * r][l] * b.dinv[c][l] + P[3 * r + 1][l] * b.dinv[c + 3][l] +
-                                          P[3 * r + 2][l] * b.dinv[c + 6][l]);
-  for (int l = 0; l < count; ++l)
-    for (int r = 0; r < 3; ++r) {
-      out[l][3 + r] = H[3 * r][l];
-      out[l][6 + r] = H[3 * r + 1][l];
-      out[l][9 + r] = H[3 * r + 2][l];
-      out[l][r] = -(H[3 * r][l] + H[3 * r + 1][l] + H[3 * r + 2][l]);
-    }
+  scatter_nodal(P, b, count, out);
 }
 
 /// Force differentials df = -K(x) dx of the elements of one block (the
@@ -255,19 +262,7 @@ template <MaterialModel kModel>
       for (int k = 0; k < 9; ++k) dP[k][l] = mu * g[k] + lp * cdf * C[k] + s * (dC[k] + dC2[k]);
     }
   }
-  double H[9][kLanes];
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      for (int l = 0; l < kLanes; ++l)
-        H[3 * r + c][l] = -b.volume[l] * (dP[3 * r][l] * b.dinv[c][l] + dP[3 * r + 1][l] * b.dinv[c + 3][l] +
-                                          dP[3 * r + 2][l] * b.dinv[c + 6][l]);
-  for (int l = 0; l < count; ++l)
-    for (int r = 0; r < 3; ++r) {
-      out[l][3 + r] = H[3 * r][l];
-      out[l][6 + r] = H[3 * r + 1][l];
-      out[l][9 + r] = H[3 * r + 2][l];
-      out[l][r] = -(H[3 * r][l] + H[3 * r + 1][l] + H[3 * r + 2][l]);
-    }
+  scatter_nodal(dP, b, count, out);
 }
 
 }  // namespace icd::fem::lanes
