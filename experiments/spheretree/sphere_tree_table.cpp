@@ -1,6 +1,7 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
-//                   [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS] [--reduction split|merge|both]
+//                   [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS]
+//                   [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
 //                   [--polish 0|1] [--polish-rounds N] [--polish-evals N]
@@ -169,7 +170,8 @@ icd::collision::SphereTree fit_leaves_to_probes(const icd::SurfaceMesh& mesh,
 void print_usage(std::ostream& os) {
   os << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
         " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-        " [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS] [--reduction split|merge|both]"
+        " [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS]"
+        " [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
         " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]"

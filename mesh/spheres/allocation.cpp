@@ -122,7 +122,8 @@ std::vector<int> allocate_children(const std::vector<ChildCountCosts>& costs, lo
     allocate_with_threshold(costs, extra, options.worst_threshold, count);
   else
     allocate_fixed_split(costs, extra, options.worst_share, count);
-  for (size_t p = 0; p < costs.size(); ++p) assert(count[p] >= 1 && count[p] <= max_count(costs[p]));
+  for (size_t p = 0; p < costs.size(); ++p)
+    assert(count[p] >= 1 && count[p] <= max_count(costs[p]));
   return count;
 }
 

@@ -477,7 +477,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
         allocate_children(costs, std::min<long long>(cap, 1LL << 30), allocation);
     double allocated_worst = 0;
     for (size_t p = 0; p < costs.size(); ++p)
-      allocated_worst = std::max(allocated_worst, costs[p].worst[static_cast<size_t>(count[p] - 1)]);
+      allocated_worst =
+          std::max(allocated_worst, costs[p].worst[static_cast<size_t>(count[p] - 1)]);
     out.allocated_worst_bound.push_back(allocated_worst);
 
     std::vector<Node> children;

@@ -284,9 +284,10 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       joint.members = merged_sorted(level.spheres[i].members, level.spheres[j].members);
       joint.tag = level.spheres[i].tag;
       const std::vector<int> joint_medial = merged(level.medial[i], level.medial[j]);
-      Halves h = split_in_two(coarse, dense, oracle, reduction, joint, joint_medial,
-                              7919u * static_cast<unsigned>(i) + 31u * static_cast<unsigned>(j) + 5u,
-                              options.polish, choice, directions);
+      Halves h =
+          split_in_two(coarse, dense, oracle, reduction, joint, joint_medial,
+                       7919u * static_cast<unsigned>(i) + 31u * static_cast<unsigned>(j) + 5u,
+                       options.polish, choice, directions);
       if (h.spheres.size() != 2) continue;
       result.measured += 2;
       if (!(h.error[0] < worst && h.error[1] < worst)) continue;
