@@ -485,11 +485,11 @@ TEST(SphereTreeBuilder, RespectsSphereCapsPerLevel) {
 }
 
 TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuarantee) {
-  // The threshold rule at the leaf level (leaf_worst_target). The default
-  // rule's leaf allocation within the cap reaches a largest worst child bound
-  // W, so a target of 1.2 W is feasible (every parent's fewest children below
-  // it are at most its count there): the threshold build's largest allocated
-  // bound must be <= the target. Level 1 keeps the default rule (same bound).
+  // The threshold rule at the leaf level (leaf_worst_target). The fixed
+  // split's (worst_share) leaf allocation within the cap reaches a largest
+  // worst child bound W, so a target of 1.2 W is feasible (every parent's
+  // fewest children below it are at most its count there): the threshold
+  // build's largest allocated bound must be <= the target. Level 1 keeps the fixed split (same bound).
   // Both a feasible and an unreachable target (1e-9) keep every guarantee:
   // caps, nodes cover their samples with margin, children divide them, every
   // level covers a dense random sampling (brute force).
@@ -498,6 +498,7 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   o.max_spheres_per_level = {1, 4, 10};
   o.split_worst = false;  // the steps after the allocation are tested elsewhere
   o.protrusion_polish = false;
+  o.leaf_worst_target = 0;  // the fixed split
   const SphereTreeBuild plain = build_sphere_tree(torus, o);
   ASSERT_EQ(plain.allocated_worst_bound.size(), 2u);
   const double scale = (torus.V.colwise().maxCoeff() - torus.V.colwise().minCoeff()).maxCoeff();
