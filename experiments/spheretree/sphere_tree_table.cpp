@@ -1,6 +1,7 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
-//                   [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS]
+//                   [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]
+//                   [--coverage-spacing UNITS]
 //                   [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
@@ -170,7 +171,8 @@ icd::collision::SphereTree fit_leaves_to_probes(const icd::SurfaceMesh& mesh,
 void print_usage(std::ostream& os) {
   os << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
         " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-        " [--worst-share F] [--leaf-worst-target REL] [--coverage-spacing UNITS]"
+        " [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]"
+        " [--coverage-spacing UNITS]"
         " [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
@@ -224,6 +226,8 @@ int main(int argc, char** argv) {
       options.worst_share = std::atof(value);
     else if (key == "--leaf-worst-target")
       options.leaf_worst_target = std::atof(value);
+    else if (key == "--leaf-worst-factor")
+      options.leaf_worst_factor = std::atof(value);
     else if (key == "--lloyd")
       options.lloyd_iterations = std::atoi(value);
     else if (key == "--octree")

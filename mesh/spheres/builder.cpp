@@ -39,7 +39,8 @@ void check_options(const SphereTreeOptions& o) {
     fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
   }
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
-  if (!(o.leaf_worst_target >= 0)) fail("leaf_worst_target must be >= 0");
+  if (!(o.leaf_worst_target >= 0) || !(o.leaf_worst_factor >= 0))
+    fail("leaf_worst_target and leaf_worst_factor must be >= 0");
   if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
       o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
       !(o.worst_split.mean_rise_limit >= 0)) {
@@ -472,7 +473,20 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     }
     AllocationOptions allocation;
     allocation.worst_share = options.worst_share;
-    if (l == options.depth) allocation.worst_threshold = options.leaf_worst_target * scale;
+    if (l == options.depth && options.leaf_worst_factor > 0) {
+      const std::vector<int> fixed =
+          allocate_children(costs, std::min<long long>(cap, 1LL << 30), allocation);
+      double fixed_worst = 0;
+      for (size_t p = 0; p < costs.size(); ++p)
+        fixed_worst = std::max(fixed_worst, costs[p].worst[static_cast<size_t>(fixed[p] - 1)]);
+      allocation.worst_threshold = options.leaf_worst_factor * fixed_worst;
+      if (options.leaf_worst_target > 0) {
+        allocation.worst_threshold =
+            std::min(allocation.worst_threshold, options.leaf_worst_target * scale);
+      }
+    } else if (l == options.depth) {
+      allocation.worst_threshold = options.leaf_worst_target * scale;
+    }
     const std::vector<int> count =
         allocate_children(costs, std::min<long long>(cap, 1LL << 30), allocation);
     double allocated_worst = 0;

@@ -48,6 +48,11 @@ struct SphereTreeOptions {
   /// medial samples) is <= leaf_worst_target * longest side, then the rest
   /// where the summed bound drops most. Upper levels keep worst_share.
   double leaf_worst_target = 0;
+  /// When > 0: the threshold rule's threshold at the leaf level is this
+  /// factor times the largest worst bound of the configurations the fixed
+  /// split (worst_share) would choose there (so it follows the model instead
+  /// of its bounding box); the smaller of the two when leaf_worst_target > 0.
+  double leaf_worst_factor = 0;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;

@@ -489,10 +489,12 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   // split's (worst_share) leaf allocation within the cap reaches a largest
   // worst child bound W, so a target of 1.2 W is feasible (every parent's
   // fewest children below it are at most its count there): the threshold
-  // build's largest allocated bound must be <= the target. Level 1 keeps the fixed split (same bound).
-  // Both a feasible and an unreachable target (1e-9) keep every guarantee:
-  // caps, nodes cover their samples with margin, children divide them, every
-  // level covers a dense random sampling (brute force).
+  // build's largest allocated bound must be <= the target. Level 1 keeps the
+  // fixed split (same bound). Both a feasible and an unreachable target
+  // (1e-9) keep every guarantee: caps, nodes cover their samples with
+  // margin, children divide them, every level covers a dense random sampling
+  // (brute force). leaf_worst_factor 1.2 (1.2 times the fixed split's own
+  // bound) must meet the same threshold.
   const icd::SurfaceMesh torus = icd::make_torus(1.0, 0.3, 24, 12);
   SphereTreeOptions o = small_options();
   o.max_spheres_per_level = {1, 4, 10};
@@ -521,6 +523,16 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
     expect_nodes_cover_and_children_divide(build);
     expect_every_level_covers(tree, torus, 19);
   }
+  // The same threshold as a factor on the fixed split's own bound.
+  o.leaf_worst_target = 0;
+  o.leaf_worst_factor = 1.2;
+  const SphereTreeBuild by_factor = build_sphere_tree(torus, o);
+  ASSERT_EQ(by_factor.allocated_worst_bound.size(), 2u);
+  EXPECT_LE(by_factor.allocated_worst_bound[1], target * (1 + 1e-12));
+  expect_nodes_cover_and_children_divide(by_factor);
+  o.leaf_worst_factor = -1;
+  EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
+  o.leaf_worst_factor = 0;
   o.leaf_worst_target = -0.1;
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
 }
