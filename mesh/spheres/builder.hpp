@@ -47,12 +47,18 @@ struct SphereTreeOptions {
   /// first each parent the fewest children whose worst error bound (on the
   /// medial samples) is <= leaf_worst_target * longest side, then the rest
   /// where the summed bound drops most. Upper levels keep worst_share.
-  double leaf_worst_target = 0;
+  /// 0 turns the rule off (with leaf_worst_factor 0 too). Default 0.045
+  /// with leaf_worst_factor 1.05 (7 perturbed builds, medians: dragon mean42
+  /// 17.68 -> 16.88, mean2562 20.83 -> 19.93, worst42 <= 80 in 6 of 7 either
+  /// way; bunny mean42 14.62 -> 14.45, worst42 45.0 -> 49.4, all <= 80;
+  /// experiments/spheretree/results/README.md).
+  double leaf_worst_target = 0.045;
   /// When > 0: the threshold rule's threshold at the leaf level is this
   /// factor times the largest worst bound of the configurations the fixed
   /// split (worst_share) would choose there (so it follows the model instead
   /// of its bounding box); the smaller of the two when leaf_worst_target > 0.
-  double leaf_worst_factor = 0;
+  /// 0: off.
+  double leaf_worst_factor = 1.05;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;

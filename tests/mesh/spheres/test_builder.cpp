@@ -228,6 +228,10 @@ SphereTreeOptions lossy_leaf_options() {
   o.medial_spacing = 1.0 / 6;
   o.worst_split.measure_directions = 300;
   o.worst_split.choice_directions = 100;
+  // The cases below were set up (to exercise fills, failed tries and
+  // re-divisions) with the fixed-split leaf allocation.
+  o.leaf_worst_target = 0;
+  o.leaf_worst_factor = 0;
   return o;
 }
 
@@ -501,6 +505,7 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   o.split_worst = false;  // the steps after the allocation are tested elsewhere
   o.protrusion_polish = false;
   o.leaf_worst_target = 0;  // the fixed split
+  o.leaf_worst_factor = 0;
   const SphereTreeBuild plain = build_sphere_tree(torus, o);
   ASSERT_EQ(plain.allocated_worst_bound.size(), 2u);
   const double scale = (torus.V.colwise().maxCoeff() - torus.V.colwise().minCoeff()).maxCoeff();
