@@ -455,13 +455,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     for (size_t p = 0; p < parents.size(); ++p) {
       choices[p].configs = reduce(parents[p].medial);
     }
-    long long cap = 1;
-    for (int i = 0; i < l; ++i) cap *= options.branching;
-    if (static_cast<int>(options.max_spheres_per_level.size()) > l &&
-        options.max_spheres_per_level[static_cast<size_t>(l)] > 0) {
-      cap = std::min<long long>(cap, options.max_spheres_per_level[static_cast<size_t>(l)]);
-    }
-    cap = std::max<long long>(cap, static_cast<long long>(parents.size()));
+    const long long cap =
+        std::max<long long>(level_cap(options, l), static_cast<long long>(parents.size()));
     std::vector<ChildCountCosts> costs(choices.size());
     for (size_t p = 0; p < choices.size(); ++p) {
       for (const auto& config : choices[p].configs) {
@@ -531,13 +526,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     end_step(l == 1 ? "level 1" : l == 2 ? "level 2" : l == 3 ? "level 3" : "level > 3");
   }
   if (options.fill_leaf_budget && options.depth >= 1) {
-    long long cap = 1;
-    for (int i = 0; i < options.depth; ++i) cap *= options.branching;
-    if (static_cast<int>(options.max_spheres_per_level.size()) > options.depth &&
-        options.max_spheres_per_level[static_cast<size_t>(options.depth)] > 0) {
-      cap = std::min<long long>(cap,
-                                options.max_spheres_per_level[static_cast<size_t>(options.depth)]);
-    }
+    const long long cap = level_cap(options, options.depth);
     out.num_budget_splits = fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
                                              cap, options.branching);
     end_step("leaf budget");
