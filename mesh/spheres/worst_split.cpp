@@ -135,22 +135,17 @@ Halves split_in_two(const ReductionProblem& coarse, const ReductionProblem& dens
   return out;
 }
 
-/// Sorted union of two index lists.
+/// Sorted union of two index lists (a linear merge when both are sorted).
 std::vector<int> merged(const std::vector<int>& a, const std::vector<int>& b) {
-  std::vector<int> out(a);
-  out.insert(out.end(), b.begin(), b.end());
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
-/// Sorted union of two sorted index lists (as merged(), in linear time).
-std::vector<int> merged_sorted(const std::vector<int>& a, const std::vector<int>& b) {
-  if (!std::is_sorted(a.begin(), a.end()) || !std::is_sorted(b.begin(), b.end()))
-    return merged(a, b);
   std::vector<int> out;
   out.reserve(a.size() + b.size());
-  std::merge(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  if (std::is_sorted(a.begin(), a.end()) && std::is_sorted(b.begin(), b.end())) {
+    std::merge(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  } else {
+    out = a;
+    out.insert(out.end(), b.begin(), b.end());
+    std::sort(out.begin(), out.end());
+  }
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
@@ -243,7 +238,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
         const FittedSphere& a = level.spheres[j];
         const FittedSphere& b = level.spheres[k];
         if ((a.center - b.center).norm() > a.radius + b.radius) continue;
-        const std::vector<int> members = merged_sorted(a.members, b.members);
+        const std::vector<int> members = merged(a.members, b.members);
         const std::vector<Eigen::Vector3d> hull =
             union_extreme_points(dense, members, extreme_of(j), extreme_of(k));
         FittedSphere fit = fit_sphere(dense, members, nullptr, reduction, &hull);
@@ -265,6 +260,15 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
   };
 
   std::vector<char> tried(value.size(), 0);
+  // Leaf `at` replaced by a sphere of measured true error `error`: untried again.
+  auto replace_leaf = [&](size_t at, FittedSphere sphere, std::vector<int> medial, double error) {
+    level.spheres[at] = std::move(sphere);
+    level.medial[at] = std::move(medial);
+    extreme[at].clear();
+    value[at] = error;
+    exact[at] = 1;
+    tried[at] = 0;
+  };
   // Leaf i (true error `worst`) and one of its overlapping siblings, nearest
   // centre first, re-divided into two spheres whose true errors are both
   // below `worst`; true when a pair was replaced (indices unchanged).
@@ -281,7 +285,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       near.resize(static_cast<size_t>(options.redivide_siblings));
     for (const auto& [d, j] : near) {
       FittedSphere joint;
-      joint.members = merged_sorted(level.spheres[i].members, level.spheres[j].members);
+      joint.members = merged(level.spheres[i].members, level.spheres[j].members);
       joint.tag = level.spheres[i].tag;
       const std::vector<int> joint_medial = merged(level.medial[i], level.medial[j]);
       Halves h =
@@ -292,15 +296,8 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       result.measured += 2;
       if (!(h.error[0] < worst && h.error[1] < worst)) continue;
       h.spheres[1].tag = level.spheres[j].tag;
-      for (size_t k = 0; k < 2; ++k) {
-        const size_t at = k == 0 ? i : j;
-        level.spheres[at] = std::move(h.spheres[k]);
-        level.medial[at] = std::move(h.medial[k]);
-        extreme[at].clear();
-        value[at] = h.error[k];
-        exact[at] = 1;
-        tried[at] = 0;
-      }
+      for (size_t k = 0; k < 2; ++k)
+        replace_leaf(k == 0 ? i : j, std::move(h.spheres[k]), std::move(h.medial[k]), h.error[k]);
       ++result.redivisions;
       return true;
     }
@@ -331,26 +328,26 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
                                  level.medial[i], 7919u * static_cast<unsigned>(i) + 17u,
                                  options.polish, choice, directions);
     const bool relief = worst >= relief_threshold;
-    // A failed relief try: picks come largest true error first and splits
-    // leave smaller halves, so the first failure is at the level's worst
-    // leaf; with stop_relief_when_stuck the band closes there.
-    auto relief_failed = [&]() {
-      if (options.stop_relief_when_stuck) relief_threshold = kNoRelief;
-    };
-    auto no_split = [&]() {
+    // A relief try that found no split (`counter`: relief_no_split) or no
+    // room (relief_no_merge) first tries the re-division with a sibling; if
+    // that fails too it counts. Picks come largest true error first and
+    // splits leave smaller halves, so the first failure is at the level's
+    // worst leaf; with stop_relief_when_stuck the band closes there.
+    auto relief_stuck = [&](int& counter) {
       if (!relief) return;
       if (options.redivide_siblings > 0 && redivide(i, worst)) return;
-      ++result.relief_no_split, relief_failed();
+      ++counter;
+      if (options.stop_relief_when_stuck) relief_threshold = kNoRelief;
     };
     if (halves.spheres.size() != 2) {
-      no_split();
+      relief_stuck(result.relief_no_split);
       continue;
     }
     result.measured += 2;
     const double e0 = halves.error[0];
     const double e1 = halves.error[1];
     if (!(e0 < worst && e1 < worst)) {
-      no_split();
+      relief_stuck(result.relief_no_split);
       continue;
     }
     // Below the relief band the level's mean error must not rise:
@@ -359,8 +356,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     if (!free_slot) {
       std::optional<Merge> merge = best_merge(i, worst);
       if (!merge) {
-        if (relief && !(options.redivide_siblings > 0 && redivide(i, worst)))
-          ++result.relief_no_merge, relief_failed();
+        relief_stuck(result.relief_no_merge);
         continue;
       }
       for (size_t j : {merge->first, merge->second}) {
@@ -369,12 +365,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       const double rise = merge->error - value[merge->first] - value[merge->second];
       if (!relief && e0 + e1 - worst + rise > options.mean_rise_limit * mean_error) continue;
       // The merged sphere replaces the first of the pair, the second goes.
-      level.spheres[merge->first] = std::move(merge->sphere);
-      level.medial[merge->first] = std::move(merge->medial);
-      extreme[merge->first].clear();
-      value[merge->first] = merge->error;
-      exact[merge->first] = 1;
-      tried[merge->first] = 0;
+      replace_leaf(merge->first, std::move(merge->sphere), std::move(merge->medial), merge->error);
       const auto gone = static_cast<std::ptrdiff_t>(merge->second);
       level.spheres.erase(level.spheres.begin() + gone);
       level.medial.erase(level.medial.begin() + gone);
@@ -388,11 +379,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       children[static_cast<size_t>(p)] -= 1;
       ++result.merges;
     }
-    level.spheres[i] = std::move(halves.spheres[0]);
-    level.medial[i] = std::move(halves.medial[0]);
-    extreme[i].clear();
-    value[i] = e0;
-    tried[i] = 0;
+    replace_leaf(i, std::move(halves.spheres[0]), std::move(halves.medial[0]), e0);
     const auto at = static_cast<std::ptrdiff_t>(i) + 1;
     level.spheres.insert(level.spheres.begin() + at, std::move(halves.spheres[1]));
     level.medial.insert(level.medial.begin() + at, std::move(halves.medial[1]));
