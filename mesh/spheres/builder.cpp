@@ -68,13 +68,16 @@ struct ParentChoices {
     for (const auto& s : c) sum += s.error;
     return sum;
   }
+  static double worst_error(const std::vector<FittedSphere>& c) {
+    double worst = 0;
+    for (const auto& s : c) worst = std::max(worst, s.error);
+    return worst;
+  }
 };
 
 /// Worst error, then summed error: the order in which best_of_both compares configurations.
 bool better_config(const std::vector<FittedSphere>& a, const std::vector<FittedSphere>& b) {
-  double wa = 0, wb = 0;
-  for (const auto& s : a) wa = std::max(wa, s.error);
-  for (const auto& s : b) wb = std::max(wb, s.error);
+  const double wa = ParentChoices::worst_error(a), wb = ParentChoices::worst_error(b);
   if (wa != wb) return wa < wb;
   return ParentChoices::total_error(a) < ParentChoices::total_error(b);
 }
@@ -460,21 +463,22 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     std::vector<ChildCountCosts> costs(choices.size());
     for (size_t p = 0; p < choices.size(); ++p) {
       for (const auto& config : choices[p].configs) {
-        double worst = 0;
-        for (const auto& sp : config) worst = std::max(worst, sp.error);
-        costs[p].worst.push_back(worst);
+        costs[p].worst.push_back(ParentChoices::worst_error(config));
         costs[p].sum.push_back(ParentChoices::total_error(config));
       }
     }
+    // The largest worst child bound of the configurations `count` chooses.
+    auto chosen_worst = [&](const std::vector<int>& count) {
+      double worst = 0;
+      for (size_t p = 0; p < costs.size(); ++p)
+        worst = std::max(worst, costs[p].worst[static_cast<size_t>(count[p] - 1)]);
+      return worst;
+    };
     AllocationOptions allocation;
     allocation.worst_share = options.worst_share;
     if (l == options.depth && options.leaf_worst_factor > 0) {
-      const std::vector<int> fixed =
-          allocate_children(costs, std::min<long long>(cap, 1LL << 30), allocation);
-      double fixed_worst = 0;
-      for (size_t p = 0; p < costs.size(); ++p)
-        fixed_worst = std::max(fixed_worst, costs[p].worst[static_cast<size_t>(fixed[p] - 1)]);
-      allocation.worst_threshold = options.leaf_worst_factor * fixed_worst;
+      allocation.worst_threshold =
+          options.leaf_worst_factor * chosen_worst(allocate_children(costs, cap, allocation));
       if (options.leaf_worst_target > 0) {
         allocation.worst_threshold =
             std::min(allocation.worst_threshold, options.leaf_worst_target * scale);
@@ -482,13 +486,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     } else if (l == options.depth) {
       allocation.worst_threshold = options.leaf_worst_target * scale;
     }
-    const std::vector<int> count =
-        allocate_children(costs, std::min<long long>(cap, 1LL << 30), allocation);
-    double allocated_worst = 0;
-    for (size_t p = 0; p < costs.size(); ++p)
-      allocated_worst =
-          std::max(allocated_worst, costs[p].worst[static_cast<size_t>(count[p] - 1)]);
-    out.allocated_worst_bound.push_back(allocated_worst);
+    const std::vector<int> count = allocate_children(costs, cap, allocation);
+    out.allocated_worst_bound.push_back(chosen_worst(count));
 
     std::vector<Node> children;
     std::vector<int> parent_index;
