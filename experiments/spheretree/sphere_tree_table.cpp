@@ -352,20 +352,19 @@ int main(int argc, char** argv) {
         model.name.c_str(), static_cast<long long>(ours.samples.points.rows()),
         ours.num_medial_spheres, ours.num_refinement_points, ours.medial_seconds, build_cpu_s,
         ours.polish_cpu_seconds, ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+    // Model units -> the table's (longest bounding-box side 2000).
+    const double to_2000 = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
     if (options.split_worst) {
       const auto& w = ours.worst_split;
-      const double unit = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
       std::printf(
           "# %s worst split: %d splits in %d tries (%d merges; %d worst leaves with a full parent; "
           "relief band: %d without two better halves, %d without a merge; %d re-divided with a "
           "sibling), %d spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d dirs) %.2f\n",
           model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent,
           w.relief_no_split, w.relief_no_merge, w.redivisions, w.measured,
-          options.worst_split.measure_directions, unit * w.worst_before, unit * w.worst_after,
-          options.worst_split.choice_directions, unit * w.mean_before);
+          options.worst_split.measure_directions, to_2000 * w.worst_before, to_2000 * w.worst_after,
+          options.worst_split.choice_directions, to_2000 * w.mean_before);
     }
-    const double to_2000 =
-        2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
     std::printf("# %s allocation: largest worst child bound chosen per level (medial samples):",
                 model.name.c_str());
     for (size_t l = 0; l < ours.allocated_worst_bound.size(); ++l)
