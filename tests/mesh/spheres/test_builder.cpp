@@ -259,6 +259,34 @@ double leaf_worst_protrusion(const icd::collision::SphereTree& tree, const MeshO
   return e.empty() ? 0.0 : std::max(0.0, *std::max_element(e.begin(), e.end()));
 }
 
+/// The guarantees of split_worst_leaves on the 3-level `build` of `mesh`
+/// with options `o`, against the same build without it (`plain`): the leaf
+/// count bookkeeping (plain + splits - merges), at most `cap` leaves, the
+/// branching, coverage with margin and children dividing their parent's
+/// samples, every level covering a dense random sampling (`seed`), and the
+/// true worst on the measuring directions, recomputed here, equal to the
+/// reported one and not above the start's.
+void expect_worst_split_guarantees(const SphereTreeBuild& plain, const SphereTreeBuild& build,
+                                   const icd::SurfaceMesh& mesh, const SphereTreeOptions& o,
+                                   int cap, unsigned seed) {
+  const auto& tree = build.tree;
+  const auto& r = build.worst_split;
+  const int leaves = tree.num_nodes() - tree.level_offset[2];
+  EXPECT_EQ(leaves, plain.tree.num_nodes() - plain.tree.level_offset[2] + r.splits - r.merges);
+  EXPECT_LE(leaves, cap);
+  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+  expect_nodes_cover_and_children_divide(build);
+  expect_every_level_covers(tree, mesh, seed);
+  const MeshOracle oracle(mesh);
+  const icd::MatX3d dirs = spiral_directions(o.worst_split.measure_directions);
+  const double before = leaf_worst_protrusion(plain.tree, oracle, dirs);
+  const double after = leaf_worst_protrusion(tree, oracle, dirs);
+  EXPECT_NEAR(r.worst_before, before, 1e-12);
+  EXPECT_NEAR(r.worst_after, after, 1e-12);
+  EXPECT_LE(after, before);
+  EXPECT_LE(r.worst_after, r.worst_before);
+}
+
 TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   // Splitting leaves to spend the lost budget. On this sphere (coarse medial
   // samples, branching 8) the top-down pass loses leaves and the fill splits
@@ -306,26 +334,13 @@ TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst)
   ASSERT_EQ(tree.num_levels(), 3);
   const auto& result = build.worst_split;
   EXPECT_GT(result.splits, 0) << "the case must exercise the split";
-  const int leaves = tree.level_offset[3] - tree.level_offset[2];
-  const int plain_leaves = plain.tree.level_offset[3] - plain.tree.level_offset[2];
-  EXPECT_LT(plain_leaves, 64);
-  EXPECT_EQ(leaves, plain_leaves + result.splits - result.merges);
-  EXPECT_LE(leaves, 64);
-  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-  expect_nodes_cover_and_children_divide(build);
-  expect_every_level_covers(tree, sphere, 17);
+  EXPECT_LT(plain.tree.level_offset[3] - plain.tree.level_offset[2], 64);
+  expect_worst_split_guarantees(plain, build, sphere, o, 64, 17);
   // Inner levels are untouched: the split divides a leaf's samples.
   for (int i = 0; i < tree.level_offset[2]; ++i) {
     EXPECT_EQ(tree.spheres[i].r, plain.tree.spheres[i].r);
     EXPECT_EQ(build.node_samples[i], plain.node_samples[i]);
   }
-  const MeshOracle oracle(sphere);
-  const icd::MatX3d dirs = spiral_directions(o.worst_split.measure_directions);
-  const double before = leaf_worst_protrusion(plain.tree, oracle, dirs);
-  const double after = leaf_worst_protrusion(tree, oracle, dirs);
-  EXPECT_NEAR(result.worst_before, before, 1e-12);
-  EXPECT_NEAR(result.worst_after, after, 1e-12);
-  EXPECT_LE(after, before);
 }
 
 TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondItsBound) {
@@ -407,19 +422,9 @@ TEST(SphereTreeBuilder, SplitWorstRedivideWithASiblingKeepsEveryGuarantee) {
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
   const auto& r = build.worst_split;
   EXPECT_GT(r.redivisions, 0) << "the case must exercise the re-division";
-  const auto& tree = build.tree;
-  EXPECT_NO_THROW(icd::collision::validate(tree));
-  const int leaves = tree.num_nodes() - tree.level_offset[2];
-  EXPECT_EQ(leaves, plain.tree.num_nodes() - plain.tree.level_offset[2] + r.splits - r.merges);
-  EXPECT_LE(leaves, 40);
-  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-  const MeshOracle oracle(sphere);
-  const icd::MatX3d dirs = spiral_directions(o.worst_split.measure_directions);
-  EXPECT_NEAR(r.worst_before, leaf_worst_protrusion(plain.tree, oracle, dirs), 1e-12);
-  EXPECT_NEAR(r.worst_after, leaf_worst_protrusion(tree, oracle, dirs), 1e-12);
-  EXPECT_LE(r.worst_after, r.worst_before);
-  expect_nodes_cover_and_children_divide(build);
-  expect_every_level_covers(tree, sphere, 29);
+  EXPECT_NO_THROW(icd::collision::validate(build.tree));
+  ASSERT_EQ(build.tree.num_levels(), 3);
+  expect_worst_split_guarantees(plain, build, sphere, o, 40, 29);
   o.worst_split.redivide_siblings = -1;
   EXPECT_THROW(build_sphere_tree(sphere, o), icd::ParameterError);
 }
