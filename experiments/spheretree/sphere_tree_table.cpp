@@ -13,6 +13,8 @@
 //                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
 //                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]
 //                   [--split-stop-stuck 0|1] [--split-redivide N]  (split_worst)
+//                   [--caps 1,8,64,N[,M]]  (spheres allowed per level; depth = count - 1)
+//                   [--branching B]  (children per node at most; default 8)
 //                   [--flat N]  (diagnostic: one level of at most N spheres under the root,
 //                                every other step as usual: the cost of the nested partition)
 //                   [--perturb E]  (build for the mesh scaled by 1 + E, evaluate on the
@@ -179,7 +181,7 @@ void print_usage(std::ostream& os) {
         " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]"
         " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]"
         " [--split-stop-stuck 0|1] [--split-redivide N]"
-        " [--flat N]\n"
+        " [--caps 1,8,64,N[,M]] [--branching B] [--flat N]\n"
         "       sphere_tree_table --help\n";
 }
 
@@ -252,7 +254,22 @@ int main(int argc, char** argv) {
       options.worst_split.redivide_siblings = std::atoi(value);
     else if (key == "--split-tries")
       options.worst_split.max_tries = std::atoi(value);
-    else if (key == "--flat") {
+    else if (key == "--branching")
+      options.branching = std::atoi(value);
+    else if (key == "--caps") {
+      // the spheres allowed per level, root first, e.g. 1,8,64,512,700:
+      // depth = count - 1
+      std::vector<int> caps;
+      std::stringstream list(value);
+      for (std::string item; std::getline(list, item, ',');) caps.push_back(std::atoi(item.c_str()));
+      if (caps.size() < 2 || caps.front() != 1) {
+        std::cerr << "--caps: a comma-separated list starting with 1 (the root), got " << value
+                  << "\n";
+        return 2;
+      }
+      options.depth = static_cast<int>(caps.size()) - 1;
+      options.max_spheres_per_level = caps;
+    } else if (key == "--flat") {
       const int n = std::atoi(value);
       options.depth = 1;
       options.branching = std::max(2, n);
