@@ -15,6 +15,97 @@
 #include "mesh/io/primitives.hpp"
 
 namespace icd::mesh {
+
+std::vector<int> farthest_members(const MatX3d& points, const std::vector<int>& members,
+                                  const MatX3d& dirs) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  std::vector<int> arg(static_cast<size_t>(dirs.rows()), members.empty() ? -1 : members.front());
+  if (members.empty()) return arg;
+  auto value = [](double d0, double d1, double d2, double x, double y, double z) {
+    return d0 * x + d1 * y + d2 * z;
+  };
+  // Members bucketed by the cells of a grid over their bounding box (a
+  // counting sort of their positions), each cell with the bounding box of
+  // its members. The value of a member along d, fl(fl(d0 x + d1 y) + d2 z)
+  // with every product rounded, is at most the same expression on its
+  // cell's box corner farthest along d: rounding is monotone, so the bound
+  // holds in floating point too, and only cells whose bound reaches the
+  // best value found are scanned.
+  const size_t n = members.size();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(inf), hi = Eigen::Vector3d::Constant(-inf);
+  for (int s : members) {
+    lo = lo.cwiseMin(points.row(s).transpose());
+    hi = hi.cwiseMax(points.row(s).transpose());
+  }
+  // About 64 members per occupied cell on a surface (about 4 G^2 cells occupied).
+  const int g = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(n) / 256.0)), 1, 128);
+  const Eigen::Vector3d extent = (hi - lo).cwiseMax(1e-300);
+  auto cell_of = [&](int s) {
+    int c = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int i = std::min(g - 1, static_cast<int>((points(s, k) - lo[k]) / extent[k] * g));
+      c = c * g + std::max(0, i);
+    }
+    return c;
+  };
+  const auto cells = static_cast<size_t>(g) * static_cast<size_t>(g) * static_cast<size_t>(g);
+  std::vector<int> cell(n);
+  std::vector<size_t> start(cells + 1, 0);
+  for (size_t i = 0; i < n; ++i) {
+    cell[i] = cell_of(members[i]);
+    ++start[static_cast<size_t>(cell[i]) + 1];
+  }
+  for (size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  std::vector<size_t> order(n);  // positions in members, cell by cell, in member order
+  {
+    std::vector<size_t> next(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < n; ++i) order[next[static_cast<size_t>(cell[i])]++] = i;
+  }
+  struct Block {
+    size_t begin, end;
+    Eigen::Vector3d lo, hi;
+  };
+  std::vector<Block> blocks;
+  for (size_t c = 0; c < cells; ++c) {
+    if (start[c] == start[c + 1]) continue;
+    Block b{start[c], start[c + 1], Eigen::Vector3d::Constant(inf), Eigen::Vector3d::Constant(-inf)};
+    for (size_t k = b.begin; k < b.end; ++k) {
+      b.lo = b.lo.cwiseMin(points.row(members[order[k]]).transpose());
+      b.hi = b.hi.cwiseMax(points.row(members[order[k]]).transpose());
+    }
+    blocks.push_back(b);
+  }
+  std::vector<double> bound(blocks.size());
+  for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
+    const double d0 = dirs(d, 0), d1 = dirs(d, 1), d2 = dirs(d, 2);
+    size_t top = 0;
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      const Block& k = blocks[b];
+      bound[b] = value(d0, d1, d2, d0 >= 0 ? k.hi.x() : k.lo.x(), d1 >= 0 ? k.hi.y() : k.lo.y(),
+                       d2 >= 0 ? k.hi.z() : k.lo.z());
+      if (bound[b] > bound[top]) top = b;
+    }
+    // The first member (in member order) with the largest value, as a scan
+    // of every member with "v > best" finds it.
+    double best = -inf;
+    size_t best_at = 0;
+    auto scan = [&](const Block& b) {
+      for (size_t k = b.begin; k < b.end; ++k) {
+        const size_t i = order[k];
+        const auto p = points.row(members[i]);
+        const double v = value(d0, d1, d2, p(0), p(1), p(2));
+        if (v > best || (v == best && i < best_at)) best = v, best_at = i;
+      }
+    };
+    scan(blocks[top]);
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      if (b != top && bound[b] >= best) scan(blocks[b]);
+    }
+    if (best > -inf) arg[static_cast<size_t>(d)] = members[best_at];
+  }
+  return arg;
+}
+
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
@@ -27,16 +118,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// vertices. The small hull's facets are found by brute force over triples.
 std::vector<int> prefilter(const MatX3d& points, const std::vector<int>& members) {
   static const MatX3d dirs = make_icosphere(1, 1.0).V;
-  std::vector<int> support;
-  for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
-    int best = members.front();
-    double best_v = -kInf;
-    for (int s : members) {
-      const double v = dirs.row(d).dot(points.row(s));
-      if (v > best_v) best_v = v, best = s;
-    }
-    support.push_back(best);
-  }
+  std::vector<int> support = farthest_members(points, members, dirs);
   std::sort(support.begin(), support.end());
   support.erase(std::unique(support.begin(), support.end()), support.end());
   const auto n = support.size();
@@ -122,16 +204,7 @@ std::vector<Eigen::Vector3d> extreme_points(const MatX3d& points,
 /// subdivided icosahedron), without duplicates.
 std::vector<Eigen::Vector3d> support_points(const MatX3d& points, const std::vector<int>& members) {
   static const MatX3d dirs = make_icosphere(2, 1.0).V;
-  std::vector<double> best(static_cast<size_t>(dirs.rows()), -kInf);
-  std::vector<int> arg(static_cast<size_t>(dirs.rows()), members.front());
-  for (int s : members) {
-    const Eigen::Vector3d p = points.row(s).transpose();
-    for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
-      const double v = dirs(d, 0) * p.x() + dirs(d, 1) * p.y() + dirs(d, 2) * p.z();
-      if (v > best[static_cast<size_t>(d)])
-        best[static_cast<size_t>(d)] = v, arg[static_cast<size_t>(d)] = s;
-    }
-  }
+  std::vector<int> arg = farthest_members(points, members, dirs);
   std::sort(arg.begin(), arg.end());
   arg.erase(std::unique(arg.begin(), arg.end()), arg.end());
   std::vector<Eigen::Vector3d> out;

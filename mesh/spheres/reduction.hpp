@@ -59,6 +59,16 @@ FittedSphere fit_sphere(const ReductionProblem& problem, const std::vector<int>&
                         const FittedSphere* hint, const ReductionOptions& options,
                         const std::vector<Eigen::Vector3d>* extreme = nullptr);
 
+/// For each direction (row of `dirs`), the member of `members` with the
+/// largest value dirs(d, 0) * x + dirs(d, 1) * y + dirs(d, 2) * z (evaluated
+/// left to right) over its sample (x, y, z) = points.row(member), the first
+/// in the order of `members` on ties: what a scan of every member finds,
+/// found faster by bucketing the members in the cells of a grid and
+/// scanning only the cells whose bounding box can reach the best value
+/// found. -1 for every direction when `members` is empty.
+std::vector<int> farthest_members(const MatX3d& points, const std::vector<int>& members,
+                                  const MatX3d& dirs);
+
 /// The extreme points (convex hull vertices) of the samples `members`
 /// (non-empty) as fit_sphere() uses them: every member when there are at
 /// most 64, or when the members are coplanar.
