@@ -30,6 +30,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <exception>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -187,7 +188,7 @@ void print_usage(std::ostream& os) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
@@ -262,8 +263,11 @@ int main(int argc, char** argv) {
       std::vector<int> caps;
       std::stringstream list(value);
       for (std::string item; std::getline(list, item, ',');) caps.push_back(std::atoi(item.c_str()));
-      if (caps.size() < 2 || caps.front() != 1) {
-        std::cerr << "--caps: a comma-separated list starting with 1 (the root), got " << value
+      if (caps.size() < 2 || caps.front() != 1 ||
+          std::any_of(caps.begin(), caps.end(), [](int c) { return c < 1; })) {
+        std::cerr << "--caps: a comma-separated list of positive counts starting with 1 (the "
+                     "root), got "
+                  << value
                   << "\n";
         return 2;
       }
@@ -417,4 +421,13 @@ int main(int argc, char** argv) {
     write_tree(results, model.name + "_octree", octree);
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "sphere_tree_table: " << e.what() << "\n";
+    return 1;
+  }
 }
