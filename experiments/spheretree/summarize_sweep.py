@@ -26,6 +26,9 @@ for line in open(sys.argv[1]):
     m = re.search(r"build CPU time ([\d.]+) s", line)
     if m:
         extra["cpu"] = float(m.group(1))
+    m = re.search(r"wall ([\d.]+) s on", line)
+    if m:
+        extra["wall"] = float(m.group(1))
 
 rows = []
 for e, per_level, extra in builds:
@@ -36,6 +39,8 @@ for e, per_level, extra in builds:
     rows.append(row)
 
 cols = ["leaves", "worst42", "mean42", "mean162", "mean2562", "worst2562", "uncovered", "cpu"]
+if any("wall" in extra for _, _, extra in builds):
+    cols.append("wall")
 print("E".ljust(8) + "".join(c.rjust(10) for c in cols))
 for r in rows:
     print(r["E"].ljust(8) + "".join(str(r.get(c, "-")).rjust(10) for c in cols))

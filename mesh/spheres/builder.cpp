@@ -4,6 +4,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <queue>
 #include <string>
@@ -12,6 +13,7 @@
 #include "mesh/spheres/allocation.hpp"
 #include "mesh/spheres/medial_axis.hpp"
 #include "mesh/spheres/mesh_oracle.hpp"
+#include "mesh/spheres/parallel.hpp"
 #include "mesh/spheres/point_grid.hpp"
 #include "mesh/spheres/sum_exchange.hpp"
 
@@ -47,6 +49,7 @@ void check_options(const SphereTreeOptions& o) {
     fail("worst_split: measure/choice directions must be >= 1, max_tries >= 0, relief_fraction >= 0");
   }
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
+  if (o.threads < 0) fail("threads must be >= 0, got " + std::to_string(o.threads));
   if (o.protrusion.search_directions < 1 || o.protrusion.check_directions < 1 ||
       o.protrusion.max_evaluations < 0 || !(o.protrusion.initial_step > 0) ||
       !(o.protrusion.min_step > 0)) {
@@ -327,19 +330,26 @@ int fill_leaf_budget(const ReductionProblem& coarse, const ReductionProblem& den
 /// then `exchange_rounds` times the leaves hand boundary samples to
 /// neighbours whose ancestors all cover them (shrink_by_exchange) and the
 /// leaves that changed are polished again. Returns the number of moves kept.
-int polish_tree(const ReductionProblem& dense, const MeshOracle& oracle,
+int polish_tree(const ReductionProblem& dense, const std::vector<const MeshOracle*>& oracles,
                 std::vector<std::vector<Node>>& levels,
                 const std::vector<std::vector<int>>& parent_of,
                 const ProtrusionPolishOptions& options, int exchange_rounds,
                 CpuClock::time_point deadline) {
   int moved = 0;
   const size_t last = levels.size() - 1;
+  // Each node's polish reads only its own sphere and samples: one task per node.
   auto polish_level = [&](size_t l, const std::vector<char>* only) {
-    for (size_t i = 0; i < levels[l].size() && CpuClock::now() < deadline; ++i) {
-      if (only != nullptr && !(*only)[i]) continue;
+    std::vector<char> did_move(levels[l].size(), 0);
+    parallel_for(levels[l].size(), static_cast<int>(oracles.size()), [&](size_t i, int worker) {
+      if ((only != nullptr && !(*only)[i]) || !(CpuClock::now() < deadline)) return;
       const auto seed = static_cast<unsigned>(1000003 * l + i);
-      moved += polish_protrusion(dense, oracle, levels[l][i].sphere, seed, options).moved ? 1 : 0;
-    }
+      did_move[i] = polish_protrusion(dense, *oracles[static_cast<size_t>(worker)],
+                                      levels[l][i].sphere, seed, options)
+                            .moved
+                        ? 1
+                        : 0;
+    });
+    moved += static_cast<int>(std::count(did_move.begin(), did_move.end(), 1));
   };
   polish_level(last, nullptr);
   for (int round = 0; round < exchange_rounds && last >= 1; ++round) {
@@ -387,6 +397,14 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   };
   const SurfaceMesh closed = close_holes(input);
   const MeshOracle oracle(closed);
+  // One oracle per worker thread (its inside test is not safe for concurrent use).
+  const int workers = worker_count(options.threads);
+  std::vector<std::unique_ptr<MeshOracle>> extra_oracles;
+  std::vector<const MeshOracle*> oracles{&oracle};
+  for (int w = 1; w < workers; ++w) {
+    extra_oracles.push_back(std::make_unique<MeshOracle>(closed));
+    oracles.push_back(extra_oracles.back().get());
+  }
   const double scale = longest_bounding_box_side(closed.V);
   if (!(scale > 0)) throw InputError("build_sphere_tree: the mesh has a degenerate bounding box");
 
@@ -455,9 +473,9 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   for (int l = 1; l <= options.depth; ++l) {
     const std::vector<Node>& parents = levels.back();
     std::vector<ParentChoices> choices(parents.size());
-    for (size_t p = 0; p < parents.size(); ++p) {
+    parallel_for(parents.size(), workers, [&](size_t p, int) {
       choices[p].configs = reduce(parents[p].medial);
-    }
+    });
     const long long cap =
         std::max<long long>(level_cap(options, l), static_cast<long long>(parents.size()));
     std::vector<ChildCountCosts> costs(choices.size());
@@ -489,9 +507,16 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     const std::vector<int> count = allocate_children(costs, cap, allocation);
     out.allocated_worst_bound.push_back(chosen_worst(count));
 
-    std::vector<Node> children;
-    std::vector<int> parent_index;
-    for (size_t p = 0; p < parents.size(); ++p) {
+    // Each parent's children, fitted to its coverage samples: one task per parent.
+    std::vector<std::vector<Node>> children_of(parents.size());
+    parallel_for(parents.size(), workers, [&](size_t p, int worker) {
+      // With one parent (level 1) its children are polished in parallel instead.
+      auto polish_all = [&](std::vector<FittedSphere>& spheres) {
+        parallel_for(spheres.size(), parents.size() == 1 ? workers : 1, [&](size_t i, int w) {
+          polish_sphere(dense, *oracles[static_cast<size_t>(parents.size() == 1 ? w : worker)],
+                        spheres[i]);
+        });
+      };
       std::vector<FittedSphere> kids = choices[p].configs[static_cast<size_t>(count[p] - 1)];
       std::vector<std::vector<int>> kid_medial;
       for (size_t k = 0; k < kids.size(); ++k) {
@@ -502,13 +527,13 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       // child's radius refitted to cover its share with margin.
       std::vector<FittedSphere> fitted = kids;
       assign_and_refit(dense, parents[p].sphere.members, fitted);
-      for (auto& f : fitted) polish_sphere(dense, oracle, f);
+      polish_all(fitted);
       assign_and_refit(dense, parents[p].sphere.members, fitted);
       ExchangeOptions exchange;
       exchange.rounds = 2;
       for (int round = 0; round < options.exchange_rounds; ++round) {
         shrink_by_exchange(dense, fitted, exchange);
-        for (auto& f : fitted) polish_sphere(dense, oracle, f);
+        polish_all(fitted);
       }
       if (options.exchange_rounds > 0) shrink_by_exchange(dense, fitted, exchange);
       for (auto& f : fitted) {
@@ -516,6 +541,13 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
         n.sphere = std::move(f);
         if (n.sphere.tag >= 0) n.medial = kid_medial[static_cast<size_t>(n.sphere.tag)];
         if (n.medial.empty()) n.medial = parents[p].medial;  // keep the subtree placeable
+        children_of[p].push_back(std::move(n));
+      }
+    });
+    std::vector<Node> children;
+    std::vector<int> parent_index;
+    for (size_t p = 0; p < parents.size(); ++p) {
+      for (Node& n : children_of[p]) {
         children.push_back(std::move(n));
         parent_index.push_back(static_cast<int>(p));
       }
@@ -562,7 +594,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   end_step("sum exchange");
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
-    out.num_polished = polish_tree(dense, oracle, levels, parent_of, options.protrusion,
+    out.num_polished = polish_tree(dense, oracles, levels, parent_of, options.protrusion,
                                    options.protrusion_exchange_rounds, deadline);
     out.polish_cpu_seconds = std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }

@@ -128,6 +128,12 @@ struct SphereTreeOptions {
   /// the spread (median mean2562 21.07 -> 21.22), for about 10 s CPU.
   bool split_worst = true;
   WorstSplitOptions worst_split;  ///< see split_worst_leaves (its deadline is time_limit's)
+  /// Worker threads (0: std::thread::hardware_concurrency(); 1: none). The
+  /// per-node steps (each level's reduction and fitting of a parent's
+  /// children, the protrusion polish) run one node per task; the tree does
+  /// not depend on the number of threads (as long as the CPU budget below is
+  /// not reached: it counts the CPU time of all threads).
+  int threads = 0;
   /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),
   /// not wall-clock time, so a loaded machine does not change the tree; > 0).
   /// Past it the optimisation stops early (no more Lloyd rounds or polish

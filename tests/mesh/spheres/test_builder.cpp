@@ -1,7 +1,7 @@
 // Sphere-tree builder on small meshes (sphere, box, torus): layout, coverage
 // of every level (margin bookkeeping and an independent dense random
 // sampling checked by brute force), error decreasing level to level,
-// determinism, and option checks.
+// determinism (also across thread counts), and option checks.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -482,6 +482,31 @@ TEST(SphereTreeBuilder, IsDeterministic) {
     EXPECT_EQ(a.spheres[i].r, b.spheres[i].r);
   }
   EXPECT_EQ(a.first_child, b.first_child);
+}
+
+TEST(SphereTreeBuilder, DoesNotDependOnTheThreadCount) {
+  // Parallel steps (a parent's children, the protrusion polish) work on one
+  // node per task: one thread and three give the same tree, bit for bit.
+  const Case torus = cases()[2];
+  SphereTreeOptions one = small_options(), three = small_options();
+  one.threads = 1;
+  three.threads = 3;
+  const SphereTreeBuild a = build_sphere_tree(torus.mesh, one);
+  const SphereTreeBuild b = build_sphere_tree(torus.mesh, three);
+  ASSERT_EQ(a.tree.num_nodes(), b.tree.num_nodes());
+  ASSERT_GT(a.tree.num_nodes(), 5);
+  for (int i = 0; i < a.tree.num_nodes(); ++i) {
+    EXPECT_EQ(a.tree.spheres[i].x, b.tree.spheres[i].x) << i;
+    EXPECT_EQ(a.tree.spheres[i].y, b.tree.spheres[i].y) << i;
+    EXPECT_EQ(a.tree.spheres[i].z, b.tree.spheres[i].z) << i;
+    EXPECT_EQ(a.tree.spheres[i].r, b.tree.spheres[i].r) << i;
+  }
+  EXPECT_EQ(a.tree.first_child, b.tree.first_child);
+  EXPECT_EQ(a.tree.child_count, b.tree.child_count);
+  EXPECT_EQ(a.node_samples, b.node_samples);
+  EXPECT_EQ(a.num_polished, b.num_polished);
+  one.threads = -1;
+  EXPECT_THROW(build_sphere_tree(torus.mesh, one), icd::ParameterError);
 }
 
 TEST(SphereTreeBuilder, RespectsSphereCapsPerLevel) {
