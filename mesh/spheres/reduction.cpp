@@ -30,7 +30,10 @@ std::vector<int> farthest_members(const MatX3d& points, const std::vector<int>& 
   // with every product rounded, is at most the same expression on its
   // cell's box corner farthest along d: rounding is monotone, so the bound
   // holds in floating point too, and only cells whose bound reaches the
-  // best value found are scanned.
+  // best value found are scanned (with a slack far above a few roundings of
+  // the terms, in case a compiler evaluates the two expressions differently,
+  // e.g. contracted to fused multiply-adds: scanning more never changes the
+  // answer).
   const size_t n = members.size();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(inf), hi = Eigen::Vector3d::Constant(-inf);
   for (int s : members) {
@@ -78,6 +81,9 @@ std::vector<int> farthest_members(const MatX3d& points, const std::vector<int>& 
   std::vector<double> bound(blocks.size());
   for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
     const double d0 = dirs(d, 0), d1 = dirs(d, 1), d2 = dirs(d, 2);
+    const double slack = 1e-12 * (std::abs(d0) * std::max(std::abs(lo.x()), std::abs(hi.x())) +
+                                  std::abs(d1) * std::max(std::abs(lo.y()), std::abs(hi.y())) +
+                                  std::abs(d2) * std::max(std::abs(lo.z()), std::abs(hi.z())));
     size_t top = 0;
     for (size_t b = 0; b < blocks.size(); ++b) {
       const Block& k = blocks[b];
@@ -99,7 +105,7 @@ std::vector<int> farthest_members(const MatX3d& points, const std::vector<int>& 
     };
     scan(blocks[top]);
     for (size_t b = 0; b < blocks.size(); ++b) {
-      if (b != top && bound[b] >= best) scan(blocks[b]);
+      if (b != top && bound[b] + slack >= best) scan(blocks[b]);
     }
     if (best > -inf) arg[static_cast<size_t>(d)] = members[best_at];
   }
