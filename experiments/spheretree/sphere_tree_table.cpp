@@ -266,13 +266,13 @@ int run(int argc, char** argv) {
       // depth = count - 1
       std::vector<int> caps;
       std::stringstream list(value);
-      for (std::string item; std::getline(list, item, ',');) caps.push_back(std::atoi(item.c_str()));
+      for (std::string item; std::getline(list, item, ',');)
+        caps.push_back(std::atoi(item.c_str()));
       if (caps.size() < 2 || caps.front() != 1 ||
           std::any_of(caps.begin(), caps.end(), [](int c) { return c < 1; })) {
         std::cerr << "--caps: a comma-separated list of positive counts starting with 1 (the "
                      "root), got "
-                  << value
-                  << "\n";
+                  << value << "\n";
         return 2;
       }
       options.depth = static_cast<int>(caps.size()) - 1;
@@ -377,9 +377,11 @@ int run(int argc, char** argv) {
         "moved)%s\n",
         model.name.c_str(), static_cast<long long>(ours.samples.points.rows()),
         ours.num_medial_spheres, ours.num_refinement_points, ours.medial_seconds, build_cpu_s,
-        ours.seconds, icd::mesh::worker_count(options.threads), ours.polish_cpu_seconds, ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
+        ours.seconds, icd::mesh::worker_count(options.threads), ours.polish_cpu_seconds,
+        ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // Model units -> the table's (longest bounding-box side 2000).
-    const double to_2000 = 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    const double to_2000 =
+        2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
     if (options.split_worst) {
       const auto& w = ours.worst_split;
       std::printf(

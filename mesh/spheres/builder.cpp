@@ -473,9 +473,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   for (int l = 1; l <= options.depth; ++l) {
     const std::vector<Node>& parents = levels.back();
     std::vector<ParentChoices> choices(parents.size());
-    parallel_for(parents.size(), workers, [&](size_t p, int) {
-      choices[p].configs = reduce(parents[p].medial);
-    });
+    parallel_for(parents.size(), workers,
+                 [&](size_t p, int) { choices[p].configs = reduce(parents[p].medial); });
     const long long cap =
         std::max<long long>(level_cap(options, l), static_cast<long long>(parents.size()));
     std::vector<ChildCountCosts> costs(choices.size());
@@ -511,10 +510,10 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     std::vector<std::vector<Node>> children_of(parents.size());
     parallel_for(parents.size(), workers, [&](size_t p, int worker) {
       // With one parent (level 1) its children are polished in parallel instead.
+      const bool spread = parents.size() == 1;
       auto polish_all = [&](std::vector<FittedSphere>& spheres) {
-        parallel_for(spheres.size(), parents.size() == 1 ? workers : 1, [&](size_t i, int w) {
-          polish_sphere(dense, *oracles[static_cast<size_t>(parents.size() == 1 ? w : worker)],
-                        spheres[i]);
+        parallel_for(spheres.size(), spread ? workers : 1, [&](size_t i, int w) {
+          polish_sphere(dense, *oracles[static_cast<size_t>(spread ? w : worker)], spheres[i]);
         });
       };
       std::vector<FittedSphere> kids = choices[p].configs[static_cast<size_t>(count[p] - 1)];

@@ -24,7 +24,8 @@ inline int worker_count(int requested) {
 /// thread has stopped (tasks not yet started are skipped).
 template <class Task>
 void parallel_for(size_t n, int workers, Task&& task) {
-  const int threads = static_cast<int>(std::min<size_t>(n, static_cast<size_t>(std::max(workers, 1))));
+  const int threads =
+      static_cast<int>(std::min<size_t>(n, static_cast<size_t>(std::max(workers, 1))));
   if (threads <= 1) {
     for (size_t i = 0; i < n; ++i) task(i, 0);
     return;

@@ -71,7 +71,8 @@ std::vector<int> farthest_members(const MatX3d& points, const std::vector<int>& 
   std::vector<Block> blocks;
   for (size_t c = 0; c < cells; ++c) {
     if (start[c] == start[c + 1]) continue;
-    Block b{start[c], start[c + 1], Eigen::Vector3d::Constant(inf), Eigen::Vector3d::Constant(-inf)};
+    Block b{start[c], start[c + 1], Eigen::Vector3d::Constant(inf),
+            Eigen::Vector3d::Constant(-inf)};
     for (size_t k = b.begin; k < b.end; ++k) {
       b.lo = b.lo.cwiseMin(points.row(members[order[k]]).transpose());
       b.hi = b.hi.cwiseMax(points.row(members[order[k]]).transpose());

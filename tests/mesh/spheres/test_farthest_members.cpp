@@ -15,8 +15,8 @@
 
 namespace {
 
-using icd::mesh::farthest_members;
 using icd::MatX3d;
+using icd::mesh::farthest_members;
 
 /// The reference: every member in order, "v > best" (the first maximum wins).
 std::vector<int> scan_all(const MatX3d& points, const std::vector<int>& members,
@@ -26,8 +26,8 @@ std::vector<int> scan_all(const MatX3d& points, const std::vector<int>& members,
     double best = -std::numeric_limits<double>::infinity();
     int arg = members.front();
     for (int s : members) {
-      const double v = dirs(d, 0) * points(s, 0) + dirs(d, 1) * points(s, 1) +
-                       dirs(d, 2) * points(s, 2);
+      const double v =
+          dirs(d, 0) * points(s, 0) + dirs(d, 1) * points(s, 1) + dirs(d, 2) * points(s, 2);
       if (v > best) best = v, arg = s;
     }
     out.push_back(arg);
@@ -51,7 +51,8 @@ TEST(FarthestMembers, EqualsAScanOfEveryMemberTiesIncluded) {
     const int n = trial < 3 ? 10 + 30 * trial : 500 + 700 * trial;
     MatX3d points(n, 3);
     for (int i = 0; i < n; ++i) {
-      for (int c = 0; c < 3; ++c) points(i, c) = trial % 2 == 0 ? std::round(8 * u(rng)) / 8 : u(rng);
+      for (int c = 0; c < 3; ++c)
+        points(i, c) = trial % 2 == 0 ? std::round(8 * u(rng)) / 8 : u(rng);
     }
     for (int i = 0; i + 7 < n; i += 7) points.row(i + 7) = points.row(i);
     std::vector<int> members(static_cast<size_t>(n));
