@@ -15,6 +15,8 @@
 //                   [--split-stop-stuck 0|1] [--split-redivide N]  (split_worst)
 //                   [--caps 1,8,64,N[,M]]  (spheres allowed per level; depth = count - 1)
 //                   [--branching B]  (children per node at most; default 8)
+//                   [--build-branching B]  (SphereTreeOptions::build_branching)
+//                   [--inner-worst-target REL]  (SphereTreeOptions::inner_worst_target)
 //                   [--threads N]  (worker threads of the build; 0 = all cores, the default)
 //                   [--flat N]  (diagnostic: one level of at most N spheres under the root,
 //                                every other step as usual: the cost of the nested partition)
@@ -181,10 +183,12 @@ void print_usage(std::ostream& os) {
         " [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
-        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E] [--fill 0|1]"
+        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E]"
+        " [--fill 0|1]"
         " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]"
         " [--split-stop-stuck 0|1] [--split-redivide N]"
-        " [--caps 1,8,64,N[,M]] [--branching B] [--threads N] [--flat N]\n"
+        " [--caps 1,8,64,N[,M]] [--branching B] [--build-branching B]"
+        " [--inner-worst-target REL] [--threads N] [--flat N]\n"
         "       sphere_tree_table --help\n";
 }
 
@@ -261,6 +265,10 @@ int run(int argc, char** argv) {
       options.threads = std::atoi(value);
     else if (key == "--branching")
       options.branching = std::atoi(value);
+    else if (key == "--inner-worst-target")
+      options.inner_worst_target = std::atof(value);
+    else if (key == "--build-branching")
+      options.build_branching = std::atoi(value);
     else if (key == "--caps") {
       // the spheres allowed per level, root first, e.g. 1,8,64,512,700:
       // depth = count - 1

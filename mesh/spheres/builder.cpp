@@ -15,6 +15,7 @@
 #include "mesh/spheres/mesh_oracle.hpp"
 #include "mesh/spheres/parallel.hpp"
 #include "mesh/spheres/point_grid.hpp"
+#include "mesh/spheres/regroup.hpp"
 #include "mesh/spheres/sum_exchange.hpp"
 
 namespace icd::mesh {
@@ -25,6 +26,9 @@ using Clock = std::chrono::steady_clock;
 void check_options(const SphereTreeOptions& o) {
   auto fail = [](const std::string& what) { throw ParameterError("SphereTreeOptions::" + what); };
   if (o.branching < 2) fail("branching must be >= 2, got " + std::to_string(o.branching));
+  if (o.build_branching != 0 && o.build_branching < o.branching) {
+    fail("build_branching must be 0 or >= branching, got " + std::to_string(o.build_branching));
+  }
   if (o.depth < 0 || o.depth > 8) fail("depth must be in [0, 8], got " + std::to_string(o.depth));
   if (!(o.cover_spacing > 0) || !(o.medial_spacing >= o.cover_spacing)) {
     fail("cover_spacing must be > 0 and medial_spacing >= cover_spacing");
@@ -41,8 +45,8 @@ void check_options(const SphereTreeOptions& o) {
     fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
   }
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
-  if (!(o.leaf_worst_target >= 0) || !(o.leaf_worst_factor >= 0))
-    fail("leaf_worst_target and leaf_worst_factor must be >= 0");
+  if (!(o.leaf_worst_target >= 0) || !(o.leaf_worst_factor >= 0) || !(o.inner_worst_target >= 0))
+    fail("leaf_worst_target, leaf_worst_factor and inner_worst_target must be >= 0");
   if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
       o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
       !(o.worst_split.mean_rise_limit >= 0)) {
@@ -334,7 +338,7 @@ int polish_tree(const ReductionProblem& dense, const std::vector<const MeshOracl
                 std::vector<std::vector<Node>>& levels,
                 const std::vector<std::vector<int>>& parent_of,
                 const ProtrusionPolishOptions& options, int exchange_rounds,
-                CpuClock::time_point deadline) {
+                CpuClock::time_point deadline, bool inner = true) {
   int moved = 0;
   const size_t last = levels.size() - 1;
   // Each node's polish reads only its own sphere and samples: one task per node.
@@ -376,7 +380,118 @@ int polish_tree(const ReductionProblem& dense, const std::vector<const MeshOracl
     refit_inner_nodes(dense, levels, parent_of);
     polish_level(last, &changed);
   }
-  for (size_t l = last; l-- > 0;) polish_level(l, nullptr);
+  if (inner) {
+    for (size_t l = last; l-- > 0;) polish_level(l, nullptr);
+  }
+  return moved;
+}
+
+/// Gives every node at most `branching` children, levels from the leaves
+/// up: the children of a level keep their spheres, their parents are chosen
+/// anew (regroup_children, with the radius each parent needs about its
+/// centre to cover a child's samples), the level is reordered so that
+/// siblings stay contiguous, and every node of the level above whose samples
+/// changed gets the union of its children's samples, a new centre (the
+/// better of a fresh fit and a polish of the old one) and, with
+/// `protrusion`, every inner node its protrusion polish (until `deadline`;
+/// polish_tree leaves the inner nodes to this step). Needs #level l <=
+/// branching x #level l-1 (the allocation keeps to it). Returns the number
+/// of nodes that got another parent.
+int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOracle*>& oracles,
+                 const ReductionOptions& reduction, const ProtrusionPolishOptions* protrusion,
+                 int branching, CpuClock::time_point deadline,
+                 std::vector<std::vector<Node>>& levels, std::vector<std::vector<int>>& parent_of) {
+  const int workers = static_cast<int>(oracles.size());
+  // Each node's extreme points: the reach of its parents, and their fits (a
+  // hull vertex of a union is one of a part's, so a level's come from the
+  // level below's).
+  int moved = 0;
+  std::vector<std::vector<Eigen::Vector3d>> extreme(levels.back().size());
+  parallel_for(extreme.size(), workers, [&](size_t i, int) {
+    extreme[i] = member_extreme_points(dense, levels.back()[i].sphere.members);
+  });
+  for (size_t l = levels.size() - 1; l >= 1; --l) {
+    std::vector<Node>& nodes = levels[l];
+    const std::vector<Node>& parents = levels[l - 1];
+    std::vector<int> count(parents.size(), 0);
+    for (int p : parent_of[l]) count[static_cast<size_t>(p)] += 1;
+    if (*std::max_element(count.begin(), count.end()) > branching) {
+      std::vector<std::vector<double>> reach(nodes.size(), std::vector<double>(parents.size()));
+      parallel_for(nodes.size(), workers, [&](size_t i, int) {
+        double gap = 0;
+        for (int s : nodes[i].sphere.members) gap = std::max(gap, dense.gap[s]);
+        for (size_t p = 0; p < parents.size(); ++p) {
+          double r = 0;
+          for (const auto& x : extreme[i]) r = std::max(r, (x - parents[p].sphere.center).norm());
+          reach[i][p] = r + gap;
+        }
+      });
+      const std::vector<int> parent = regroup_children(reach, parent_of[l], branching);
+      for (size_t i = 0; i < parent.size(); ++i) moved += parent[i] != parent_of[l][i] ? 1 : 0;
+      parent_of[l] = parent;
+    }
+    // The level above: the union of its children's samples, refitted where it changed.
+    std::vector<Node>& above = levels[l - 1];
+    std::vector<std::vector<int>> unions(above.size());
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      const auto& m = nodes[i].sphere.members;
+      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
+      u.insert(u.end(), m.begin(), m.end());
+    }
+    std::vector<std::vector<size_t>> kids(above.size());
+    for (size_t i = 0; i < nodes.size(); ++i)
+      kids[static_cast<size_t>(parent_of[l][i])].push_back(i);
+    std::vector<std::vector<Eigen::Vector3d>> above_extreme(above.size());
+    parallel_for(above.size(), workers, [&](size_t p, int worker) {
+      std::sort(unions[p].begin(), unions[p].end());
+      FittedSphere& sp = above[p].sphere;
+      const MeshOracle& oracle = *oracles[static_cast<size_t>(worker)];
+      std::vector<Eigen::Vector3d>& hull = above_extreme[p];
+      if (kids[p].empty()) {  // a childless node keeps its sphere
+        if (!sp.members.empty()) hull = member_extreme_points(dense, sp.members);
+        return;
+      }
+      hull = extreme[kids[p].front()];
+      for (size_t k = 1; k < kids[p].size(); ++k)
+        hull = union_extreme_points(dense, unions[p], hull, extreme[kids[p][k]]);
+      if (unions[p] != sp.members) {
+        FittedSphere kept = sp;
+        kept.members = unions[p];
+        polish_sphere(dense, oracle, kept);
+        FittedSphere fresh = fit_sphere(dense, unions[p], nullptr, reduction, &hull);
+        polish_sphere(dense, oracle, fresh);
+        sp = fresh.error < kept.error ? std::move(fresh) : std::move(kept);
+      }
+      // Every inner node: polish_tree left them to this step.
+      if (protrusion != nullptr && CpuClock::now() < deadline) {
+        polish_protrusion(dense, oracle, sp, static_cast<unsigned>(1000003 * (l - 1) + p),
+                          *protrusion);
+      }
+    });
+    extreme = std::move(above_extreme);
+  }
+  // Siblings contiguous, in parent order, top-down (stable; each level
+  // follows the new order of the one above).
+  for (size_t l = 1; l < levels.size(); ++l) {
+    std::vector<int> order(levels[l].size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return parent_of[l][static_cast<size_t>(a)] < parent_of[l][static_cast<size_t>(b)];
+    });
+    std::vector<Node> sorted;
+    std::vector<int> sorted_parent, new_index(order.size());
+    for (size_t k = 0; k < order.size(); ++k) {
+      const auto i = static_cast<size_t>(order[k]);
+      sorted.push_back(std::move(levels[l][i]));
+      sorted_parent.push_back(parent_of[l][i]);
+      new_index[i] = static_cast<int>(k);
+    }
+    levels[l] = std::move(sorted);
+    parent_of[l] = std::move(sorted_parent);
+    if (l + 1 < levels.size()) {
+      for (int& p : parent_of[l + 1]) p = new_index[static_cast<size_t>(p)];
+    }
+  }
   return moved;
 }
 
@@ -438,14 +553,15 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   if (options.reduction != ReductionMethod::split_lloyd) {
     owners = medial_owners(coarse, options.medial_spacing * scale);
   }
-  auto reduce = [&](const std::vector<int>& members) {
+  const int build_branching = std::max(options.branching, options.build_branching);
+  auto reduce = [&](const std::vector<int>& members, int max_k) {
     if (options.reduction == ReductionMethod::split_lloyd) {
-      return reduce_to_spheres(coarse, members, options.branching, reduction);
+      return reduce_to_spheres(coarse, members, max_k, reduction);
     }
     std::vector<std::vector<FittedSphere>> mb =
-        merge_burst_reduce(coarse, owners, members, options.branching, reduction, merge_burst);
+        merge_burst_reduce(coarse, owners, members, max_k, reduction, merge_burst);
     if (options.reduction == ReductionMethod::best_of_both) {
-      const auto split = reduce_to_spheres(coarse, members, options.branching, reduction);
+      const auto split = reduce_to_spheres(coarse, members, max_k, reduction);
       for (size_t k = 0; k < mb.size(); ++k) {
         if (better_config(split[k], mb[k])) mb[k] = split[k];
       }
@@ -473,10 +589,13 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   for (int l = 1; l <= options.depth; ++l) {
     const std::vector<Node>& parents = levels.back();
     std::vector<ParentChoices> choices(parents.size());
+    const int max_k = l >= 2 ? build_branching : options.branching;
     parallel_for(parents.size(), workers,
-                 [&](size_t p, int) { choices[p].configs = reduce(parents[p].medial); });
-    const long long cap =
+                 [&](size_t p, int) { choices[p].configs = reduce(parents[p].medial, max_k); });
+    long long cap =
         std::max<long long>(level_cap(options, l), static_cast<long long>(parents.size()));
+    // What regroup_tree can place under the parents with `branching` each.
+    cap = std::min<long long>(cap, static_cast<long long>(parents.size()) * options.branching);
     std::vector<ChildCountCosts> costs(choices.size());
     for (size_t p = 0; p < choices.size(); ++p) {
       for (const auto& config : choices[p].configs) {
@@ -502,6 +621,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       }
     } else if (l == options.depth) {
       allocation.worst_threshold = options.leaf_worst_target * scale;
+    } else if (l >= 2 && options.inner_worst_target > 0) {
+      allocation.worst_threshold = options.inner_worst_target * scale;
     }
     const std::vector<int> count = allocate_children(costs, cap, allocation);
     out.allocated_worst_bound.push_back(chosen_worst(count));
@@ -555,10 +676,20 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     parent_of.push_back(std::move(parent_index));
     end_step(l == 1 ? "level 1" : l == 2 ? "level 2" : l == 3 ? "level 3" : "level > 3");
   }
+  // With regrouping ahead, a leaf's parent may take any number of children:
+  // only the level's count must fit under the parents with `branching` each.
+  const bool regroup = build_branching > options.branching && levels.size() > 2;
+  const long long leaf_cap =
+      levels.size() < 2
+          ? 1
+          : std::min<long long>(
+                level_cap(options, options.depth),
+                static_cast<long long>(levels[levels.size() - 2].size()) * options.branching);
+  const int leaf_parent_limit =
+      regroup ? static_cast<int>(std::max<long long>(leaf_cap, 2)) : options.branching;
   if (options.fill_leaf_budget && options.depth >= 1) {
-    const long long cap = level_cap(options, options.depth);
     out.num_budget_splits = fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
-                                             cap, options.branching);
+                                             leaf_cap, leaf_parent_limit);
     end_step("leaf budget");
   }
   if (options.joint_leaf_refinement && levels.size() > 2) {
@@ -593,8 +724,9 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   end_step("sum exchange");
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
+    // With regrouping ahead, the inner nodes are polished after it.
     out.num_polished = polish_tree(dense, oracles, levels, parent_of, options.protrusion,
-                                   options.protrusion_exchange_rounds, deadline);
+                                   options.protrusion_exchange_rounds, deadline, !regroup);
     out.polish_cpu_seconds = std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }
   end_step("protrusion polish");
@@ -608,8 +740,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     WorstSplitOptions split = options.worst_split;
     split.deadline = std::min(split.deadline, deadline);
     out.worst_split = split_worst_leaves(coarse, dense, oracle, reduction, leaf_level,
-                                         static_cast<int>(level_cap(options, options.depth)),
-                                         options.branching, split);
+                                         static_cast<int>(leaf_cap), leaf_parent_limit, split);
     levels.back().clear();
     for (size_t i = 0; i < leaf_level.spheres.size(); ++i) {
       Node n;
@@ -619,6 +750,12 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     }
     parent_of.back() = std::move(leaf_level.parent);
     end_step("worst split");
+  }
+  if (regroup) {
+    out.num_regrouped = regroup_tree(dense, oracles, reduction,
+                                     options.protrusion_polish ? &options.protrusion : nullptr,
+                                     options.branching, deadline, levels, parent_of);
+    end_step("regroup");
   }
 
   // Flatten breadth-first: level by level, children of a node contiguous.

@@ -28,6 +28,15 @@ enum class ReductionMethod {
 /// side is 2000), which makes the defaults independent of the model's scale.
 struct SphereTreeOptions {
   int branching = 8;  ///< at most this many children per node (>= 2)
+  /// Children a parent at level >= 1 may get while the tree is built (0:
+  /// branching; else >= branching). Above branching, levels 2 and below are
+  /// built as if their parents could take that many (so the allocation can
+  /// give some parents more children and others fewer), and at the end each
+  /// level is regrouped under the level above with at most `branching`
+  /// children per node (regroup_children), leaves first: the leaves do not
+  /// change, inner nodes are refitted and polished around their new
+  /// children. The tree keeps its branching factor and caps.
+  int build_branching = 0;
   /// Levels *below the root*: the tree has depth + 1 levels (the root is
   /// level 0), at most branching^l nodes on level l. depth 3 with branching 8
   /// is the paper's setting (1 + 8 + 64 + 512 nodes at most), as in the
@@ -59,6 +68,10 @@ struct SphereTreeOptions {
   /// of its bounding box); the smaller of the two when leaf_worst_target > 0.
   /// 0: off.
   double leaf_worst_factor = 1.05;
+  /// When > 0 (relative): the threshold rule (see leaf_worst_target) with
+  /// this threshold at the inner levels 2 .. depth - 1 instead of
+  /// worst_share. 0: off.
+  double inner_worst_target = 0;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;
@@ -158,6 +171,7 @@ struct SphereTreeBuild {
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
   int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget
+  int num_regrouped = 0;           ///< nodes that build_branching's regrouping gave another parent
   WorstSplitResult worst_split;    ///< what split_worst_leaves did (with split_worst)
   /// For each level l >= 1 (index l - 1): the largest worst child error bound
   /// (medial samples, model units) of the configurations the allocation chose.

@@ -572,6 +572,38 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
 }
 
+TEST(SphereTreeBuilder, BuildBranchingRegroupsToTheBranchingAndKeepsEveryGuarantee) {
+  // Built with up to 8 children per parent below level 1, then regrouped to
+  // branching 3 (leaves under level 2, level 2 under level 1): the regrouping
+  // must have moved nodes, and the tree must keep its branching, its caps,
+  // coverage with margin with children dividing their parent's samples, and
+  // every level covering a dense random sampling (brute force); and it must
+  // not depend on the thread count (1 and 3 threads).
+  const icd::SurfaceMesh torus = icd::make_torus(1.0, 0.3, 24, 12);
+  SphereTreeOptions o = small_options();
+  o.branching = 3;
+  o.depth = 3;
+  o.max_spheres_per_level = {1, 3, 7, 19};
+  o.build_branching = 8;
+  o.threads = 1;
+  const SphereTreeBuild build = build_sphere_tree(torus, o);
+  const auto& tree = build.tree;
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  ASSERT_EQ(tree.num_levels(), 4);
+  EXPECT_GT(build.num_regrouped, 0) << "the case must exercise the regrouping";
+  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+  for (int l = 1; l < 4; ++l)
+    EXPECT_LE(tree.level_offset[l + 1] - tree.level_offset[l], o.max_spheres_per_level[l]);
+  expect_nodes_cover_and_children_divide(build);
+  expect_every_level_covers(tree, torus, 23);
+  o.threads = 3;
+  const SphereTreeBuild threaded = build_sphere_tree(torus, o);
+  EXPECT_EQ(threaded.node_samples, build.node_samples);
+  EXPECT_EQ(threaded.tree.child_count, tree.child_count);
+  o.build_branching = 2;  // below the branching
+  EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
+}
+
 TEST(SphereTreeBuilder, RejectsBadOptionsAndMeshes) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   SphereTreeOptions o = small_options();
