@@ -389,14 +389,21 @@ int polish_tree(const ReductionProblem& dense, const std::vector<const MeshOracl
 /// Gives every node at most `branching` children, levels from the leaves
 /// up: the children of a level keep their spheres, their parents are chosen
 /// anew (regroup_children, with the radius each parent needs about its
-/// centre to cover a child's samples), the level is reordered so that
-/// siblings stay contiguous, and every node of the level above whose samples
-/// changed gets the union of its children's samples, a new centre (the
-/// better of a fresh fit and a polish of the old one) and, with
-/// `protrusion`, every inner node its protrusion polish (until `deadline`;
-/// polish_tree leaves the inner nodes to this step). Needs #level l <=
-/// branching x #level l-1 (the allocation keeps to it). Returns the number
-/// of nodes that got another parent.
+/// centre to cover a child's support points), and every node of the level
+/// above whose samples changed gets the union of its children's samples and
+/// a new centre (the better of a fresh fit and a polish of the old one);
+/// kRegroupRounds rounds of both, then, with `protrusion`, every inner node
+/// its protrusion polish (until `deadline`; polish_tree leaves the inner
+/// nodes to this step). Last, every level is reordered so that siblings are
+/// contiguous. Needs #level l <= branching x #level l-1 (the allocation
+/// keeps to it). Returns the number of parent changes.
+/// Rounds of regroup_children and refitting per level in regroup_tree.
+constexpr int kRegroupRounds = 3;
+/// Directions of the support points that stand for a node's samples in
+/// regroup_tree (the reach of a parent, and the fit of a new centre; the
+/// radius is always refitted over every sample).
+constexpr int kRegroupDirections = 256;
+
 int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOracle*>& oracles,
                  const ReductionOptions& reduction, const ProtrusionPolishOptions* protrusion,
                  int branching, CpuClock::time_point deadline,
@@ -406,68 +413,102 @@ int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOrac
   // hull vertex of a union is one of a part's, so a level's come from the
   // level below's).
   int moved = 0;
-  std::vector<std::vector<Eigen::Vector3d>> extreme(levels.back().size());
+  const MatX3d dirs = spiral_directions(kRegroupDirections);
+  auto along = [&](Eigen::Index d, int s) {
+    return dirs(d, 0) * dense.points(s, 0) + dirs(d, 1) * dense.points(s, 1) +
+           dirs(d, 2) * dense.points(s, 2);
+  };
+  // The support points' coordinates, each sample once.
+  auto points_of = [&](std::vector<int> support) {
+    std::sort(support.begin(), support.end());
+    support.erase(std::unique(support.begin(), support.end()), support.end());
+    std::vector<Eigen::Vector3d> out;
+    for (int s : support) {
+      if (s >= 0) out.push_back(dense.points.row(s).transpose());  // -1: no samples
+    }
+    return out;
+  };
+  std::vector<std::vector<int>> extreme(levels.back().size());
   parallel_for(extreme.size(), workers, [&](size_t i, int) {
-    extreme[i] = member_extreme_points(dense, levels.back()[i].sphere.members);
+    extreme[i] = farthest_members(dense.points, levels.back()[i].sphere.members, dirs);
   });
   for (size_t l = levels.size() - 1; l >= 1; --l) {
     std::vector<Node>& nodes = levels[l];
-    const std::vector<Node>& parents = levels[l - 1];
-    std::vector<int> count(parents.size(), 0);
-    for (int p : parent_of[l]) count[static_cast<size_t>(p)] += 1;
-    if (*std::max_element(count.begin(), count.end()) > branching) {
-      std::vector<std::vector<double>> reach(nodes.size(), std::vector<double>(parents.size()));
-      parallel_for(nodes.size(), workers, [&](size_t i, int) {
-        double gap = 0;
-        for (int s : nodes[i].sphere.members) gap = std::max(gap, dense.gap[s]);
-        for (size_t p = 0; p < parents.size(); ++p) {
-          double r = 0;
-          for (const auto& x : extreme[i]) r = std::max(r, (x - parents[p].sphere.center).norm());
-          reach[i][p] = r + gap;
-        }
-      });
-      const std::vector<int> parent = regroup_children(reach, parent_of[l], branching);
-      for (size_t i = 0; i < parent.size(); ++i) moved += parent[i] != parent_of[l][i] ? 1 : 0;
-      parent_of[l] = parent;
-    }
-    // The level above: the union of its children's samples, refitted where it changed.
     std::vector<Node>& above = levels[l - 1];
-    std::vector<std::vector<int>> unions(above.size());
-    for (size_t i = 0; i < nodes.size(); ++i) {
-      const auto& m = nodes[i].sphere.members;
-      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
-      u.insert(u.end(), m.begin(), m.end());
-    }
-    std::vector<std::vector<size_t>> kids(above.size());
-    for (size_t i = 0; i < nodes.size(); ++i)
-      kids[static_cast<size_t>(parent_of[l][i])].push_back(i);
-    std::vector<std::vector<Eigen::Vector3d>> above_extreme(above.size());
-    parallel_for(above.size(), workers, [&](size_t p, int worker) {
-      std::sort(unions[p].begin(), unions[p].end());
-      FittedSphere& sp = above[p].sphere;
-      const MeshOracle& oracle = *oracles[static_cast<size_t>(worker)];
-      std::vector<Eigen::Vector3d>& hull = above_extreme[p];
-      if (kids[p].empty()) {  // a childless node keeps its sphere
-        if (!sp.members.empty()) hull = member_extreme_points(dense, sp.members);
-        return;
+    std::vector<std::vector<int>> above_extreme(above.size());
+    // The level above: the union of its children's samples (support points
+    // folded from theirs), refitted where it changed.
+    auto refit_above = [&]() {
+      std::vector<std::vector<int>> unions(above.size());
+      std::vector<std::vector<size_t>> kids(above.size());
+      for (size_t i = 0; i < nodes.size(); ++i) {
+        const auto p = static_cast<size_t>(parent_of[l][i]);
+        const auto& m = nodes[i].sphere.members;
+        unions[p].insert(unions[p].end(), m.begin(), m.end());
+        kids[p].push_back(i);
       }
-      hull = extreme[kids[p].front()];
-      for (size_t k = 1; k < kids[p].size(); ++k)
-        hull = union_extreme_points(dense, unions[p], hull, extreme[kids[p][k]]);
-      if (unions[p] != sp.members) {
+      parallel_for(above.size(), workers, [&](size_t p, int worker) {
+        std::sort(unions[p].begin(), unions[p].end());
+        FittedSphere& sp = above[p].sphere;
+        std::vector<int>& support = above_extreme[p];
+        if (kids[p].empty()) {  // a childless node keeps its sphere
+          support = farthest_members(dense.points, sp.members, dirs);
+          return;
+        }
+        // The farthest sample of a union along a direction is one of its parts'.
+        support = extreme[kids[p].front()];
+        for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
+          for (size_t k = 1; k < kids[p].size(); ++k) {
+            const int s = extreme[kids[p][k]][static_cast<size_t>(d)];
+            int& best = support[static_cast<size_t>(d)];
+            if (s >= 0 && (best < 0 || along(d, s) > along(d, best))) best = s;
+          }
+        }
+        if (unions[p] == sp.members) return;
+        const std::vector<Eigen::Vector3d> hull = points_of(support);
+        const MeshOracle& oracle = *oracles[static_cast<size_t>(worker)];
         FittedSphere kept = sp;
         kept.members = unions[p];
         polish_sphere(dense, oracle, kept);
         FittedSphere fresh = fit_sphere(dense, unions[p], nullptr, reduction, &hull);
         polish_sphere(dense, oracle, fresh);
         sp = fresh.error < kept.error ? std::move(fresh) : std::move(kept);
+      });
+    };
+    // Rounds of regrouping (against the parents' current centres) and refitting.
+    std::vector<int> count(above.size(), 0);
+    for (int p : parent_of[l]) count[static_cast<size_t>(p)] += 1;
+    const bool overfull = *std::max_element(count.begin(), count.end()) > branching;
+    for (int round = 0; round < (overfull ? kRegroupRounds : 1); ++round) {
+      if (overfull) {
+        std::vector<std::vector<double>> reach(nodes.size(), std::vector<double>(above.size()));
+        parallel_for(nodes.size(), workers, [&](size_t i, int) {
+          double gap = 0;
+          for (int s : nodes[i].sphere.members) gap = std::max(gap, dense.gap[s]);
+          const std::vector<Eigen::Vector3d> support = points_of(extreme[i]);
+          for (size_t p = 0; p < above.size(); ++p) {
+            double r = 0;
+            for (const auto& x : support) r = std::max(r, (x - above[p].sphere.center).norm());
+            reach[i][p] = r + gap;
+          }
+        });
+        const std::vector<int> parent = regroup_children(reach, parent_of[l], branching);
+        int changed = 0;
+        for (size_t i = 0; i < parent.size(); ++i) changed += parent[i] != parent_of[l][i] ? 1 : 0;
+        moved += changed;
+        parent_of[l] = parent;
+        if (round > 0 && changed == 0) break;
       }
-      // Every inner node: polish_tree left them to this step.
-      if (protrusion != nullptr && CpuClock::now() < deadline) {
-        polish_protrusion(dense, oracle, sp, static_cast<unsigned>(1000003 * (l - 1) + p),
-                          *protrusion);
-      }
-    });
+      refit_above();
+    }
+    // Every inner node: polish_tree left them to this step.
+    if (protrusion != nullptr) {
+      parallel_for(above.size(), workers, [&](size_t p, int worker) {
+        if (above[p].sphere.members.empty() || !(CpuClock::now() < deadline)) return;
+        polish_protrusion(dense, *oracles[static_cast<size_t>(worker)], above[p].sphere,
+                          static_cast<unsigned>(1000003 * (l - 1) + p), *protrusion);
+      });
+    }
     extreme = std::move(above_extreme);
   }
   // Siblings contiguous, in parent order, top-down (stable; each level
