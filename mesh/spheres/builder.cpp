@@ -386,6 +386,13 @@ int polish_tree(const ReductionProblem& dense, const std::vector<const MeshOracl
   return moved;
 }
 
+/// Rounds of regroup_children and refitting per level in regroup_tree.
+constexpr int kRegroupRounds = 3;
+/// Directions of the support points that stand for a node's samples in
+/// regroup_tree (the reach of a parent, and the fit of a new centre; the
+/// radius is always refitted over every sample).
+constexpr int kRegroupDirections = 256;
+
 /// Gives every node at most `branching` children, levels from the leaves
 /// up: the children of a level keep their spheres, their parents are chosen
 /// anew (regroup_children, with the radius each parent needs about its
@@ -397,21 +404,14 @@ int polish_tree(const ReductionProblem& dense, const std::vector<const MeshOracl
 /// nodes to this step). Last, every level is reordered so that siblings are
 /// contiguous. Needs #level l <= branching x #level l-1 (the allocation
 /// keeps to it). Returns the number of parent changes.
-/// Rounds of regroup_children and refitting per level in regroup_tree.
-constexpr int kRegroupRounds = 3;
-/// Directions of the support points that stand for a node's samples in
-/// regroup_tree (the reach of a parent, and the fit of a new centre; the
-/// radius is always refitted over every sample).
-constexpr int kRegroupDirections = 256;
-
 int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOracle*>& oracles,
                  const ReductionOptions& reduction, const ProtrusionPolishOptions* protrusion,
                  int branching, CpuClock::time_point deadline,
                  std::vector<std::vector<Node>>& levels, std::vector<std::vector<int>>& parent_of) {
   const int workers = static_cast<int>(oracles.size());
-  // Each node's extreme points: the reach of its parents, and their fits (a
-  // hull vertex of a union is one of a part's, so a level's come from the
-  // level below's).
+  // Each node's support points (sample indices, one per direction) stand
+  // for its samples: the reach of its parents, and their fits. A level's
+  // are folded from the level below's.
   int moved = 0;
   const MatX3d dirs = spiral_directions(kRegroupDirections);
   auto along = [&](Eigen::Index d, int s) {

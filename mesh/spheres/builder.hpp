@@ -171,7 +171,7 @@ struct SphereTreeBuild {
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
   int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget
-  int num_regrouped = 0;           ///< nodes that build_branching's regrouping gave another parent
+  int num_regrouped = 0;           ///< parent changes made by build_branching's regrouping
   WorstSplitResult worst_split;    ///< what split_worst_leaves did (with split_worst)
   /// For each level l >= 1 (index l - 1): the largest worst child error bound
   /// (medial samples, model units) of the configurations the allocation chose.
