@@ -639,7 +639,16 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     cap = std::min<long long>(cap, static_cast<long long>(parents.size()) * options.branching);
     std::vector<ChildCountCosts> costs(choices.size());
     for (size_t p = 0; p < choices.size(); ++p) {
+      // A parent cannot use more children than it has coverage samples (a
+      // child without one is dropped), whatever its medial samples allow.
+      // Applied with build_branching only: on the default it changes the
+      // trees (which then need the 7-build protocol and a new preprocess
+      // cache key); there a node with a single sample is rare.
+      const size_t usable = build_branching > options.branching
+                                ? std::max<size_t>(1, parents[p].sphere.members.size())
+                                : choices[p].configs.size();
       for (const auto& config : choices[p].configs) {
+        if (costs[p].worst.size() == usable) break;
         costs[p].worst.push_back(ParentChoices::worst_error(config));
         costs[p].sum.push_back(ParentChoices::total_error(config));
       }
