@@ -37,8 +37,8 @@ struct SphereTreeOptions {
   /// change, inner nodes are refitted and polished around their new
   /// children. The tree keeps its branching factor and caps. Measured with
   /// 12 and inner_worst_target 0.085 (7 perturbed builds, medians): dragon
-  /// leaf mean42 16.88 -> 15.71 but worst42 <= 80 in 5 instead of 6 of 7,
-  /// bunny mean42 14.45 -> 13.10; upper levels looser; hence off
+  /// leaf mean42 16.88 -> 15.34 but worst42 <= 80 in 4 instead of 6 of 7,
+  /// bunny mean42 14.45 -> 12.79; upper levels looser; hence off
   /// (experiments/spheretree/results/README.md, "This session (5)").
   int build_branching = 0;
   /// Levels *below the root*: the tree has depth + 1 levels (the root is
