@@ -642,8 +642,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       // A parent cannot use more children than it has coverage samples (a
       // child without one is dropped), whatever its medial samples allow.
       // Applied with build_branching only: on the default it changes the
-      // trees (which then need the 7-build protocol and a new preprocess
-      // cache key); there a node with a single sample is rare.
+      // bunny and dragon trees too, which then need the 7-build protocol
+      // and a new preprocess cache key (not done yet).
       const size_t usable = build_branching > options.branching
                                 ? std::max<size_t>(1, parents[p].sphere.members.size())
                                 : choices[p].configs.size();
