@@ -479,17 +479,22 @@ int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOrac
     std::vector<int> count(above.size(), 0);
     for (int p : parent_of[l]) count[static_cast<size_t>(p)] += 1;
     const bool overfull = *std::max_element(count.begin(), count.end()) > branching;
+    // The children do not change over the rounds: their support points and
+    // largest margins are taken once.
+    std::vector<std::vector<Eigen::Vector3d>> support(overfull ? nodes.size() : 0);
+    std::vector<double> gap(support.size(), 0.0);
+    parallel_for(support.size(), workers, [&](size_t i, int) {
+      for (int s : nodes[i].sphere.members) gap[i] = std::max(gap[i], dense.gap[s]);
+      support[i] = points_of(extreme[i]);
+    });
     for (int round = 0; round < (overfull ? kRegroupRounds : 1); ++round) {
       if (overfull) {
         std::vector<std::vector<double>> reach(nodes.size(), std::vector<double>(above.size()));
         parallel_for(nodes.size(), workers, [&](size_t i, int) {
-          double gap = 0;
-          for (int s : nodes[i].sphere.members) gap = std::max(gap, dense.gap[s]);
-          const std::vector<Eigen::Vector3d> support = points_of(extreme[i]);
           for (size_t p = 0; p < above.size(); ++p) {
             double r = 0;
-            for (const auto& x : support) r = std::max(r, (x - above[p].sphere.center).norm());
-            reach[i][p] = r + gap;
+            for (const auto& x : support[i]) r = std::max(r, (x - above[p].sphere.center).norm());
+            reach[i][p] = r + gap[i];
           }
         });
         const std::vector<int> parent = regroup_children(reach, parent_of[l], branching);
