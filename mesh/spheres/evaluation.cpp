@@ -42,16 +42,25 @@ class SphereGrid {
     }
   }
 
-  bool covered(const Eigen::Vector3d& p) const {
+  /// Number of spheres that contain p, counted up to 2; `only` is the one
+  /// when there is exactly one.
+  int count_covering(const Eigen::Vector3d& p, int& only) const {
+    int count = 0;
+    auto visit = [&](int i) {
+      if (!inside(i, p)) return false;
+      only = i;
+      return ++count >= 2;
+    };
     for (int i : m_big) {
-      if (inside(i, p)) return true;
+      if (visit(i)) return count;
     }
     auto it = m_cells.find(key(cell(p)));
-    if (it == m_cells.end()) return false;
-    for (int i : it->second) {
-      if (inside(i, p)) return true;
+    if (it != m_cells.end()) {
+      for (int i : it->second) {
+        if (visit(i)) return count;
+      }
     }
-    return false;
+    return count;
   }
 
   /// Distance from p to the nearest sphere (<= 0 when covered); brute force.
@@ -138,6 +147,16 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     }
   }
   std::vector<SphereGrid> grids;
+  // Per level: which spheres cover some vertex or dense sample alone.
+  std::vector<std::vector<char>> alone(static_cast<size_t>(num_levels));
+  std::vector<std::vector<double>> errors42(static_cast<size_t>(num_levels)),
+      errors162(static_cast<size_t>(num_levels));
+  auto note_coverage = [&](int l, const Eigen::Vector3d& p) {
+    int only = -1;
+    const int count = grids[static_cast<size_t>(l)].count_covering(p, only);
+    if (count == 1) alone[static_cast<size_t>(l)][static_cast<size_t>(only)] = 1;
+    return count > 0;
+  };
   for (int l = 0; l < num_levels; ++l) {
     LevelMetrics& m = out[static_cast<size_t>(l)];
     m.level = l;
@@ -151,6 +170,8 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
       m.worst_error_162 = std::max(m.worst_error_162, e162);
       m.mean_error_42 += e42 / m.num_spheres;
       m.mean_error_162 += e162 / m.num_spheres;
+      errors42[static_cast<size_t>(l)].push_back(e42);
+      errors162[static_cast<size_t>(l)].push_back(e162);
       const int p = parent[static_cast<size_t>(i)];
       if (p >= 0) {
         const auto& ps = spheres[static_cast<size_t>(p)];
@@ -160,8 +181,9 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     }
     grids.emplace_back(
         std::vector<collision::Sphere>(spheres.begin() + begin, spheres.begin() + end));
+    alone[static_cast<size_t>(l)].assign(static_cast<size_t>(m.num_spheres), 0);
     for (Eigen::Index v = 0; v < scaled.V.rows(); ++v) {
-      if (!grids.back().covered(scaled.V.row(v))) ++m.num_uncovered_vertices;
+      if (!note_coverage(l, scaled.V.row(v).transpose())) ++m.num_uncovered_vertices;
     }
   }
 
@@ -187,7 +209,7 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
         for (int l = 0; l < num_levels; ++l) {
           LevelMetrics& m = out[static_cast<size_t>(l)];
           ++m.num_dense_samples;
-          if (grids[static_cast<size_t>(l)].covered(p)) continue;
+          if (note_coverage(l, p)) continue;
           ++m.num_uncovered_samples;
           uncovered_area[static_cast<size_t>(l)] += weight;
           m.max_uncovered_gap = std::max(m.max_uncovered_gap, grids[static_cast<size_t>(l)].gap(p));
@@ -196,8 +218,21 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     }
   }
   for (int l = 0; l < num_levels; ++l) {
-    out[static_cast<size_t>(l)].uncovered_area_fraction =
+    LevelMetrics& m = out[static_cast<size_t>(l)];
+    m.uncovered_area_fraction =
         total_area > 0 ? uncovered_area[static_cast<size_t>(l)] / total_area : 0.0;
+    int covering = 0;
+    for (int i = 0; i < m.num_spheres; ++i) {
+      if (!alone[static_cast<size_t>(l)][static_cast<size_t>(i)]) continue;
+      ++covering;
+      m.mean_error_42_covering += errors42[static_cast<size_t>(l)][static_cast<size_t>(i)];
+      m.mean_error_162_covering += errors162[static_cast<size_t>(l)][static_cast<size_t>(i)];
+    }
+    m.num_redundant_spheres = m.num_spheres - covering;
+    if (covering > 0) {
+      m.mean_error_42_covering /= covering;
+      m.mean_error_162_covering /= covering;
+    }
   }
   return out;
 }

@@ -34,6 +34,15 @@ struct LevelMetrics {
   double max_uncovered_gap =
       0;  ///< largest distance from an uncovered sample to the nearest sphere
   int num_uncovered_vertices = 0;  ///< mesh vertices outside every sphere of the level
+  /// Spheres that cover no dense sample and no vertex alone: every point of
+  /// the surface they cover (as sampled) another sphere of the level covers
+  /// too, so removing one of them uncovers nothing. Such a sphere (say, one
+  /// tucked inside the object, touching the surface at a point) has a small
+  /// error and pulls the level's mean down without covering anything; the
+  /// means over the other spheres say what the covering spheres achieve.
+  int num_redundant_spheres = 0;
+  double mean_error_42_covering = 0;   ///< mean 42-probe error of the other spheres
+  double mean_error_162_covering = 0;  ///< mean 162-probe error of the other spheres
   /// How far the level's spheres stick out of their parents (max over nodes
   /// of |c - c_parent| + r - r_parent, >= 0; 0 for the root).
   double max_child_protrusion = 0;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "collision/sphere_tree.hpp"
 #include "mesh/io/error.hpp"
@@ -75,6 +76,64 @@ TEST(Evaluation, UncoveredAreaMatchesTheFaceDiskClosedForm) {
   EXPECT_EQ(metrics[1].num_uncovered_samples, 0);
   EXPECT_EQ(metrics[1].uncovered_area_fraction, 0.0);
   EXPECT_EQ(metrics[1].num_uncovered_vertices, 0);
+}
+
+/// Root (radius 2, covers the cube) over one level of `children` spheres.
+icd::collision::SphereTree root_over(const std::vector<icd::collision::Sphere>& children) {
+  icd::collision::SphereTree t;
+  t.spheres = {{0, 0, 0, 2.0}};
+  t.spheres.insert(t.spheres.end(), children.begin(), children.end());
+  t.rest_spheres = t.spheres;
+  const int n = static_cast<int>(children.size());
+  t.first_child.assign(static_cast<size_t>(n) + 1, -1);
+  t.first_child[0] = 1;
+  t.child_count.assign(static_cast<size_t>(n) + 1, 0);
+  t.child_count[0] = n;
+  t.level.assign(static_cast<size_t>(n) + 1, 1);
+  t.level[0] = 0;
+  t.level_offset = {0, 1, n + 1};
+  return t;
+}
+
+/// 42-probe error of a sphere of the cube [-1, 1]^3 (normalized units).
+double cube_error_42(const icd::collision::Sphere& s) {
+  const icd::MatX3d dirs = probe_directions(1);
+  double e = 0;
+  for (Eigen::Index d = 0; d < dirs.rows(); ++d)
+    e = std::max(e, cube_distance(1000.0 * (s.center() + s.r * dirs.row(d).transpose()), 1000.0));
+  return e;
+}
+
+TEST(Evaluation, CountsSpheresThatCoverNothingAlone) {
+  const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
+  EvaluationOptions options;
+  options.coverage_spacing = 20.0;
+  // Two halves, each alone over the corners of its side (|(1, 1, 1) - (-0.5, 0, 0)| = 2.06 >
+  // 1.51); one sphere inside touching only the face centres, which the halves cover too; one
+  // tucked inside the object, touching nothing.
+  const icd::collision::Sphere left{-0.5, 0, 0, 1.51}, right{0.5, 0, 0, 1.51},
+      middle{0, 0, 0, 1.0}, inner{0.2, 0.1, 0, 0.4};
+  const auto metrics = evaluate_sphere_tree(cube, root_over({left, middle, right, inner}), options);
+  ASSERT_EQ(metrics.size(), 2u);
+  EXPECT_EQ(metrics[1].num_uncovered_samples, 0);
+  EXPECT_EQ(metrics[1].num_redundant_spheres, 2);
+  EXPECT_NEAR(metrics[1].mean_error_42_covering, 0.5 * (cube_error_42(left) + cube_error_42(right)),
+              1e-6);
+  EXPECT_NEAR(metrics[1].mean_error_42,
+              0.25 * (cube_error_42(left) + cube_error_42(right) + cube_error_42(middle) +
+                      cube_error_42(inner)),
+              1e-6);
+  EXPECT_EQ(metrics[0].num_redundant_spheres, 0);
+  EXPECT_NEAR(metrics[0].mean_error_42_covering, metrics[0].mean_error_42, 1e-9);
+
+  // Redundancy is per sphere: two copies of a covering sphere can each be removed alone.
+  const icd::collision::Sphere whole{0, 0, 0, std::sqrt(3.0) + 1e-6};
+  const auto twice = evaluate_sphere_tree(cube, root_over({whole, whole}), options);
+  EXPECT_EQ(twice[1].num_redundant_spheres, 2);
+  // Without the middle and inner spheres nothing is redundant.
+  const auto halves = evaluate_sphere_tree(cube, root_over({left, right}), options);
+  EXPECT_EQ(halves[1].num_redundant_spheres, 0);
+  EXPECT_NEAR(halves[1].mean_error_42_covering, halves[1].mean_error_42, 1e-9);
 }
 
 TEST(Evaluation, RejectsBadOptionsAndTrees) {
