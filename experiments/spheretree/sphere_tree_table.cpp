@@ -86,12 +86,12 @@ void print_table(const std::string& model, const std::string& method, double sec
   for (const auto& m : levels) {
     std::printf(
         "%-7s %-7s %5d %7d %9.1f %8.2f %9.1f %8.2f %10.5f%% %8lld %7.2f %6d %9.1f %8.2f %6d %8.2f "
-        "%8.2f\n",
+        "%8.2f %7.2f\n",
         model.c_str(), method.c_str(), m.level, m.num_spheres, m.worst_error_42, m.mean_error_42,
         m.worst_error_162, m.mean_error_162, 100.0 * m.uncovered_area_fraction,
         m.num_uncovered_samples, m.max_uncovered_gap, m.num_uncovered_vertices,
         m.max_child_protrusion, seconds, m.num_redundant_spheres, m.mean_error_42_covering,
-        m.mean_error_162_covering);
+        m.mean_error_162_covering, m.shell_thickness);
   }
 }
 
@@ -348,11 +348,13 @@ int run(int argc, char** argv) {
       "# from a probe outside the (hole-closed) mesh to the surface; coverage on a dense\n"
       "# sampling (spacing 1 unit), gap = largest distance of an uncovered sample to a sphere;\n"
       "# redund = spheres that cover no vertex or dense sample alone (each removable alone\n"
-      "# without uncovering anything), mean42c / mean162c = means over the other spheres.\n");
-  std::printf("%-7s %-7s %5s %7s %9s %8s %9s %8s %11s %8s %7s %6s %9s %8s %6s %8s %8s\n", "model",
-              "method", "level", "spheres", "worst42", "mean42", "worst162", "mean162",
+      "# without uncovering anything), mean42c / mean162c = means over the other spheres;\n"
+      "# shell = volume of the level's union outside the object / surface area (the mean\n"
+      "# thickness of the shell it adds; independent of the sphere count).\n");
+  std::printf("%-7s %-7s %5s %7s %9s %8s %9s %8s %11s %8s %7s %6s %9s %8s %6s %8s %8s %7s\n",
+              "model", "method", "level", "spheres", "worst42", "mean42", "worst162", "mean162",
               "uncovered", "unc.pts", "gap", "unc.v", "protrude", "build_s", "redund", "mean42c",
-              "mean162c");
+              "mean162c", "shell");
   for (const auto& model : models) {
     const fs::path path = data / model.file;
     if (!fs::exists(path)) {

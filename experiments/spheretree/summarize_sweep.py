@@ -21,6 +21,8 @@ for line in open(sys.argv[1]):
             mean162=float(f[7]), uncovered=int(f[9]))
         if len(f) > 16:
             per_level[int(f[2])].update(redund=int(f[14]), mean42c=float(f[15]))
+        if len(f) > 17:
+            per_level[int(f[2])].update(shell=float(f[17]))
     m = re.match(r"# \w+ level (\d+): error on 2562 directions: worst ([\d.]+) mean ([\d.]+)", line)
     if m and "fit42" not in line:
         per_level.setdefault(int(m.group(1)), {}).update(
@@ -43,6 +45,8 @@ for e, per_level, extra in builds:
 cols = ["leaves", "worst42", "mean42", "mean162", "mean2562", "worst2562", "uncovered", "cpu"]
 if any("redund" in r for r in rows):
     cols[3:3] = ["redund", "mean42c"]
+if any("shell" in r for r in rows):
+    cols.insert(cols.index("mean2562") + 1, "shell")
 if any("wall" in extra for _, _, extra in builds):
     cols.append("wall")
 print("E".ljust(8) + "".join(c.rjust(10) for c in cols))

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 #include <unordered_map>
 
@@ -40,6 +41,12 @@ class SphereGrid {
         for (int b = lo.y(); b <= hi.y(); ++b)
           for (int c = lo.z(); c <= hi.z(); ++c) m_cells[key({a, b, c})].push_back(i);
     }
+    // Cells whose keys collide share a bucket: list each sphere once, so that
+    // the counts below count spheres, not cells.
+    for (auto& [cell_key, list] : m_cells) {
+      std::sort(list.begin(), list.end());
+      list.erase(std::unique(list.begin(), list.end()), list.end());
+    }
   }
 
   /// Number of spheres that contain p, counted up to 2; `only` is the one
@@ -59,6 +66,17 @@ class SphereGrid {
       for (int i : it->second) {
         if (visit(i)) return count;
       }
+    }
+    return count;
+  }
+
+  /// Number of spheres that contain p.
+  int count_all(const Eigen::Vector3d& p) const {
+    int count = 0;
+    for (int i : m_big) count += inside(i, p) ? 1 : 0;
+    auto it = m_cells.find(key(cell(p)));
+    if (it != m_cells.end()) {
+      for (int i : it->second) count += inside(i, p) ? 1 : 0;
     }
     return count;
   }
@@ -114,9 +132,11 @@ MatX3d probe_directions(int subdivisions) { return make_icosphere(subdivisions, 
 std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
                                                const collision::SphereTree& tree,
                                                const EvaluationOptions& options) {
-  if (!(options.normalized_size > 0) || !(options.coverage_spacing > 0)) {
+  if (!(options.normalized_size > 0) || !(options.coverage_spacing > 0) ||
+      options.shell_samples < 0) {
     throw ParameterError(
-        "EvaluationOptions: normalized_size and coverage_spacing must be positive");
+        "EvaluationOptions: normalized_size and coverage_spacing must be positive, "
+        "shell_samples >= 0");
   }
   check_tree(tree);
   const double side = longest_bounding_box_side(mesh.V);
@@ -216,6 +236,35 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
         }
       }
     }
+  }
+  // Shell volume: each sphere's part beyond the depth of its centre (the
+  // rest is inside the object), sampled uniformly by volume; a sample outside
+  // the object counts 1 / (spheres containing it), so the sum is the volume
+  // of the union outside the object.
+  for (int l = 0; l < num_levels && options.shell_samples > 0 && total_area > 0; ++l) {
+    LevelMetrics& m = out[static_cast<size_t>(l)];
+    const int begin = tree.level_offset[static_cast<size_t>(l)];
+    double volume = 0;
+    for (int i = 0; i < m.num_spheres; ++i) {
+      const auto& s = spheres[static_cast<size_t>(begin + i)];
+      const double depth = oracle.inside(s.center()) ? oracle.distance(s.center()) : 0.0;
+      if (depth >= s.r) continue;
+      const double r3 = s.r * s.r * s.r, d3 = depth * depth * depth;
+      const double part = 4.0 / 3.0 * M_PI * (r3 - d3) / options.shell_samples;
+      std::mt19937 rng(static_cast<unsigned>(begin + i) * 2654435761u + 12345u);
+      std::uniform_real_distribution<double> uniform(0.0, 1.0);
+      std::normal_distribution<double> normal(0.0, 1.0);
+      for (int k = 0; k < options.shell_samples; ++k) {
+        Eigen::Vector3d dir(normal(rng), normal(rng), normal(rng));
+        dir.normalize();
+        const double rho = std::cbrt(d3 + uniform(rng) * (r3 - d3));
+        const Eigen::Vector3d p = s.center() + rho * dir;
+        if (oracle.inside(p)) continue;
+        const int count = grids[static_cast<size_t>(l)].count_all(p);
+        volume += part / std::max(count, 1);
+      }
+    }
+    m.shell_thickness = volume / total_area;
   }
   for (int l = 0; l < num_levels; ++l) {
     LevelMetrics& m = out[static_cast<size_t>(l)];

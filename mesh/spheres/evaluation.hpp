@@ -17,6 +17,9 @@ struct EvaluationOptions {
   /// spacing)) whose corners are tested, weighted by a third of each
   /// sub-triangle's area. Make it much finer than the build's samples.
   double coverage_spacing = 1.0;
+  /// Points per sphere of the shell-volume estimate (LevelMetrics::shell_thickness;
+  /// 0 skips it; >= 0).
+  int shell_samples = 256;
 };
 
 /// Metrics of one level of the tree (normalized units).
@@ -43,6 +46,14 @@ struct LevelMetrics {
   int num_redundant_spheres = 0;
   double mean_error_42_covering = 0;   ///< mean 42-probe error of the other spheres
   double mean_error_162_covering = 0;  ///< mean 162-probe error of the other spheres
+  /// Volume of the level's union of spheres outside the object divided by
+  /// the surface area: the mean thickness of the shell the level adds around
+  /// the object (normalized units). Unlike the mean error it does not depend
+  /// on how many spheres share the work, and a sphere inside the object adds
+  /// nothing. Estimated by sampling each sphere's part beyond its centre's
+  /// depth (EvaluationOptions::shell_samples points, fixed seed), each point
+  /// weighted by one over the number of spheres that contain it.
+  double shell_thickness = 0;
   /// How far the level's spheres stick out of their parents (max over nodes
   /// of |c - c_parent| + r - r_parent, >= 0; 0 for the root).
   double max_child_protrusion = 0;

@@ -136,6 +136,27 @@ TEST(Evaluation, CountsSpheresThatCoverNothingAlone) {
   EXPECT_NEAR(halves[1].mean_error_42_covering, halves[1].mean_error_42, 1e-9);
 }
 
+TEST(Evaluation, ShellThicknessIsTheUnionVolumeOutsideOverTheArea) {
+  const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
+  EvaluationOptions options;
+  options.coverage_spacing = 50.0;
+  options.shell_samples = 20000;
+  // A sphere of radius R < sqrt(2) about the centre sticks out of each face by
+  // a cap of height h = R - 1 and volume pi h^2 (3R - h) / 3; the area is 24.
+  const double R = 1.2, h = R - 1;
+  const double expected = 1000.0 * 6 * M_PI * h * h * (3 * R - h) / 3 / 24;  // normalized units
+  const icd::collision::Sphere ball{0, 0, 0, R}, inner{0.1, 0, 0, 0.5};
+  const auto one = evaluate_sphere_tree(cube, root_over({ball}), options);
+  EXPECT_NEAR(one[1].shell_thickness, expected, 0.02 * expected);
+  // A copy of the sphere and a sphere inside the object add no volume.
+  const auto more = evaluate_sphere_tree(cube, root_over({ball, inner, ball}), options);
+  EXPECT_NEAR(more[1].shell_thickness, expected, 0.02 * expected);
+  const auto inside = evaluate_sphere_tree(cube, root_over({inner}), options);
+  EXPECT_EQ(inside[1].shell_thickness, 0.0);
+  options.shell_samples = -1;
+  EXPECT_THROW(evaluate_sphere_tree(cube, root_over({ball}), options), icd::ParameterError);
+}
+
 TEST(Evaluation, RejectsBadOptionsAndTrees) {
   const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
   EvaluationOptions bad;
