@@ -1,7 +1,7 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
 //                   [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]
-//                   [--coverage-spacing UNITS]
+//                   [--coverage-spacing UNITS] [--shell-samples N]  (evaluation)
 //                   [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
@@ -11,6 +11,7 @@
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
 //                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
+//                   [--prune 0|1]  (SphereTreeOptions::prune_redundant_leaves)
 //                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]
 //                   [--split-stop-stuck 0|1] [--split-redivide N]  (split_worst)
 //                   [--caps 1,8,64,N[,M]]  (spheres allowed per level; depth = count - 1)
@@ -182,12 +183,12 @@ void print_usage(std::ostream& os) {
   os << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
         " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
         " [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]"
-        " [--coverage-spacing UNITS]"
+        " [--coverage-spacing UNITS] [--shell-samples N]"
         " [--reduction split|merge|both]"
         " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
         " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
         " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E]"
-        " [--fill 0|1]"
+        " [--fill 0|1] [--prune 0|1]"
         " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]"
         " [--split-stop-stuck 0|1] [--split-redivide N]"
         " [--caps 1,8,64,N[,M]] [--branching B] [--build-branching B]"
@@ -252,6 +253,8 @@ int run(int argc, char** argv) {
       options.relieve_moves = std::atoi(value);
     else if (key == "--fill")
       options.fill_leaf_budget = std::atoi(value) != 0;
+    else if (key == "--prune")
+      options.prune_redundant_leaves = std::atoi(value) != 0;
     else if (key == "--split-worst")
       options.split_worst = std::atoi(value) != 0;
     else if (key == "--split-relief")
@@ -315,6 +318,8 @@ int run(int argc, char** argv) {
       options.protrusion.check_directions = std::atoi(value);
     else if (key == "--coverage-spacing")
       evaluation.coverage_spacing = std::atof(value);
+    else if (key == "--shell-samples")
+      evaluation.shell_samples = std::atoi(value);
     else if (key == "--reduction") {
       const std::string v = value;
       if (v == "split")
@@ -398,6 +403,10 @@ int run(int argc, char** argv) {
     // Model units -> the table's (longest bounding-box side 2000).
     const double to_2000 =
         2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    if (options.prune_redundant_leaves || options.fill_leaf_budget) {
+      std::printf("# %s: %d redundant leaves pruned, %d leaves split to fill the budget\n",
+                  model.name.c_str(), ours.num_pruned, ours.num_budget_splits);
+    }
     if (options.split_worst) {
       const auto& w = ours.worst_split;
       std::printf(

@@ -20,7 +20,8 @@ for line in open(sys.argv[1]):
             leaves=int(f[3]), worst42=float(f[4]), mean42=float(f[5]), worst162=float(f[6]),
             mean162=float(f[7]), uncovered=int(f[9]))
         if len(f) > 16:
-            per_level[int(f[2])].update(redund=int(f[14]), mean42c=float(f[15]))
+            per_level[int(f[2])].update(redund=int(f[14]), mean42c=float(f[15]),
+                                        mean162c=float(f[16]))
         if len(f) > 17:
             per_level[int(f[2])].update(shell=float(f[17]))
     m = re.match(r"# \w+ level (\d+): error on 2562 directions: worst ([\d.]+) mean ([\d.]+)", line)
@@ -44,7 +45,7 @@ for e, per_level, extra in builds:
 
 cols = ["leaves", "worst42", "mean42", "mean162", "mean2562", "worst2562", "uncovered", "cpu"]
 if any("redund" in r for r in rows):
-    cols[3:3] = ["redund", "mean42c"]
+    cols[3:3] = ["redund", "mean42c", "mean162c"]
 if any("shell" in r for r in rows):
     cols.insert(cols.index("mean2562") + 1, "shell")
 if any("wall" in extra for _, _, extra in builds):

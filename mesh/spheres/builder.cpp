@@ -269,6 +269,91 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
   refit_inner_nodes(dense, levels, parent_of);
 }
 
+/// Removes the leaves that cover nothing alone: a leaf all of whose samples
+/// other leaves cover with margin, those leaves' ancestors too, is dropped
+/// and its samples go to them (the first such leaf, in level order). The
+/// boundary exchanges leave such leaves behind (stripped to one sample, the
+/// last one a sphere keeps, by neighbours that grew over their patch): they
+/// cost a leaf slot and cover nothing. Fewest samples first, so that of two
+/// leaves that cover each other's samples the larger stays. No radius grows;
+/// every sample stays covered with margin by a leaf and its ancestors, and
+/// the inner nodes' samples become the union of their children's again.
+/// Siblings stay contiguous. Returns the number of leaves removed.
+int prune_redundant_leaves(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
+                           std::vector<std::vector<int>>& parent_of) {
+  if (levels.size() < 2) return 0;
+  const size_t last = levels.size() - 1;
+  std::vector<Node>& leaves = levels[last];
+  const size_t n = leaves.size();
+  auto reach = [&](const FittedSphere& sp, int s) {
+    return (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s];
+  };
+  auto ancestors_cover = [&](size_t leaf, int s) {
+    int node = static_cast<int>(leaf);
+    for (size_t l = last; l >= 1; --l) {
+      node = parent_of[l][static_cast<size_t>(node)];
+      const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
+      if (reach(a, s) > a.radius) return false;
+    }
+    return true;
+  };
+  // Leaves whose spheres meet: the only ones that can cover each other's samples.
+  std::vector<std::vector<size_t>> near(n);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j) {
+      const FittedSphere &a = leaves[i].sphere, &b = leaves[j].sphere;
+      if (j != i && (a.center - b.center).norm() < a.radius + b.radius) near[i].push_back(j);
+    }
+  }
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return leaves[a].sphere.members.size() < leaves[b].sphere.members.size();
+  });
+  std::vector<int> children(levels[last - 1].size(), 0);
+  for (int p : parent_of[last]) children[static_cast<size_t>(p)] += 1;
+  std::vector<char> gone(n, 0);
+  int removed = 0;
+  for (size_t i : order) {
+    // A parent keeps at least one child.
+    if (children[static_cast<size_t>(parent_of[last][i])] < 2) continue;
+    const std::vector<int>& members = leaves[i].sphere.members;
+    std::vector<size_t> to;
+    for (int s : members) {
+      size_t k = n;
+      for (size_t j : near[i]) {
+        if (!gone[j] && reach(leaves[j].sphere, s) <= leaves[j].sphere.radius &&
+            ancestors_cover(j, s)) {
+          k = j;
+          break;
+        }
+      }
+      if (k == n) break;
+      to.push_back(k);
+    }
+    if (to.size() != members.size()) continue;
+    for (size_t m = 0; m < to.size(); ++m) {
+      std::vector<int>& into = leaves[to[m]].sphere.members;
+      into.insert(std::upper_bound(into.begin(), into.end(), members[m]), members[m]);
+    }
+    gone[i] = 1;
+    children[static_cast<size_t>(parent_of[last][i])] -= 1;
+    ++removed;
+  }
+  if (removed == 0) return 0;
+  std::vector<Node> kept;
+  std::vector<int> kept_parent;
+  for (size_t i = 0; i < n; ++i) {
+    if (gone[i]) continue;
+    kept.push_back(std::move(leaves[i]));
+    kept_parent.push_back(parent_of[last][i]);
+  }
+  leaves = std::move(kept);
+  parent_of[last] = std::move(kept_parent);
+  refit_inner_nodes(dense, levels, parent_of);
+  return removed;
+}
+
 /// Spends leaf spheres that the top-down pass lost (a child of a chosen
 /// configuration that receives no coverage sample is dropped): while the leaf
 /// level holds fewer than `cap` spheres, the leaf with the largest error bound
@@ -777,6 +862,12 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     refit_inner_nodes(dense, levels, parent_of);
   }
   end_step("sum exchange");
+  if (options.prune_redundant_leaves && levels.size() > 1) {
+    out.num_pruned = prune_redundant_leaves(dense, levels, parent_of);
+    out.num_budget_splits += fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
+                                              leaf_cap, leaf_parent_limit);
+    end_step("prune");
+  }
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
     // With regrouping ahead, the inner nodes are polished after it.

@@ -106,6 +106,12 @@ struct SphereTreeOptions {
   /// than its cap): the leaf with the largest error bound whose parent has
   /// room is split in two, while that lowers both halves' bound below it.
   bool fill_leaf_budget = false;
+  /// After lower_error_sum: remove the leaves that cover nothing alone (all
+  /// their samples covered with margin by other leaves, and by those leaves'
+  /// ancestors; the boundary exchanges strip such leaves down to one sample)
+  /// and spend their slots as fill_leaf_budget does (the leaf with the
+  /// largest error bound whose parent has room split in two).
+  bool prune_redundant_leaves = false;
   /// After the top-down pass, optimise the leaves jointly (a leaf may take
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.
@@ -174,7 +180,8 @@ struct SphereTreeBuild {
   double polish_cpu_seconds = 0;   ///< CPU time of the protrusion polish
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
-  int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget
+  int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget (and after pruning)
+  int num_pruned = 0;              ///< leaves removed by prune_redundant_leaves
   int num_regrouped = 0;           ///< parent changes made by build_branching's regrouping
   WorstSplitResult worst_split;    ///< what split_worst_leaves did (with split_worst)
   /// For each level l >= 1 (index l - 1): the largest worst child error bound

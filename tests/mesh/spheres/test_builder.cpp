@@ -313,6 +313,84 @@ TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   expect_every_level_covers(tree, sphere, 13);
 }
 
+/// Leaves of `build` all of whose samples some other leaf covers with margin,
+/// that leaf's ancestors too (brute force over every leaf and ancestor).
+int leaves_covered_by_others(const SphereTreeBuild& build) {
+  const auto& tree = build.tree;
+  const auto& P = build.samples.points;
+  const int leaf_level = tree.num_levels() - 1;
+  std::vector<int> parent(static_cast<size_t>(tree.num_nodes()), -1);
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    for (int k = 0; k < tree.child_count[i]; ++k) parent[tree.first_child[i] + k] = i;
+  }
+  auto covers = [&](int node, int s) {
+    return (P.row(s).transpose() - tree.spheres[node].center()).norm() + build.samples.gap[s] <=
+           tree.spheres[node].r;
+  };
+  int count = 0;
+  for (int i = tree.level_offset[leaf_level]; i < tree.num_nodes(); ++i) {
+    bool all = true;
+    for (int s : build.node_samples[i]) {
+      bool found = false;
+      for (int j = tree.level_offset[leaf_level]; j < tree.num_nodes() && !found; ++j) {
+        if (j == i || !covers(j, s)) continue;
+        found = true;
+        for (int a = parent[j]; a >= 0 && found; a = parent[a]) found = covers(a, s);
+      }
+      if (!found) {
+        all = false;
+        break;
+      }
+    }
+    count += all ? 1 : 0;
+  }
+  return count;
+}
+
+TEST(SphereTreeBuilder, PruneRedundantLeavesRemovesOnlyThemAndKeepsEveryGuarantee) {
+  // With the protrusion polish and split_worst off, the pruning (and the fill
+  // of the slots it frees) is the last change to the leaves. Every leaf it
+  // removes was one whose samples other leaves (and their ancestors) cover
+  // with margin, counted by brute force on the same build without it; the
+  // independent evaluation finds fewer leaves that cover nothing alone; and
+  // the tree keeps its caps, branching and coverage.
+  // On this torus (coarse medial samples, branching 8) the boundary
+  // exchanges leave most leaves covered by others.
+  const icd::SurfaceMesh torus = icd::make_torus(1.0, 0.3, 24, 12);
+  SphereTreeOptions o = lossy_leaf_options();
+  o.protrusion_polish = false;
+  o.split_worst = false;
+  const SphereTreeBuild plain = build_sphere_tree(torus, o);
+  o.prune_redundant_leaves = true;
+  const SphereTreeBuild build = build_sphere_tree(torus, o);
+  const auto& tree = build.tree;
+  const int redundant = leaves_covered_by_others(plain);
+  EXPECT_GT(build.num_pruned, 0) << "the case must exercise the pruning";
+  EXPECT_LE(build.num_pruned, redundant);
+  const int leaf_level = tree.num_levels() - 1;
+  EXPECT_EQ(tree.num_nodes() - tree.level_offset[leaf_level],
+            plain.tree.num_nodes() - plain.tree.level_offset[leaf_level] - build.num_pruned +
+                build.num_budget_splits);
+  EXPECT_LT(leaves_covered_by_others(build), redundant);
+  // A sample moves only to a leaf whose ancestors cover it already: no inner
+  // node grows (the inner levels keep their nodes and centres).
+  ASSERT_EQ(tree.level_offset[leaf_level], plain.tree.level_offset[leaf_level]);
+  for (int i = 0; i < tree.level_offset[leaf_level]; ++i) {
+    EXPECT_EQ(tree.spheres[i].center(), plain.tree.spheres[i].center());
+    EXPECT_LE(tree.spheres[i].r, plain.tree.spheres[i].r) << "inner node " << i;
+  }
+  EvaluationOptions evaluation;
+  evaluation.coverage_spacing = 10;
+  evaluation.shell_samples = 0;
+  EXPECT_LT(evaluate_sphere_tree(torus, tree, evaluation).back().num_redundant_spheres,
+            evaluate_sphere_tree(torus, plain.tree, evaluation).back().num_redundant_spheres);
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+  EXPECT_LE(tree.num_nodes() - tree.level_offset[leaf_level], 64);
+  expect_nodes_cover_and_children_divide(build);
+  expect_every_level_covers(tree, torus, 29);
+}
+
 TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst) {
   // The worst-leaf split is the last step, so the build without it is the
   // tree it starts from. On this sphere (coarse medial samples, branching 8)
