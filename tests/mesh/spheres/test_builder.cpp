@@ -352,43 +352,56 @@ TEST(SphereTreeBuilder, PruneRedundantLeavesRemovesOnlyThemAndKeepsEveryGuarante
   // of the slots it frees) is the last change to the leaves. Every leaf it
   // removes was one whose samples other leaves (and their ancestors) cover
   // with margin, counted by brute force on the same build without it; the
-  // independent evaluation finds fewer leaves that cover nothing alone; and
-  // the tree keeps its caps, branching and coverage.
-  // On this torus (coarse medial samples, branching 8) the boundary
-  // exchanges leave most leaves covered by others.
-  const icd::SurfaceMesh torus = icd::make_torus(1.0, 0.3, 24, 12);
-  SphereTreeOptions o = lossy_leaf_options();
-  o.protrusion_polish = false;
-  o.split_worst = false;
-  const SphereTreeBuild plain = build_sphere_tree(torus, o);
-  o.prune_redundant_leaves = true;
-  const SphereTreeBuild build = build_sphere_tree(torus, o);
-  const auto& tree = build.tree;
-  const int redundant = leaves_covered_by_others(plain);
-  EXPECT_GT(build.num_pruned, 0) << "the case must exercise the pruning";
-  EXPECT_LE(build.num_pruned, redundant);
-  const int leaf_level = tree.num_levels() - 1;
-  EXPECT_EQ(tree.num_nodes() - tree.level_offset[leaf_level],
-            plain.tree.num_nodes() - plain.tree.level_offset[leaf_level] - build.num_pruned +
-                build.num_budget_splits);
-  EXPECT_LT(leaves_covered_by_others(build), redundant);
-  // A sample moves only to a leaf whose ancestors cover it already: no inner
-  // node grows (the inner levels keep their nodes and centres).
-  ASSERT_EQ(tree.level_offset[leaf_level], plain.tree.level_offset[leaf_level]);
-  for (int i = 0; i < tree.level_offset[leaf_level]; ++i) {
-    EXPECT_EQ(tree.spheres[i].center(), plain.tree.spheres[i].center());
-    EXPECT_LE(tree.spheres[i].r, plain.tree.spheres[i].r) << "inner node " << i;
+  // independent evaluation finds fewer leaves that cover nothing alone; no
+  // inner node grows; and the tree keeps its caps, branching and coverage.
+  // On the torus (coarse medial samples, branching 8) the boundary exchanges
+  // leave 40 of 64 leaves covered by others; on the box with depth 3, 28 of
+  // 139, and 5 more covered by leaves whose ancestors do not cover the
+  // sample (which the pruning must not use).
+  struct PruneCase {
+    icd::SurfaceMesh mesh;
+    int depth;
+  };
+  const std::vector<PruneCase> prune_cases = {
+      {icd::make_torus(1.0, 0.3, 24, 12), 2}, {icd::make_box_surface({0, 0, 0}, {2, 1, 0.6}), 3}};
+  for (const PruneCase& c : prune_cases) {
+    SCOPED_TRACE("depth " + std::to_string(c.depth));
+    SphereTreeOptions o = lossy_leaf_options();
+    o.depth = c.depth;
+    o.protrusion_polish = false;
+    o.split_worst = false;
+    const SphereTreeBuild plain = build_sphere_tree(c.mesh, o);
+    o.prune_redundant_leaves = true;
+    const SphereTreeBuild build = build_sphere_tree(c.mesh, o);
+    const auto& tree = build.tree;
+    const int redundant = leaves_covered_by_others(plain);
+    EXPECT_GT(build.num_pruned, 0) << "the case must exercise the pruning";
+    EXPECT_LE(build.num_pruned, redundant);
+    const int leaf_level = tree.num_levels() - 1;
+    EXPECT_EQ(tree.num_nodes() - tree.level_offset[leaf_level],
+              plain.tree.num_nodes() - plain.tree.level_offset[leaf_level] - build.num_pruned +
+                  build.num_budget_splits);
+    EXPECT_LT(leaves_covered_by_others(build), redundant);
+    // A sample moves only to a leaf whose ancestors cover it already: no inner
+    // node grows (the inner levels keep their nodes and centres).
+    ASSERT_EQ(tree.level_offset[leaf_level], plain.tree.level_offset[leaf_level]);
+    for (int i = 0; i < tree.level_offset[leaf_level]; ++i) {
+      EXPECT_EQ(tree.spheres[i].center(), plain.tree.spheres[i].center());
+      EXPECT_LE(tree.spheres[i].r, plain.tree.spheres[i].r) << "inner node " << i;
+    }
+    EvaluationOptions evaluation;
+    evaluation.coverage_spacing = 10;
+    evaluation.shell_samples = 0;
+    EXPECT_LT(evaluate_sphere_tree(c.mesh, tree, evaluation).back().num_redundant_spheres,
+              evaluate_sphere_tree(c.mesh, plain.tree, evaluation).back().num_redundant_spheres);
+    EXPECT_NO_THROW(icd::collision::validate(tree));
+    for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+    long long cap = 1;
+    for (int l = 0; l < c.depth; ++l) cap *= o.branching;
+    EXPECT_LE(tree.num_nodes() - tree.level_offset[leaf_level], cap);
+    expect_nodes_cover_and_children_divide(build);
+    expect_every_level_covers(tree, c.mesh, 29);
   }
-  EvaluationOptions evaluation;
-  evaluation.coverage_spacing = 10;
-  evaluation.shell_samples = 0;
-  EXPECT_LT(evaluate_sphere_tree(torus, tree, evaluation).back().num_redundant_spheres,
-            evaluate_sphere_tree(torus, plain.tree, evaluation).back().num_redundant_spheres);
-  EXPECT_NO_THROW(icd::collision::validate(tree));
-  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-  EXPECT_LE(tree.num_nodes() - tree.level_offset[leaf_level], 64);
-  expect_nodes_cover_and_children_divide(build);
-  expect_every_level_covers(tree, torus, 29);
 }
 
 TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst) {
