@@ -50,7 +50,9 @@ void check_options(const SphereTreeOptions& o) {
   if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
       o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
       !(o.worst_split.mean_rise_limit >= 0)) {
-    fail("worst_split: measure/choice directions must be >= 1, max_tries >= 0, relief_fraction >= 0");
+    fail(
+        "worst_split: measure/choice directions must be >= 1, max_tries >= 0, relief_fraction >= "
+        "0");
   }
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
   if (o.threads < 0) fail("threads must be >= 0, got " + std::to_string(o.threads));
@@ -638,7 +640,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   auto step_start = CpuClock::now();
   auto end_step = [&](const char* name) {
     const auto now = CpuClock::now();
-    out.step_cpu_seconds.emplace_back(name, std::chrono::duration<double>(now - step_start).count());
+    out.step_cpu_seconds.emplace_back(name,
+                                      std::chrono::duration<double>(now - step_start).count());
     step_start = now;
   };
   const SurfaceMesh closed = close_holes(input);

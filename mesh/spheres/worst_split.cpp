@@ -119,7 +119,8 @@ Halves split_in_two(const ReductionProblem& coarse, const ReductionProblem& dens
   }
   if (out.spheres.size() != 2) return Halves{};
   for (size_t k = 0; k < 2; ++k)
-    out.error[k] = sphere_protrusion(oracle, out.spheres[k].center, out.spheres[k].radius, directions);
+    out.error[k] =
+        sphere_protrusion(oracle, out.spheres[k].center, out.spheres[k].radius, directions);
   std::vector<FittedSphere> medial_split = out.spheres;
   for (auto& h : medial_split) h.tag = -1;
   medial_split[0].tag = 0, medial_split[1].tag = 1;
@@ -219,7 +220,8 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
   // subset's worth of the measuring ones: slightly below the mean on those,
   // so the rule below errs on the side of not raising the mean).
   double mean_error = 0;
-  for (const auto& s : level.spheres) mean_error += sphere_protrusion(oracle, s.center, s.radius, choice);
+  for (const auto& s : level.spheres)
+    mean_error += sphere_protrusion(oracle, s.center, s.radius, choice);
   mean_error /= static_cast<double>(std::max<size_t>(level.spheres.size(), 1));
   result.mean_before = mean_error;
 
@@ -324,9 +326,9 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       }
     }
     ++result.tries;
-    Halves halves = split_in_two(coarse, dense, oracle, reduction, level.spheres[i],
-                                 level.medial[i], 7919u * static_cast<unsigned>(i) + 17u,
-                                 options.polish, choice, directions);
+    Halves halves =
+        split_in_two(coarse, dense, oracle, reduction, level.spheres[i], level.medial[i],
+                     7919u * static_cast<unsigned>(i) + 17u, options.polish, choice, directions);
     const bool relief = worst >= relief_threshold;
     // A relief try that found no split (`counter`: relief_no_split) or no
     // room (relief_no_merge) first tries the re-division with a sibling; if

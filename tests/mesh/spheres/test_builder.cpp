@@ -164,7 +164,8 @@ TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem
       const SphereTreeBuild& build = cached_build(c, method);
       expect_nodes_cover_and_children_divide(build);
       ASSERT_FALSE(build.node_samples.empty());
-      EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), build.samples.points.rows());
+      EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()),
+                build.samples.points.rows());
     }
 }
 
@@ -175,7 +176,8 @@ TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
       const SphereTreeBuild& build = cached_build(c, method);
       const auto& tree = build.tree;
       const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
-      for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, P), 0) << "level " << l;
+      for (int l = 0; l < tree.num_levels(); ++l)
+        EXPECT_EQ(uncovered_on_level(tree, l, P), 0) << "level " << l;
     }
 }
 
@@ -216,7 +218,8 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
   EXPECT_NO_THROW(icd::collision::validate(tree));
   expect_nodes_cover_and_children_divide(build);
   const icd::MatX3d D = dense_random_points(torus.mesh, 5000, 11);
-  for (int l = 0; l < tree.num_levels(); ++l) EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+  for (int l = 0; l < tree.num_levels(); ++l)
+    EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
 }
 
 /// Options of the leaf-budget tests: the icosphere's coarse medial samples
@@ -245,8 +248,8 @@ void expect_every_level_covers(const icd::collision::SphereTree& tree, const icd
 
 /// Protrusion of each leaf of `tree` on `directions` (recomputed here with
 /// sphere_protrusion, independently of the builder's bookkeeping).
-std::vector<double> leaf_protrusions(const icd::collision::SphereTree& tree, const MeshOracle& oracle,
-                                     const icd::MatX3d& directions) {
+std::vector<double> leaf_protrusions(const icd::collision::SphereTree& tree,
+                                     const MeshOracle& oracle, const icd::MatX3d& directions) {
   std::vector<double> e;
   for (int i = tree.level_offset[tree.num_levels() - 1]; i < tree.num_nodes(); ++i)
     e.push_back(sphere_protrusion(oracle, tree.spheres[i].center(), tree.spheres[i].r, directions));
@@ -305,8 +308,8 @@ TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
   ASSERT_EQ(tree.num_levels(), 3);
   EXPECT_GT(build.num_budget_splits, 0) << "the case must exercise the fill";
   const int leaves = tree.level_offset[3] - tree.level_offset[2];
-  EXPECT_EQ(leaves, plain.tree.level_offset[3] - plain.tree.level_offset[2] +
-                        build.num_budget_splits);
+  EXPECT_EQ(leaves,
+            plain.tree.level_offset[3] - plain.tree.level_offset[2] + build.num_budget_splits);
   EXPECT_LE(leaves, 64);
   expect_nodes_cover_and_children_divide(build);
   for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
@@ -362,8 +365,8 @@ TEST(SphereTreeBuilder, PruneRedundantLeavesRemovesOnlyThemAndKeepsEveryGuarante
     icd::SurfaceMesh mesh;
     int depth;
   };
-  const std::vector<PruneCase> prune_cases = {
-      {icd::make_torus(1.0, 0.3, 24, 12), 2}, {icd::make_box_surface({0, 0, 0}, {2, 1, 0.6}), 3}};
+  const std::vector<PruneCase> prune_cases = {{icd::make_torus(1.0, 0.3, 24, 12), 2},
+                                              {icd::make_box_surface({0, 0, 0}, {2, 1, 0.6}), 3}};
   for (const PruneCase& c : prune_cases) {
     SCOPED_TRACE("depth " + std::to_string(c.depth));
     SphereTreeOptions o = lossy_leaf_options();
