@@ -102,6 +102,26 @@ long long level_cap(const SphereTreeOptions& options, int l) {
   return cap;
 }
 
+/// |s - c| + gap[s]: the radius a sphere centred at sp.center needs to cover
+/// sample s with margin.
+double reach(const ReductionProblem& problem, const FittedSphere& sp, int s) {
+  return (problem.points.row(s).transpose() - sp.center).norm() + problem.gap[s];
+}
+
+/// True when every ancestor of leaf `leaf` (of the last level) covers sample
+/// s with margin: the condition for moving s to that leaf without growing
+/// any inner node.
+bool ancestors_cover(const ReductionProblem& dense, const std::vector<std::vector<Node>>& levels,
+                     const std::vector<std::vector<int>>& parent_of, int leaf, int s) {
+  int node = leaf;
+  for (size_t l = levels.size() - 1; l >= 1; --l) {
+    node = parent_of[l][static_cast<size_t>(node)];
+    const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
+    if (reach(dense, a, s) > a.radius) return false;
+  }
+  return true;
+}
+
 /// Jointly re-optimises the leaf level across sibling groups (a leaf may take
 /// samples from a neighbour of its parent), then restores the wrapped-tree
 /// invariant bottom-up: each inner node's samples become the union of its
@@ -167,8 +187,7 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
       continue;
     }
     double r = 0;
-    for (int m : sp.members)
-      r = std::max(r, (dense.points.row(m).transpose() - sp.center).norm() + dense.gap[m]);
+    for (int m : sp.members) r = std::max(r, reach(dense, sp, m));
     sp.radius = r;
     sp.error = r - sp.depth;
     leaves[i].sphere = sp;
@@ -209,8 +228,7 @@ void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<No
       std::sort(unions[p].begin(), unions[p].end());
       sp.members = std::move(unions[p]);
       double r = 0;
-      for (int s : sp.members)
-        r = std::max(r, (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s]);
+      for (int s : sp.members) r = std::max(r, reach(dense, sp, s));
       sp.radius = r;
       sp.error = r - sp.depth;
     }
@@ -234,24 +252,13 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
   for (size_t l = 0; l < levels.size(); ++l) {
     for (const Node& n : levels[l]) level_worst[l] = std::max(level_worst[l], n.sphere.error);
   }
-  auto reach = [&](const FittedSphere& sp, int s) {
-    return (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s];
-  };
-  auto accepts = [&](int leaf, int s) {
-    int node = leaf;
-    for (size_t l = last; l >= 1; --l) {
-      node = parent_of[l][static_cast<size_t>(node)];
-      const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
-      if (reach(a, s) > a.radius) return false;
-    }
-    return true;
-  };
+  auto accepts = [&](int leaf, int s) { return ancestors_cover(dense, levels, parent_of, leaf, s); };
   auto accepts_growing = [&](int leaf, int s) {
     int node = leaf;
     for (size_t l = last; l >= 1; --l) {
       node = parent_of[l][static_cast<size_t>(node)];
       const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
-      const double r = reach(a, s);
+      const double r = reach(dense, a, s);
       if (r > a.radius && r - a.depth > level_worst[l - 1]) return false;
     }
     return true;
@@ -287,18 +294,6 @@ int prune_redundant_leaves(const ReductionProblem& dense, std::vector<std::vecto
   const size_t last = levels.size() - 1;
   std::vector<Node>& leaves = levels[last];
   const size_t n = leaves.size();
-  auto reach = [&](const FittedSphere& sp, int s) {
-    return (dense.points.row(s).transpose() - sp.center).norm() + dense.gap[s];
-  };
-  auto ancestors_cover = [&](size_t leaf, int s) {
-    int node = static_cast<int>(leaf);
-    for (size_t l = last; l >= 1; --l) {
-      node = parent_of[l][static_cast<size_t>(node)];
-      const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
-      if (reach(a, s) > a.radius) return false;
-    }
-    return true;
-  };
   // Leaves whose spheres meet: the only ones that can cover each other's samples.
   std::vector<std::vector<size_t>> near(n);
   for (size_t i = 0; i < n; ++i) {
@@ -324,8 +319,8 @@ int prune_redundant_leaves(const ReductionProblem& dense, std::vector<std::vecto
     for (int s : members) {
       size_t k = n;
       for (size_t j : near[i]) {
-        if (!gone[j] && reach(leaves[j].sphere, s) <= leaves[j].sphere.radius &&
-            ancestors_cover(j, s)) {
+        if (!gone[j] && reach(dense, leaves[j].sphere, s) <= leaves[j].sphere.radius &&
+            ancestors_cover(dense, levels, parent_of, static_cast<int>(j), s)) {
           k = j;
           break;
         }
@@ -445,14 +440,7 @@ int polish_tree(const ReductionProblem& dense, const std::vector<const MeshOracl
   polish_level(last, nullptr);
   for (int round = 0; round < exchange_rounds && last >= 1; ++round) {
     auto accepts = [&](int leaf, int s) {
-      int node = leaf;
-      for (size_t l = last; l >= 1; --l) {
-        node = parent_of[l][static_cast<size_t>(node)];
-        const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
-        if ((dense.points.row(s).transpose() - a.center).norm() + dense.gap[s] > a.radius)
-          return false;
-      }
-      return true;
+      return ancestors_cover(dense, levels, parent_of, leaf, s);
     };
     std::vector<FittedSphere> leaves;
     for (const Node& n : levels[last]) leaves.push_back(n.sphere);
@@ -735,8 +723,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       // A parent cannot use more children than it has coverage samples (a
       // child without one is dropped), whatever its medial samples allow.
       // Applied with build_branching only: on the default it changes the
-      // bunny and dragon trees too, which then need the 7-build protocol
-      // and a new preprocess cache key (not done yet).
+      // trees and measured no better (7 dragon builds: mean42 17.16 vs
+      // 16.88, worst42 <= 80 in 5 of 7; results README, "This session (6)").
       const size_t usable = build_branching > options.branching
                                 ? std::max<size_t>(1, parents[p].sphere.members.size())
                                 : choices[p].configs.size();
@@ -848,14 +836,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     for (const Node& n : levels[last])
       leaves.push_back(n.sphere), worst = std::max(worst, n.sphere.error);
     auto accepts = [&](int leaf, int s) {
-      int node = leaf;
-      for (size_t l = last; l >= 1; --l) {
-        node = parent_of[l][static_cast<size_t>(node)];
-        const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
-        if ((dense.points.row(s).transpose() - a.center).norm() + dense.gap[s] > a.radius)
-          return false;
-      }
-      return true;
+      return ancestors_cover(dense, levels, parent_of, leaf, s);
     };
     SumExchangeOptions sum;
     sum.passes = options.sum_exchange_passes;
