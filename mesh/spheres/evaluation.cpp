@@ -49,14 +49,14 @@ class SphereGrid {
     }
   }
 
-  /// Number of spheres that contain p, counted up to 2; `only` is the one
-  /// when there is exactly one.
-  int count_covering(const Eigen::Vector3d& p, int& only) const {
+  /// Number of spheres that contain p, counted up to `limit`; `found` (if
+  /// not null) is set to the last one found (with a count of 1, the only one).
+  int count_containing(const Eigen::Vector3d& p, int limit, int* found = nullptr) const {
     int count = 0;
     auto visit = [&](int i) {
       if (!inside(i, p)) return false;
-      only = i;
-      return ++count >= 2;
+      if (found != nullptr) *found = i;
+      return ++count >= limit;
     };
     for (int i : m_big) {
       if (visit(i)) return count;
@@ -66,17 +66,6 @@ class SphereGrid {
       for (int i : it->second) {
         if (visit(i)) return count;
       }
-    }
-    return count;
-  }
-
-  /// Number of spheres that contain p.
-  int count_all(const Eigen::Vector3d& p) const {
-    int count = 0;
-    for (int i : m_big) count += inside(i, p) ? 1 : 0;
-    auto it = m_cells.find(key(cell(p)));
-    if (it != m_cells.end()) {
-      for (int i : it->second) count += inside(i, p) ? 1 : 0;
     }
     return count;
   }
@@ -173,7 +162,7 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
       errors162(static_cast<size_t>(num_levels));
   auto note_coverage = [&](int l, const Eigen::Vector3d& p) {
     int only = -1;
-    const int count = grids[static_cast<size_t>(l)].count_covering(p, only);
+    const int count = grids[static_cast<size_t>(l)].count_containing(p, 2, &only);
     if (count == 1) alone[static_cast<size_t>(l)][static_cast<size_t>(only)] = 1;
     return count > 0;
   };
@@ -260,7 +249,8 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
         const double rho = std::cbrt(d3 + uniform(rng) * (r3 - d3));
         const Eigen::Vector3d p = s.center() + rho * dir;
         if (oracle.inside(p)) continue;
-        const int count = grids[static_cast<size_t>(l)].count_all(p);
+        const int count =
+            grids[static_cast<size_t>(l)].count_containing(p, std::numeric_limits<int>::max());
         volume += part / std::max(count, 1);
       }
     }
