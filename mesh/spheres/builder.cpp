@@ -102,10 +102,10 @@ long long level_cap(const SphereTreeOptions& options, int l) {
   return cap;
 }
 
-/// |s - c| + gap[s]: the radius a sphere centred at sp.center needs to cover
-/// sample s with margin.
+/// The radius sphere `sp` needs to cover sample s with margin
+/// (ReductionProblem::reach).
 double reach(const ReductionProblem& problem, const FittedSphere& sp, int s) {
-  return (problem.points.row(s).transpose() - sp.center).norm() + problem.gap[s];
+  return problem.reach(s, sp.center);
 }
 
 /// True when every ancestor of leaf `leaf` (of the last level) covers sample

@@ -16,9 +16,7 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
     throw ParameterError("ExchangeOptions: rounds must be >= 0 and max_moves_per_sphere >= 1");
   }
   const int n = static_cast<int>(spheres.size());
-  auto reach = [&](int s, const FittedSphere& sp) {
-    return (problem.points.row(s).transpose() - sp.center).norm() + problem.gap[s];
-  };
+  auto reach = [&](int s, const FittedSphere& sp) { return problem.reach(s, sp.center); };
   int moved_total = 0;
   for (int round = 0; round < options.rounds; ++round) {
     // Spheres that overlap (only they can hold a sample of each other).
@@ -91,9 +89,7 @@ int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& sp
   if (max_moves < 0) throw ParameterError("relieve_worst: max_moves must be >= 0");
   const int n = static_cast<int>(spheres.size());
   if (n < 2) return 0;
-  auto reach = [&](int s, const FittedSphere& sp) {
-    return (problem.points.row(s).transpose() - sp.center).norm() + problem.gap[s];
-  };
+  auto reach = [&](int s, const FittedSphere& sp) { return problem.reach(s, sp.center); };
   // Per sphere: a max-heap of (reach, -sample) over its current members.
   std::vector<std::vector<std::pair<double, int>>> heaps(static_cast<size_t>(n));
   std::vector<int> size(static_cast<size_t>(n));

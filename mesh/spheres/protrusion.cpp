@@ -68,7 +68,7 @@ class CoverRadius {
     }
   }
   double reach_of(int s, const Eigen::Vector3d& c) const {
-    return (m_problem.points.row(s).transpose() - c).norm() + m_problem.gap[s];
+    return m_problem.reach(s, c);
   }
 
   const ReductionProblem& m_problem;

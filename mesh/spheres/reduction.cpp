@@ -228,7 +228,7 @@ double max_distance(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector
 void refit_radius(const ReductionProblem& problem, FittedSphere& sphere) {
   double r = 0;
   for (int s : sphere.members) {
-    r = std::max(r, (problem.points.row(s).transpose() - sphere.center).norm() + problem.gap[s]);
+    r = std::max(r, problem.reach(s, sphere.center));
   }
   sphere.radius = r;
   sphere.error = r - sphere.depth;

@@ -34,6 +34,12 @@ struct ReductionProblem {
   const Eigen::VectorXd& gap;    ///< #S coverage margins
   const MedialSpheres& medial;   ///< candidate centres and their depths
   const PointGrid& medial_grid;  ///< grid over medial.centers
+
+  /// |s - c| + gap[s]: the radius a sphere centred at c needs to cover
+  /// sample s with margin.
+  double reach(int s, const Eigen::Vector3d& c) const {
+    return (points.row(s).transpose() - c).norm() + gap[s];
+  }
 };
 
 /// Options of reduce_to_spheres().

@@ -15,9 +15,7 @@ int lower_error_sum(const ReductionProblem& problem, std::vector<FittedSphere>& 
     throw ParameterError("SumExchangeOptions: passes must be >= 0 and cap_fraction in (0, 1]");
   }
   const int n = static_cast<int>(spheres.size());
-  auto reach = [&](int s, const FittedSphere& sp) {
-    return (problem.points.row(s).transpose() - sp.center).norm() + problem.gap[s];
-  };
+  auto reach = [&](int s, const FittedSphere& sp) { return problem.reach(s, sp.center); };
   int moved_total = 0;
   for (int pass = 0; pass < options.passes; ++pass) {
     std::vector<int> order(static_cast<size_t>(n));
