@@ -67,9 +67,7 @@ class CoverRadius {
       }
     }
   }
-  double reach_of(int s, const Eigen::Vector3d& c) const {
-    return m_problem.reach(s, c);
-  }
+  double reach_of(int s, const Eigen::Vector3d& c) const { return m_problem.reach(s, c); }
 
   const ReductionProblem& m_problem;
   const std::vector<int>& m_members;
