@@ -423,9 +423,10 @@ int run(int argc, char** argv) {
     for (size_t l = 0; l < ours.allocated_worst_bound.size(); ++l)
       std::printf(" %zu: %.1f;", l + 1, to_2000 * ours.allocated_worst_bound[l]);
     std::printf("\n");
-    std::printf("# %s build steps (CPU s):", model.name.c_str());
-    for (const auto& [step, seconds] : ours.step_cpu_seconds)
-      std::printf(" %s %.1f;", step.c_str(), seconds);
+    std::printf("# %s build steps (CPU s / wall s):", model.name.c_str());
+    for (size_t k = 0; k < ours.step_cpu_seconds.size(); ++k)
+      std::printf(" %s %.1f / %.1f;", ours.step_cpu_seconds[k].first.c_str(),
+                  ours.step_cpu_seconds[k].second, ours.step_wall_seconds[k].second);
     std::printf("\n");
     // The builder's own error bound (radius - centre depth), normalized, per level.
     for (int l = 0; l < ours.tree.num_levels(); ++l) {

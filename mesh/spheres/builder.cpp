@@ -241,7 +241,8 @@ void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<No
 /// their level's worst error bound when grown to cover it. Then every inner
 /// node's samples become the union of its children's and its radius is
 /// refitted exactly.
-void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& oracle,
+void exchange_across_leaves(const ReductionProblem& dense,
+                            const std::vector<const MeshOracle*>& oracles,
                             std::vector<std::vector<Node>>& levels,
                             const std::vector<std::vector<int>>& parent_of, int rounds,
                             int relieve_moves) {
@@ -268,7 +269,9 @@ void exchange_across_leaves(const ReductionProblem& dense, const MeshOracle& ora
   shrink_by_exchange(dense, leaves, exchange, accepts);
   if (relieve_moves > 0) {
     relieve_worst(dense, leaves, relieve_moves, accepts_growing);
-    for (auto& leaf : leaves) polish_sphere(dense, oracle, leaf);
+    parallel_for(leaves.size(), static_cast<int>(oracles.size()), [&](size_t i, int worker) {
+      polish_sphere(dense, *oracles[static_cast<size_t>(worker)], leaves[i]);
+    });
     shrink_by_exchange(dense, leaves, exchange, accepts);
     relieve_worst(dense, leaves, relieve_moves, accepts_growing);
     shrink_by_exchange(dense, leaves, exchange, accepts);
@@ -626,11 +629,16 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
                                         std::chrono::duration<double>(options.time_limit));
   SphereTreeBuild out;
   auto step_start = CpuClock::now();
+  auto step_wall_start = Clock::now();
   auto end_step = [&](const char* name) {
     const auto now = CpuClock::now();
+    const auto wall = Clock::now();
     out.step_cpu_seconds.emplace_back(name,
                                       std::chrono::duration<double>(now - step_start).count());
+    out.step_wall_seconds.emplace_back(
+        name, std::chrono::duration<double>(wall - step_wall_start).count());
     step_start = now;
+    step_wall_start = wall;
   };
   const SurfaceMesh closed = close_holes(input);
   const MeshOracle oracle(closed);
@@ -827,7 +835,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
   }
   if (options.leaf_exchange && levels.size() > 1)
-    exchange_across_leaves(dense, oracle, levels, parent_of, 3, options.relieve_moves);
+    exchange_across_leaves(dense, oracles, levels, parent_of, 3, options.relieve_moves);
   end_step("leaf exchange");
   if (options.sum_exchange_passes > 0 && levels.size() > 1) {
     const size_t last = levels.size() - 1;
@@ -869,7 +877,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     leaf_level.parent = parent_of.back();
     WorstSplitOptions split = options.worst_split;
     split.deadline = std::min(split.deadline, deadline);
-    out.worst_split = split_worst_leaves(coarse, dense, oracle, reduction, leaf_level,
+    out.worst_split = split_worst_leaves(coarse, dense, oracles, reduction, leaf_level,
                                          static_cast<int>(leaf_cap), leaf_parent_limit, split);
     levels.back().clear();
     for (size_t i = 0; i < leaf_level.spheres.size(); ++i) {

@@ -197,6 +197,8 @@ struct SphereTreeBuild {
   std::vector<double> allocated_worst_bound;
   /// Process CPU seconds of each build step, in order (step name, seconds).
   std::vector<std::pair<std::string, double>> step_cpu_seconds;
+  /// Wall-clock seconds of the same steps (how much the worker threads gain).
+  std::vector<std::pair<std::string, double>> step_wall_seconds;
 };
 
 /// Builds the wrapped sphere tree of the triangle mesh (V #V x 3, F #F x 3,

@@ -12,6 +12,7 @@
 
 #include "mesh/io/error.hpp"
 #include "mesh/spheres/exchange.hpp"
+#include "mesh/spheres/parallel.hpp"
 
 namespace icd::mesh {
 namespace {
@@ -49,73 +50,98 @@ std::vector<FittedSphere> settle(const ReductionProblem& dense, const MeshOracle
   return halves;
 }
 
-/// Candidate two-sphere divisions of a leaf: the two-sphere reduction of its
-/// medial samples, and the median planes of its coverage samples across its
-/// two principal axes of largest spread (each side fitted with fit_sphere).
-std::vector<std::vector<FittedSphere>> candidates(const ReductionProblem& coarse,
-                                                  const ReductionProblem& dense,
-                                                  const MeshOracle& oracle,
-                                                  const ReductionOptions& reduction,
-                                                  const FittedSphere& leaf,
-                                                  const std::vector<int>& leaf_medial) {
-  std::vector<std::vector<FittedSphere>> out;
-  if (leaf_medial.size() >= 2) {
-    std::vector<FittedSphere> h = reduce_to_spheres(coarse, leaf_medial, 2, reduction)[1];
-    if (h.size() == 2) out.push_back(settle(dense, oracle, leaf, std::move(h)));
-  }
+/// The principal axes of a leaf's coverage samples (columns, increasing
+/// spread) and their mean.
+struct Axes {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int m : leaf.members) mean += dense.points.row(m).transpose();
-  mean /= static_cast<double>(leaf.members.size());
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+};
+
+Axes principal_axes(const ReductionProblem& dense, const FittedSphere& leaf) {
+  Axes out;
+  for (int m : leaf.members) out.mean += dense.points.row(m).transpose();
+  out.mean /= static_cast<double>(leaf.members.size());
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (int m : leaf.members) {
-    const Eigen::Vector3d d = dense.points.row(m).transpose() - mean;
+    const Eigen::Vector3d d = dense.points.row(m).transpose() - out.mean;
     cov += d * d.transpose();
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(cov);
-  std::vector<double> projection(leaf.members.size());
-  for (int axis = 2; axis >= 1; --axis) {  // the two axes of largest spread
-    const Eigen::Vector3d n = eigen.eigenvectors().col(axis);
-    for (size_t k = 0; k < leaf.members.size(); ++k)
-      projection[k] = n.dot(dense.points.row(leaf.members[k]).transpose());
-    std::vector<double> sorted = projection;
-    const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
-    std::nth_element(sorted.begin(), mid, sorted.end());
-    const double median = *mid;
-    std::vector<int> side[2];
-    for (size_t k = 0; k < leaf.members.size(); ++k)
-      side[projection[k] < median ? 0 : 1].push_back(leaf.members[k]);
-    if (side[0].empty() || side[1].empty()) continue;
-    std::vector<FittedSphere> h;
-    for (const auto& members : side) h.push_back(fit_sphere(dense, members, nullptr, reduction));
-    out.push_back(settle(dense, oracle, leaf, std::move(h)));
-  }
-  out.erase(std::remove_if(out.begin(), out.end(), [](const auto& c) { return c.size() != 2; }),
-            out.end());
+  out.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
   return out;
 }
 
+/// The candidate two-sphere divisions of a leaf, numbered 0 to
+/// kNumCandidates - 1: the two-sphere reduction of its medial samples (0),
+/// and the median planes of its coverage samples across its two principal
+/// axes of largest spread (1, 2; each side fitted with fit_sphere). Settled
+/// (see settle); empty when that candidate does not divide the leaf in two.
+constexpr int kNumCandidates = 3;
+
+std::vector<FittedSphere> candidate(int k, const ReductionProblem& coarse,
+                                    const ReductionProblem& dense, const MeshOracle& oracle,
+                                    const ReductionOptions& reduction, const FittedSphere& leaf,
+                                    const std::vector<int>& leaf_medial, const Axes& axes) {
+  if (k == 0) {
+    if (leaf_medial.size() < 2) return {};
+    std::vector<FittedSphere> h = reduce_to_spheres(coarse, leaf_medial, 2, reduction)[1];
+    if (h.size() != 2) return {};
+    return settle(dense, oracle, leaf, std::move(h));
+  }
+  const Eigen::Vector3d n = axes.axes.col(3 - k);  // k = 1: largest spread
+  std::vector<double> projection(leaf.members.size());
+  for (size_t i = 0; i < leaf.members.size(); ++i)
+    projection[i] = n.dot(dense.points.row(leaf.members[i]).transpose());
+  std::vector<double> sorted = projection;
+  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+  std::nth_element(sorted.begin(), mid, sorted.end());
+  const double median = *mid;
+  std::vector<int> side[2];
+  for (size_t i = 0; i < leaf.members.size(); ++i)
+    side[projection[i] < median ? 0 : 1].push_back(leaf.members[i]);
+  if (side[0].empty() || side[1].empty()) return {};
+  std::vector<FittedSphere> h;
+  for (const auto& members : side) h.push_back(fit_sphere(dense, members, nullptr, reduction));
+  return settle(dense, oracle, leaf, std::move(h));
+}
+
 /// The candidate division whose larger true error is smallest, both halves
-/// moved by polish_protrusion first; the leaf's medial samples are divided
-/// by the assignment rule (so that each half can be split again).
+/// moved by polish_protrusion first (the candidates are computed in
+/// parallel, one per task, worker w querying oracles[w]; the choice does
+/// not depend on the number of workers); the leaf's medial samples are
+/// divided by the assignment rule (so that each half can be split again).
 Halves split_in_two(const ReductionProblem& coarse, const ReductionProblem& dense,
-                    const MeshOracle& oracle, const ReductionOptions& reduction,
-                    const FittedSphere& leaf, const std::vector<int>& leaf_medial, unsigned seed,
+                    const std::vector<const MeshOracle*>& oracles,
+                    const ReductionOptions& reduction, const FittedSphere& leaf,
+                    const std::vector<int>& leaf_medial, unsigned seed,
                     const ProtrusionPolishOptions& polish, const MatX3d& choice,
                     const MatX3d& directions) {
   Halves out;
   if (leaf.members.size() < 2) return out;
-  double best = std::numeric_limits<double>::infinity();
-  for (auto& halves : candidates(coarse, dense, oracle, reduction, leaf, leaf_medial)) {
-    double error[2];
-    for (size_t k = 0; k < 2; ++k) {
-      polish_protrusion(dense, oracle, halves[k], seed + static_cast<unsigned>(k), polish);
-      error[k] = sphere_protrusion(oracle, halves[k].center, halves[k].radius, choice);
+  const MeshOracle& oracle = *oracles.front();
+  const Axes axes = principal_axes(dense, leaf);
+  struct Tried {
+    std::vector<FittedSphere> halves;
+    double error[2] = {0, 0};
+  };
+  std::vector<Tried> tried(kNumCandidates);
+  parallel_for(tried.size(), static_cast<int>(oracles.size()), [&](size_t k, int worker) {
+    const MeshOracle& o = *oracles[static_cast<size_t>(worker)];
+    Tried& t = tried[k];
+    t.halves = candidate(static_cast<int>(k), coarse, dense, o, reduction, leaf, leaf_medial, axes);
+    if (t.halves.size() != 2) return;
+    for (size_t h = 0; h < 2; ++h) {
+      polish_protrusion(dense, o, t.halves[h], seed + static_cast<unsigned>(h), polish);
+      t.error[h] = sphere_protrusion(o, t.halves[h].center, t.halves[h].radius, choice);
     }
-    const double worst = std::max(error[0], error[1]);
+  });
+  double best = std::numeric_limits<double>::infinity();
+  for (Tried& t : tried) {
+    if (t.halves.size() != 2) continue;
+    const double worst = std::max(t.error[0], t.error[1]);
     if (!(worst < best)) continue;
     best = worst;
-    out.spheres = std::move(halves);
-    out.error[0] = error[0], out.error[1] = error[1];
+    out.spheres = std::move(t.halves);
+    out.error[0] = t.error[0], out.error[1] = t.error[1];
   }
   if (out.spheres.size() != 2) return Halves{};
   for (size_t k = 0; k < 2; ++k)
@@ -163,10 +189,14 @@ struct Merge {
 }  // namespace
 
 WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const ReductionProblem& dense,
-                                    const MeshOracle& oracle, const ReductionOptions& reduction,
-                                    LeafLevel& level, int cap, int branching,
-                                    const WorstSplitOptions& options) {
+                                    const std::vector<const MeshOracle*>& oracles,
+                                    const ReductionOptions& reduction, LeafLevel& level, int cap,
+                                    int branching, const WorstSplitOptions& options) {
   check_arguments(options, cap, branching);
+  if (oracles.empty() || std::find(oracles.begin(), oracles.end(), nullptr) != oracles.end())
+    throw ParameterError("split_worst_leaves: needs at least one oracle, none null");
+  const MeshOracle& oracle = *oracles.front();
+  const int workers = static_cast<int>(oracles.size());
   assert(level.spheres.size() == level.medial.size() &&
          level.spheres.size() == level.parent.size());
   const MatX3d directions = spiral_directions(options.measure_directions);
@@ -219,9 +249,14 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
   // The level's mean true error at the start, on the choice directions (a
   // subset's worth of the measuring ones: slightly below the mean on those,
   // so the rule below errs on the side of not raising the mean).
+  std::vector<double> start_error(level.spheres.size());
+  parallel_for(start_error.size(), workers, [&](size_t i, int worker) {
+    const FittedSphere& s = level.spheres[i];
+    start_error[i] = sphere_protrusion(*oracles[static_cast<size_t>(worker)], s.center, s.radius,
+                                       choice);
+  });
   double mean_error = 0;
-  for (const auto& s : level.spheres)
-    mean_error += sphere_protrusion(oracle, s.center, s.radius, choice);
+  for (double e : start_error) mean_error += e;  // in leaf order, as without workers
   mean_error /= static_cast<double>(std::max<size_t>(level.spheres.size(), 1));
   result.mean_before = mean_error;
 
@@ -291,7 +326,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
       joint.tag = level.spheres[i].tag;
       const std::vector<int> joint_medial = merged(level.medial[i], level.medial[j]);
       Halves h =
-          split_in_two(coarse, dense, oracle, reduction, joint, joint_medial,
+          split_in_two(coarse, dense, oracles, reduction, joint, joint_medial,
                        7919u * static_cast<unsigned>(i) + 31u * static_cast<unsigned>(j) + 5u,
                        options.polish, choice, directions);
       if (h.spheres.size() != 2) continue;
@@ -327,7 +362,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     }
     ++result.tries;
     Halves halves =
-        split_in_two(coarse, dense, oracle, reduction, level.spheres[i], level.medial[i],
+        split_in_two(coarse, dense, oracles, reduction, level.spheres[i], level.medial[i],
                      7919u * static_cast<unsigned>(i) + 17u, options.polish, choice, directions);
     const bool relief = worst >= relief_threshold;
     // A relief try that found no split (`counter`: relief_no_split) or no

@@ -106,13 +106,17 @@ struct WorstSplitResult {
 /// worst error (on these directions) never rises.
 /// The halves divide the leaf's samples, so every ancestor still covers them
 /// and every level still covers the surface; the new leaf is inserted right
-/// after the old one (siblings stay contiguous). Deterministic.
+/// after the old one (siblings stay contiguous). Deterministic: `oracles`
+/// holds one oracle of the same closed mesh per worker thread (a leaf's
+/// candidate divisions and the starting errors are computed in parallel),
+/// and the result does not depend on how many there are.
 /// Preconditions: `coarse` and `dense` share the medial set; each leaf's
 /// members are sorted, non-empty and covered with margin. Throws
-/// ParameterError for invalid options, cap < 0 or branching < 2.
+/// ParameterError for invalid options, cap < 0, branching < 2, or no (or a
+/// null) oracle.
 WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const ReductionProblem& dense,
-                                    const MeshOracle& oracle, const ReductionOptions& reduction,
-                                    LeafLevel& level, int cap, int branching,
-                                    const WorstSplitOptions& options = {});
+                                    const std::vector<const MeshOracle*>& oracles,
+                                    const ReductionOptions& reduction, LeafLevel& level, int cap,
+                                    int branching, const WorstSplitOptions& options = {});
 
 }  // namespace icd::mesh

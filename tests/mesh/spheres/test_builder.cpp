@@ -579,14 +579,19 @@ TEST(SphereTreeBuilder, IsDeterministic) {
 }
 
 TEST(SphereTreeBuilder, DoesNotDependOnTheThreadCount) {
-  // Parallel steps (a parent's children, the protrusion polish) work on one
-  // node per task: one thread and three give the same tree, bit for bit.
+  // Parallel steps (a parent's children, the protrusion polish, the leaf
+  // polish between exchanges, split_worst_leaves' candidate divisions of a
+  // leaf) work on one node or candidate per task: one thread and three give
+  // the same tree, bit for bit.
   const Case torus = cases()[2];
   SphereTreeOptions one = small_options(), three = small_options();
   one.threads = 1;
   three.threads = 3;
   const SphereTreeBuild a = build_sphere_tree(torus.mesh, one);
   const SphereTreeBuild b = build_sphere_tree(torus.mesh, three);
+  ASSERT_GT(a.worst_split.tries, 0) << "the case must exercise split_worst_leaves";
+  EXPECT_EQ(a.worst_split.splits, b.worst_split.splits);
+  EXPECT_EQ(a.worst_split.measured, b.worst_split.measured);
   ASSERT_EQ(a.tree.num_nodes(), b.tree.num_nodes());
   ASSERT_GT(a.tree.num_nodes(), 5);
   for (int i = 0; i < a.tree.num_nodes(); ++i) {
