@@ -252,8 +252,8 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
   std::vector<double> start_error(level.spheres.size());
   parallel_for(start_error.size(), workers, [&](size_t i, int worker) {
     const FittedSphere& s = level.spheres[i];
-    start_error[i] = sphere_protrusion(*oracles[static_cast<size_t>(worker)], s.center, s.radius,
-                                       choice);
+    start_error[i] =
+        sphere_protrusion(*oracles[static_cast<size_t>(worker)], s.center, s.radius, choice);
   });
   double mean_error = 0;
   for (double e : start_error) mean_error += e;  // in leaf order, as without workers

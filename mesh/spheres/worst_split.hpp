@@ -95,8 +95,8 @@ struct WorstSplitResult {
 /// `branching` children. It is made only when both halves' true errors are
 /// below E and, unless E >= relief_fraction times the starting worst (the
 /// relief band), their sum is below E + mean_rise_limit times the level's
-/// mean true error at the start (on choice_directions). A leaf of the relief band without a free slot makes
-/// room by merging the two overlapping siblings whose union fits the sphere
+/// mean true error at the start (on choice_directions). A leaf of the
+/// relief band without a free slot makes room by merging the two overlapping siblings whose union fits the sphere
 /// of lowest error bound (fit_sphere on their samples, polish_sphere,
 /// polish_protrusion), when that sphere's true error is below E as well (the
 /// leaf count is then unchanged). A leaf is tried once (again after a
