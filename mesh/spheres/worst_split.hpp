@@ -96,10 +96,11 @@ struct WorstSplitResult {
 /// below E and, unless E >= relief_fraction times the starting worst (the
 /// relief band), their sum is below E + mean_rise_limit times the level's
 /// mean true error at the start (on choice_directions). A leaf of the
-/// relief band without a free slot makes room by merging the two overlapping siblings whose union fits the sphere
-/// of lowest error bound (fit_sphere on their samples, polish_sphere,
-/// polish_protrusion), when that sphere's true error is below E as well (the
-/// leaf count is then unchanged). A leaf is tried once (again after a
+/// relief band without a free slot makes room by merging the two
+/// overlapping siblings whose union fits the sphere of lowest error bound
+/// (fit_sphere on their samples, polish_sphere, polish_protrusion), when
+/// that sphere's true error is below E as well (the leaf count is then
+/// unchanged). A leaf is tried once (again after a
 /// split). Stops after max_tries leaves, past the deadline, or when the level
 /// is at its cap and no untried leaf is in the relief band. Every change
 /// replaces spheres by ones of lower true error than E, so the level's true
