@@ -10,7 +10,8 @@
 namespace icd::collision {
 namespace {
 
-Eigen::Vector3d vtx(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F, int f, int k) {
+Eigen::Vector3d vtx(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F, int f,
+                    int k) {
   return V.row(F(f, k)).transpose();
 }
 
@@ -20,31 +21,36 @@ bool boxes_overlap(const AabbTree::Node& a, const AabbTree::Node& b) {
 
 bool tri_pair(const Eigen::Ref<const MatX3d>& V1, const Eigen::Ref<const MatX3i>& F1, int f,
               const Eigen::Ref<const MatX3d>& V2, const Eigen::Ref<const MatX3i>& F2, int g) {
-  return triangles_intersect(vtx(V1, F1, f, 0), vtx(V1, F1, f, 1), vtx(V1, F1, f, 2), vtx(V2, F2, g, 0),
-                             vtx(V2, F2, g, 1), vtx(V2, F2, g, 2));
+  return triangles_intersect(vtx(V1, F1, f, 0), vtx(V1, F1, f, 1), vtx(V1, F1, f, 2),
+                             vtx(V2, F2, g, 0), vtx(V2, F2, g, 1), vtx(V2, F2, g, 2));
 }
 
 }  // namespace
 
-AabbTree::AabbTree(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F, int leaf_size) {
+AabbTree::AabbTree(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F,
+                   int leaf_size) {
   if (leaf_size < 1) throw ParameterError("AabbTree: leaf_size must be >= 1");
   for (int i = 0; i < V.rows(); ++i)
-    if (!V.row(i).allFinite()) throw InputError("AabbTree: vertex " + std::to_string(i) + " is not finite");
+    if (!V.row(i).allFinite())
+      throw InputError("AabbTree: vertex " + std::to_string(i) + " is not finite");
   for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= V.rows())
-        throw InputError("AabbTree: face " + std::to_string(f) + " has an out-of-range vertex index");
+        throw InputError("AabbTree: face " + std::to_string(f) +
+                         " has an out-of-range vertex index");
   if (F.rows() == 0) return;
   std::vector<Eigen::Vector3d> centroids(F.rows());
-  for (int f = 0; f < F.rows(); ++f) centroids[f] = (vtx(V, F, f, 0) + vtx(V, F, f, 1) + vtx(V, F, f, 2)) / 3.0;
+  for (int f = 0; f < F.rows(); ++f)
+    centroids[f] = (vtx(V, F, f, 0) + vtx(V, F, f, 1) + vtx(V, F, f, 2)) / 3.0;
   m_order.resize(F.rows());
   std::iota(m_order.begin(), m_order.end(), 0);
   m_nodes.reserve(2 * F.rows() / leaf_size + 2);
   build(centroids, V, F, 0, static_cast<int>(F.rows()), leaf_size);
 }
 
-int AabbTree::build(const std::vector<Eigen::Vector3d>& centroids, const Eigen::Ref<const MatX3d>& V,
-                    const Eigen::Ref<const MatX3i>& F, int begin, int end, int leaf_size) {
+int AabbTree::build(const std::vector<Eigen::Vector3d>& centroids,
+                    const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F, int begin,
+                    int end, int leaf_size) {
   const int id = static_cast<int>(m_nodes.size());
   m_nodes.emplace_back();
   if (end - begin <= leaf_size) {
@@ -101,10 +107,9 @@ void AabbTree::refit(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const M
   }
 }
 
-std::vector<std::pair<int, int>> intersecting_triangle_pairs(const AabbTree& t1, const Eigen::Ref<const MatX3d>& V1,
-                                                             const Eigen::Ref<const MatX3i>& F1, const AabbTree& t2,
-                                                             const Eigen::Ref<const MatX3d>& V2,
-                                                             const Eigen::Ref<const MatX3i>& F2) {
+std::vector<std::pair<int, int>> intersecting_triangle_pairs(
+    const AabbTree& t1, const Eigen::Ref<const MatX3d>& V1, const Eigen::Ref<const MatX3i>& F1,
+    const AabbTree& t2, const Eigen::Ref<const MatX3d>& V2, const Eigen::Ref<const MatX3i>& F2) {
   std::vector<std::pair<int, int>> out;
   if (t1.nodes().empty() || t2.nodes().empty()) return out;
   std::vector<std::pair<int, int>> stack{{0, 0}};
@@ -135,10 +140,9 @@ std::vector<std::pair<int, int>> intersecting_triangle_pairs(const AabbTree& t1,
   return out;
 }
 
-std::vector<std::pair<int, int>> intersecting_triangle_pairs_brute_force(const Eigen::Ref<const MatX3d>& V1,
-                                                                         const Eigen::Ref<const MatX3i>& F1,
-                                                                         const Eigen::Ref<const MatX3d>& V2,
-                                                                         const Eigen::Ref<const MatX3i>& F2) {
+std::vector<std::pair<int, int>> intersecting_triangle_pairs_brute_force(
+    const Eigen::Ref<const MatX3d>& V1, const Eigen::Ref<const MatX3i>& F1,
+    const Eigen::Ref<const MatX3d>& V2, const Eigen::Ref<const MatX3i>& F2) {
   std::vector<std::pair<int, int>> out;
   for (int f = 0; f < F1.rows(); ++f)
     for (int g = 0; g < F2.rows(); ++g)

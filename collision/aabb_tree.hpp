@@ -41,15 +41,13 @@ class AabbTree {
 /// All pairs (f, g), f a triangle of (V1, F1), g of (V2, F2), that intersect
 /// (closed triangles, exact test), found through the two trees (built on
 /// these positions or refitted to them). Sorted.
-std::vector<std::pair<int, int>> intersecting_triangle_pairs(const AabbTree& t1, const Eigen::Ref<const MatX3d>& V1,
-                                                             const Eigen::Ref<const MatX3i>& F1, const AabbTree& t2,
-                                                             const Eigen::Ref<const MatX3d>& V2,
-                                                             const Eigen::Ref<const MatX3i>& F2);
+std::vector<std::pair<int, int>> intersecting_triangle_pairs(
+    const AabbTree& t1, const Eigen::Ref<const MatX3d>& V1, const Eigen::Ref<const MatX3i>& F1,
+    const AabbTree& t2, const Eigen::Ref<const MatX3d>& V2, const Eigen::Ref<const MatX3i>& F2);
 
 /// The same by testing every pair (#F1 x #F2 exact tests): the oracle for small meshes.
-std::vector<std::pair<int, int>> intersecting_triangle_pairs_brute_force(const Eigen::Ref<const MatX3d>& V1,
-                                                                         const Eigen::Ref<const MatX3i>& F1,
-                                                                         const Eigen::Ref<const MatX3d>& V2,
-                                                                         const Eigen::Ref<const MatX3i>& F2);
+std::vector<std::pair<int, int>> intersecting_triangle_pairs_brute_force(
+    const Eigen::Ref<const MatX3d>& V1, const Eigen::Ref<const MatX3i>& F1,
+    const Eigen::Ref<const MatX3d>& V2, const Eigen::Ref<const MatX3i>& F2);
 
 }  // namespace icd::collision

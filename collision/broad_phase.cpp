@@ -13,8 +13,10 @@ std::vector<std::pair<int, int>> sweep_and_prune(const std::vector<Sphere>& boun
   const int n = static_cast<int>(bounds.size());
   for (int i = 0; i < n; ++i) {
     const Sphere& s = bounds[i];
-    if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || !std::isfinite(s.r) || s.r < 0)
-      throw ParameterError("sweep_and_prune: object " + std::to_string(i) + " has a non-finite sphere or a negative radius");
+    if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || !std::isfinite(s.r) ||
+        s.r < 0)
+      throw ParameterError("sweep_and_prune: object " + std::to_string(i) +
+                           " has a non-finite sphere or a negative radius");
   }
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);

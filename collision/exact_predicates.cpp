@@ -86,7 +86,8 @@ constexpr double kEps = std::numeric_limits<double>::epsilon() * 0.5;
 
 }  // namespace
 
-int orient3d(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+int orient3d(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+             const Eigen::Vector3d& d) {
   const double bax = b.x() - a.x(), bay = b.y() - a.y(), baz = b.z() - a.z();
   const double cax = c.x() - a.x(), cay = c.y() - a.y(), caz = c.z() - a.z();
   const double dax = d.x() - a.x(), day = d.y() - a.y(), daz = d.z() - a.z();

@@ -10,9 +10,9 @@ namespace icd::collision {
 
 /// Options of associate_nearest_nodes().
 struct NodeAssociationOptions {
-  int k_nearest = 4;          ///< nodes nearest to the rest centre always taken (>= 1)
-  bool include_inside = true; ///< also take every candidate node inside the rest sphere
-  int max_nodes = 64;         ///< cap on |V_i| (the nearest are kept), >= k_nearest
+  int k_nearest = 4;           ///< nodes nearest to the rest centre always taken (>= 1)
+  bool include_inside = true;  ///< also take every candidate node inside the rest sphere
+  int max_nodes = 64;          ///< cap on |V_i| (the nearest are kept), >= k_nearest
 };
 
 /// The paper's association: V_i = the k nearest candidate coarse nodes to the

@@ -63,18 +63,25 @@ Sphere enclosing_sphere(const std::vector<Polygon>& parts, double extra) {
 
 SphereTree build_octree_tree(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F,
                              const OctreeTreeOptions& options) {
-  if (options.levels < 1) throw ParameterError("OctreeTreeOptions::levels must be >= 1, got " + std::to_string(options.levels));
+  if (options.levels < 1)
+    throw ParameterError("OctreeTreeOptions::levels must be >= 1, got " +
+                         std::to_string(options.levels));
   if (!(options.margin >= 0.0)) throw ParameterError("OctreeTreeOptions::margin must be >= 0");
-  if (!(options.relative_margin >= 0.0)) throw ParameterError("OctreeTreeOptions::relative_margin must be >= 0");
+  if (!(options.relative_margin >= 0.0))
+    throw ParameterError("OctreeTreeOptions::relative_margin must be >= 0");
   if (V.rows() == 0 || F.rows() == 0) throw InputError("build_octree_tree: empty mesh");
   for (int i = 0; i < V.rows(); ++i)
-    if (!V.row(i).allFinite()) throw InputError("build_octree_tree: vertex " + std::to_string(i) + " has a non-finite coordinate");
+    if (!V.row(i).allFinite())
+      throw InputError("build_octree_tree: vertex " + std::to_string(i) +
+                       " has a non-finite coordinate");
   for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= V.rows())
-        throw InputError("build_octree_tree: face " + std::to_string(f) + " has vertex index " + std::to_string(F(f, k)) + " out of range");
+        throw InputError("build_octree_tree: face " + std::to_string(f) + " has vertex index " +
+                         std::to_string(F(f, k)) + " out of range");
 
-  const Eigen::Vector3d vmin = V.colwise().minCoeff().transpose(), vmax = V.colwise().maxCoeff().transpose();
+  const Eigen::Vector3d vmin = V.colwise().minCoeff().transpose(),
+                        vmax = V.colwise().maxCoeff().transpose();
   double side = (vmax - vmin).maxCoeff();
   if (side <= 0.0) side = 1.0;
   side *= 1.0 + 1e-6;

@@ -9,8 +9,8 @@ namespace icd::collision {
 
 /// Options of build_octree_tree().
 struct OctreeTreeOptions {
-  int levels = 3;            ///< tree depth counting the root (>= 1); leaves on level levels-1
-  double margin = 0.0;       ///< absolute amount added to every radius (model units, >= 0)
+  int levels = 3;                 ///< tree depth counting the root (>= 1); leaves on level levels-1
+  double margin = 0.0;            ///< absolute amount added to every radius (model units, >= 0)
   double relative_margin = 1e-9;  ///< added radius relative to the root cube side, absorbs rounding
 };
 

@@ -19,8 +19,10 @@ long long complete_count(int levels, int branch, long long cap) {
   for (int l = 0; l < levels; ++l) {
     total += width;
     if (total > cap) return -1;
-    if (width > cap / branch + 1) width = cap + 1;
-    else width *= branch;
+    if (width > cap / branch + 1)
+      width = cap + 1;
+    else
+      width *= branch;
   }
   return total;
 }
@@ -52,17 +54,21 @@ SphereTree read_sph(std::istream& in, const std::string& name, const SphReadOpti
   };
   std::string line;
   long long line_no = 0;
-  if (!next_content_line(in, line, line_no)) throw InputError(name + ": empty file, expected header `levels branch`");
+  if (!next_content_line(in, line, line_no))
+    throw InputError(name + ": empty file, expected header `levels branch`");
   long long levels = 0, branch = 0;
   {
     std::istringstream hs(line);
     if (!(hs >> levels >> branch)) fail(line_no, "header must be `levels branch` (two integers)");
   }
   if (levels < 1 || levels > options.max_levels)
-    fail(line_no, "levels = " + std::to_string(levels) + " outside [1, " + std::to_string(options.max_levels) + "]");
+    fail(line_no, "levels = " + std::to_string(levels) + " outside [1, " +
+                      std::to_string(options.max_levels) + "]");
   if (branch < 1 || branch > options.max_branch)
-    fail(line_no, "branch = " + std::to_string(branch) + " outside [1, " + std::to_string(options.max_branch) + "]");
-  const long long expected = complete_count(static_cast<int>(levels), static_cast<int>(branch), options.max_lines);
+    fail(line_no, "branch = " + std::to_string(branch) + " outside [1, " +
+                      std::to_string(options.max_branch) + "]");
+  const long long expected =
+      complete_count(static_cast<int>(levels), static_cast<int>(branch), options.max_lines);
   if (expected < 0)
     fail(line_no, "header declares more than " + std::to_string(options.max_lines) + " node lines");
 
@@ -76,7 +82,8 @@ SphereTree read_sph(std::istream& in, const std::string& name, const SphReadOpti
   std::vector<int32_t> compact_cur;
   while (next_content_line(in, line, line_no)) {
     if (count >= expected)
-      fail(line_no, "more node lines than the " + std::to_string(expected) + " declared by the header");
+      fail(line_no,
+           "more node lines than the " + std::to_string(expected) + " declared by the header");
     std::istringstream ls(line);
     double x, y, z, r, occ;
     std::string tx, ty, tz, tr;
@@ -93,7 +100,8 @@ SphereTree read_sph(std::istream& in, const std::string& name, const SphReadOpti
       if (level > 0) {
         const long long p_in_level = in_level / branch;
         par = compact_prev[static_cast<std::size_t>(p_in_level)];
-        if (par < 0) fail(line_no, "node " + std::to_string(count) + " is used but its parent is unused");
+        if (par < 0)
+          fail(line_no, "node " + std::to_string(count) + " is used but its parent is unused");
       }
       my_compact = static_cast<int32_t>(tree.spheres.size());
       tree.spheres.push_back({x, y, z, r});
@@ -133,7 +141,8 @@ void write_sph(std::ostream& out, const SphereTree& tree, int branch) {
   for (int32_t c : tree.child_count) max_children = std::max(max_children, static_cast<int>(c));
   if (branch == 0) branch = std::max(2, max_children);
   if (branch < max_children)
-    throw ParameterError("write_sph: branch " + std::to_string(branch) + " < largest child count " + std::to_string(max_children));
+    throw ParameterError("write_sph: branch " + std::to_string(branch) + " < largest child count " +
+                         std::to_string(max_children));
   const int levels = tree.num_levels();
   // Complete index of each compact node, level by level.
   std::vector<long long> complete(tree.spheres.size());

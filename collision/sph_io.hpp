@@ -12,9 +12,9 @@ namespace icd::collision {
 
 /// Limits that protect the reader from absurd headers.
 struct SphReadOptions {
-  int max_levels = 16;           ///< largest accepted `levels`
-  int max_branch = 64;           ///< largest accepted `branch`
-  long long max_lines = 1 << 24; ///< largest accepted (B^L-1)/(B-1)
+  int max_levels = 16;            ///< largest accepted `levels`
+  int max_branch = 64;            ///< largest accepted `branch`
+  long long max_lines = 1 << 24;  ///< largest accepted (B^L-1)/(B-1)
 };
 
 /// Reads a `.sph` tree from a stream into the compact layout: unused nodes

@@ -30,16 +30,16 @@ struct Sphere {
 ///    assoc_nodes[assoc_offset[i] .. assoc_offset[i+1]) with rest distances
 ///    assoc_rest_dist[...] (distance from the rest centre to the rest node position).
 struct SphereTree {
-  std::vector<Sphere> spheres;       ///< current spheres (updated each frame)
-  std::vector<Sphere> rest_spheres;  ///< spheres in the undeformed configuration
-  std::vector<int32_t> first_child;  ///< index of first child, -1 for leaves
-  std::vector<int32_t> child_count;  ///< number of children (0 for leaves)
-  std::vector<int32_t> level;        ///< depth of each node (root = 0)
-  std::vector<int32_t> level_offset; ///< first node of each level, plus #nodes at the end
+  std::vector<Sphere> spheres;        ///< current spheres (updated each frame)
+  std::vector<Sphere> rest_spheres;   ///< spheres in the undeformed configuration
+  std::vector<int32_t> first_child;   ///< index of first child, -1 for leaves
+  std::vector<int32_t> child_count;   ///< number of children (0 for leaves)
+  std::vector<int32_t> level;         ///< depth of each node (root = 0)
+  std::vector<int32_t> level_offset;  ///< first node of each level, plus #nodes at the end
 
-  std::vector<int32_t> assoc_offset;   ///< CSR offsets into assoc_nodes (#nodes + 1), may be empty
-  std::vector<int32_t> assoc_nodes;    ///< coarse node indices V_i of each sphere
-  std::vector<double> assoc_rest_dist; ///< rest distance from sphere centre to each assoc node
+  std::vector<int32_t> assoc_offset;    ///< CSR offsets into assoc_nodes (#nodes + 1), may be empty
+  std::vector<int32_t> assoc_nodes;     ///< coarse node indices V_i of each sphere
+  std::vector<double> assoc_rest_dist;  ///< rest distance from sphere centre to each assoc node
 
   int num_nodes() const { return static_cast<int>(spheres.size()); }
   int num_levels() const { return static_cast<int>(level_offset.size()) - 1; }

@@ -10,10 +10,12 @@
 namespace icd::collision {
 
 void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_rest,
-                    const Eigen::Ref<const MatX3d>& coarse_positions, const SphereUpdateOptions& options) {
+                    const Eigen::Ref<const MatX3d>& coarse_positions,
+                    const SphereUpdateOptions& options) {
   const int n = tree.num_nodes();
   if (tree.assoc_offset.size() != static_cast<std::size_t>(n) + 1)
-    throw ParameterError("update_spheres: the tree has no coarse-node association (call associate_*_nodes first)");
+    throw ParameterError(
+        "update_spheres: the tree has no coarse-node association (call associate_*_nodes first)");
   if (coarse_rest.rows() != coarse_positions.rows())
     throw ParameterError("update_spheres: coarse_rest has " + std::to_string(coarse_rest.rows()) +
                          " rows, coarse_positions " + std::to_string(coarse_positions.rows()));

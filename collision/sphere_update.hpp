@@ -33,6 +33,7 @@ struct SphereUpdateOptions {
 /// Throws ParameterError for missing association or mismatched sizes and
 /// NumericalError (naming the node) if a sphere comes out non-finite.
 void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_rest,
-                    const Eigen::Ref<const MatX3d>& coarse_positions, const SphereUpdateOptions& options = {});
+                    const Eigen::Ref<const MatX3d>& coarse_positions,
+                    const SphereUpdateOptions& options = {});
 
 }  // namespace icd::collision

@@ -77,7 +77,8 @@ class PairStack {
   }
   WorkPair pop() { return m_buf[--m_size]; }
   void ensure(std::size_t extra) {
-    if (m_size + extra > m_buf.size()) m_buf.resize(std::max<std::size_t>(1024, 2 * (m_size + extra)));
+    if (m_size + extra > m_buf.size())
+      m_buf.resize(std::max<std::size_t>(1024, 2 * (m_size + extra)));
   }
   void push_if(const WorkPair& p, bool keep) {
     m_buf[m_size] = p;
@@ -123,7 +124,8 @@ thread_local double t_finish_cost = 0.0;
 // `interval` tests.
 class Budget {
  public:
-  Budget(const CollisionRequest& r, Clock::time_point start) : m_max_tests(r.budget_tests < 0 ? INT64_MAX : r.budget_tests) {
+  Budget(const CollisionRequest& r, Clock::time_point start)
+      : m_max_tests(r.budget_tests < 0 ? INT64_MAX : r.budget_tests) {
     m_timed = std::isfinite(r.budget_seconds);
     m_interval = r.clock_check_interval;
     if (m_timed) {
@@ -132,9 +134,11 @@ class Budget {
         const double hz = cycle_counter_hz();
         // Measured from the query's start on the steady clock, mapped to cycles.
         const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-        m_tsc_deadline = read_cycle_counter() + static_cast<uint64_t>(std::max(0.0, r.budget_seconds - elapsed) * hz);
+        m_tsc_deadline = read_cycle_counter() +
+                         static_cast<uint64_t>(std::max(0.0, r.budget_seconds - elapsed) * hz);
       } else {
-        m_deadline = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(r.budget_seconds));
+        m_deadline = start + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(r.budget_seconds));
       }
     }
     m_next = m_timed ? 0 : m_max_tests;  // a timed query reads the clock before its first test
@@ -161,8 +165,11 @@ class Budget {
     if (m_timed) {
       const double reserve = static_cast<double>(pending) * t_finish_cost;
       const bool expired =
-          m_use_tsc ? read_cycle_counter() + static_cast<uint64_t>(reserve * cycle_counter_hz()) >= m_tsc_deadline
-                    : Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(reserve)) >= m_deadline;
+          m_use_tsc ? read_cycle_counter() + static_cast<uint64_t>(reserve * cycle_counter_hz()) >=
+                          m_tsc_deadline
+                    : Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                         std::chrono::duration<double>(reserve)) >=
+                          m_deadline;
       if (expired) {
         reason = StopReason::TimeBudget;
         m_stopped_at = Clock::now();
@@ -209,8 +216,10 @@ struct Trees {
 
 // Where a known-overlapping pair goes when it cannot be split further.
 inline void settle(const Trees& t, int32_t a, int32_t b, CollisionResult& res) {
-  if (t.cca[a] == 0 && t.ccb[b] == 0) res.colliding.push_back({a, b});
-  else res.untested.push_back({a, b});  // held back by depth_cap
+  if (t.cca[a] == 0 && t.ccb[b] == 0)
+    res.colliding.push_back({a, b});
+  else
+    res.untested.push_back({a, b});  // held back by depth_cap
 }
 
 // Chooses the node to split of an overlapping pair per Fig. 7: split b if
@@ -226,14 +235,15 @@ inline bool choose_split_b(const Trees& t, const WorkPair& p) {
 // the current size of the work list (for the budget's list cap). Returns false
 // when the budget stopped it (the untested children are then reported).
 template <class PendingSize, class Queue>
-bool test_children_one_by_one(const Trees& t, const WorkPair& p, bool split_b, int32_t first, int32_t end,
-                              Budget& budget, bool record_front, CollisionResult& res, PendingSize pending,
-                              Queue queue) {
+bool test_children_one_by_one(const Trees& t, const WorkPair& p, bool split_b, int32_t first,
+                              int32_t end, Budget& budget, bool record_front, CollisionResult& res,
+                              PendingSize pending, Queue queue) {
   StopReason reason = StopReason::Completed;
   for (int32_t c = first; c < end; ++c) {
     const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
     if (!budget.allow(res.tests, pending(), reason)) {
-      for (int32_t r = c; r < end; ++r) res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
+      for (int32_t r = c; r < end; ++r)
+        res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
       res.interrupted = true;
       res.stop_reason = reason;
       return false;
@@ -243,15 +253,18 @@ bool test_children_one_by_one(const Trees& t, const WorkPair& p, bool split_b, i
       if (record_front) res.front.push_back({a, b});
       continue;
     }
-    if (t.expandable_a(a) || t.expandable_b(b)) queue(a, b);
-    else settle(t, a, b, res);
+    if (t.expandable_a(a) || t.expandable_b(b))
+      queue(a, b);
+    else
+      settle(t, a, b, res);
   }
   return true;
 }
 
 // Literal Fig. 7 (and Fig. 4 with a stack): pairs are tested when popped.
 template <class List>
-void run_literal(const Trees& t, List& list, Budget& budget, bool record_front, CollisionResult& res) {
+void run_literal(const Trees& t, List& list, Budget& budget, bool record_front,
+                 CollisionResult& res) {
   StopReason reason = StopReason::Completed;
   while (!list.empty()) {
     if (!budget.allow(res.tests, list.size(), reason)) {
@@ -299,8 +312,10 @@ inline void expand_batch(const Trees& t, const WorkPair& p, int32_t first, int32
     const double dx = o.x - s.x, dy = o.y - s.y, dz = o.z - s.z, rr = o.r + s.r;
     const bool ov = dx * dx + dy * dy + dz * dz <= rr * rr;
     const int32_t a = SplitB ? p.a : c, b = SplitB ? c : p.b;
-    if (other_expandable || (SplitB ? t.expandable_b(c) : t.expandable_a(c))) list.push_if({a, b, next_flag}, ov);
-    else if (ov) settle(t, a, b, res);
+    if (other_expandable || (SplitB ? t.expandable_b(c) : t.expandable_a(c)))
+      list.push_if({a, b, next_flag}, ov);
+    else if (ov)
+      settle(t, a, b, res);
   }
 }
 
@@ -320,14 +335,18 @@ void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, Col
       // sphere with branch-free pushes of the overlapping ones.
       list.ensure(static_cast<std::size_t>(end - first));
       res.tests += end - first;
-      if (split_b) expand_batch<true>(t, p, first, end, list, res);
-      else expand_batch<false>(t, p, first, end, list, res);
+      if (split_b)
+        expand_batch<true>(t, p, first, end, list, res);
+      else
+        expand_batch<false>(t, p, first, end, list, res);
       res.peak_list_size = std::max(res.peak_list_size, list.size());
       continue;
     }
     stopped = !test_children_one_by_one(
         t, p, split_b, first, end, budget, record_front, res, [&] { return list.size(); },
-        [&](int32_t a, int32_t b) { list.push({a, b, next_flag}); });
+        [&](int32_t a, int32_t b) {
+          list.push({a, b, next_flag});
+        });
     res.peak_list_size = std::max(res.peak_list_size, list.size());
   }
   res.untested.reserve(res.untested.size() + list.size());
@@ -345,8 +364,8 @@ inline double priority_of(PriorityKey key, const Sphere& p, const Sphere& q) {
   return key == PriorityKey::LargestSphere ? std::max(p.r, q.r) : penetration(p, q);
 }
 
-void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, PriorityKey key, Budget& budget,
-                  bool record_front, CollisionResult& res) {
+void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, PriorityKey key,
+                  Budget& budget, bool record_front, CollisionResult& res) {
   bool stopped = false;
   while (!heap.empty() && !stopped) {
     std::pop_heap(heap.begin(), heap.end());
@@ -359,7 +378,8 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
       // Full: give up the lower-priority half (reported unrefined), keep the rest.
       std::sort(heap.begin(), heap.end());
       const std::size_t drop = std::max(heap.size() / 2, heap.size() + count - cap);
-      for (std::size_t k = 0; k < drop && k < heap.size(); ++k) res.untested.push_back({heap[k].p.a, heap[k].p.b});
+      for (std::size_t k = 0; k < drop && k < heap.size(); ++k)
+        res.untested.push_back({heap[k].p.a, heap[k].p.b});
       heap.erase(heap.begin(), heap.begin() + std::min(drop, heap.size()));
       std::make_heap(heap.begin(), heap.end());
     }
@@ -392,15 +412,19 @@ CollisionRequest CollisionRequest::paper_reference(double budget_seconds) {
   return r;
 }
 
-void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request, CollisionResult& res) {
+void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request,
+             CollisionResult& res) {
   if (std::isfinite(request.budget_seconds)) {  // one-time calibrations, outside the budget
     if (t_finish_cost == 0.0) t_finish_cost = output_seconds_per_pair();
     if (request.clock == ClockSource::CycleCounter) cycle_counter_hz();
   }
   const Clock::time_point start = Clock::now();
-  if (!(request.budget_seconds > 0.0)) throw ParameterError("CollisionRequest::budget_seconds must be > 0 (infinity for none)");
-  if (request.budget_tests < -1) throw ParameterError("CollisionRequest::budget_tests must be >= 0, or -1 for none");
-  if (request.clock_check_interval < 1) throw ParameterError("CollisionRequest::clock_check_interval must be >= 1");
+  if (!(request.budget_seconds > 0.0))
+    throw ParameterError("CollisionRequest::budget_seconds must be > 0 (infinity for none)");
+  if (request.budget_tests < -1)
+    throw ParameterError("CollisionRequest::budget_tests must be >= 0, or -1 for none");
+  if (request.clock_check_interval < 1)
+    throw ParameterError("CollisionRequest::clock_check_interval must be >= 1");
   if (request.depth_cap < 0) throw ParameterError("CollisionRequest::depth_cap must be >= 0");
   if (request.mode == TraversalMode::Priority && request.max_list_size < 8)
     throw ParameterError("CollisionRequest::max_list_size must be >= 8");
@@ -413,8 +437,9 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
   res.tests = 0;
   res.peak_list_size = 0;
 
-  const Trees t{a.spheres.data(), b.spheres.data(), a.first_child.data(), a.child_count.data(),
-                b.first_child.data(), b.child_count.data(), a.level.data(), b.level.data(), request.depth_cap};
+  const Trees t{a.spheres.data(),     b.spheres.data(),     a.first_child.data(),
+                a.child_count.data(), b.first_child.data(), b.child_count.data(),
+                a.level.data(),       b.level.data(),       request.depth_cap};
   // Seeds: the root pair (Fig. 7: p.1 = root of a, p.2 = root of b, split p.2
   // first), or the previous front, splitting the shallower node first.
   std::vector<WorkPair>& seeds = t_seeds;
@@ -423,7 +448,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
     seeds.reserve(request.start_front->size());
     for (const NodePair& p : *request.start_front) {
       if (p.a < 0 || p.a >= a.num_nodes() || p.b < 0 || p.b >= b.num_nodes())
-        throw ParameterError("collide: start_front pair (" + std::to_string(p.a) + ", " + std::to_string(p.b) + ") out of range");
+        throw ParameterError("collide: start_front pair (" + std::to_string(p.a) + ", " +
+                             std::to_string(p.b) + ") out of range");
       seeds.push_back({p.a, p.b, a.level[p.a] >= b.level[p.b] ? 1 : 0});
     }
   } else {
@@ -440,7 +466,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
       if (!budget.allow(res.tests, seeds.size() - seeded, reason)) {
         res.interrupted = true;
         res.stop_reason = reason;
-        for (std::size_t k = seeded; k < seeds.size(); ++k) res.untested.push_back({seeds[k].a, seeds[k].b});
+        for (std::size_t k = seeded; k < seeds.size(); ++k)
+          res.untested.push_back({seeds[k].a, seeds[k].b});
         return false;
       }
       ++res.tests;
@@ -462,7 +489,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
       std::push_heap(t_heap.begin(), t_heap.end());
     };
     if (seed_into(push))
-      run_priority(t, t_heap, request.max_list_size, request.priority, budget, request.record_front, res);
+      run_priority(t, t_heap, request.max_list_size, request.priority, budget, request.record_front,
+                   res);
     else
       for (const HeapItem& h : t_heap) res.untested.push_back({h.p.a, h.p.b});
   } else {
@@ -477,8 +505,10 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
         list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
       }
     };
-    if (request.mode == TraversalMode::BreadthFirstFifo) go(t_queue);
-    else go(t_stack);
+    if (request.mode == TraversalMode::BreadthFirstFifo)
+      go(t_queue);
+    else
+      go(t_stack);
   }
 
   // Tightness reached: the shallowest inner node among the untested pairs.
@@ -499,7 +529,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
   const Clock::time_point end = Clock::now();
   res.seconds = std::chrono::duration<double>(end - start).count();
   if (res.stop_reason == StopReason::TimeBudget && res.untested.size() >= 256) {
-    const double observed = std::chrono::duration<double>(end - budget.m_stopped_at).count() / res.untested.size();
+    const double observed =
+        std::chrono::duration<double>(end - budget.m_stopped_at).count() / res.untested.size();
     // Smoothed and clipped, so that one preempted finish does not make later
     // queries stop far too early; never below the calibrated copy cost.
     t_finish_cost = std::max(output_seconds_per_pair(),

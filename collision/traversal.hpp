@@ -25,8 +25,10 @@ enum class TraversalMode {
 
 /// What the Priority mode refines first.
 enum class PriorityKey {
-  LargestSphere,   ///< the pair with the largest sphere, max(r_a, r_b): shrinks the suspected region fastest
-  DeepestOverlap,  ///< the pair with the deepest overlap r_a + r_b - |c_a - c_b| (contact detail first)
+  LargestSphere,  ///< the pair with the largest sphere, max(r_a, r_b): shrinks the suspected region
+                  ///< fastest
+  DeepestOverlap,  ///< the pair with the deepest overlap r_a + r_b - |c_a - c_b| (contact detail
+                   ///< first)
 };
 
 /// Why the query stopped.
@@ -90,14 +92,14 @@ struct CollisionResult {
   /// If requested: a cut of the pair tree (pruned pairs + colliding + untested)
   /// to seed the next frame's query.
   std::vector<NodePair> front;
-  bool interrupted = false;       ///< stopped by a budget with work left
+  bool interrupted = false;  ///< stopped by a budget with work left
   StopReason stop_reason = StopReason::Completed;
-  int64_t tests = 0;              ///< sphere-sphere overlap tests done
-  double seconds = 0;             ///< wall time used (steady_clock)
+  int64_t tests = 0;   ///< sphere-sphere overlap tests done
+  double seconds = 0;  ///< wall time used (steady_clock)
   /// Deepest level L such that every reported pair is made of spheres at
   /// level >= L or of leaves (the tightness the answer reached).
   int completed_level = 0;
-  std::size_t peak_list_size = 0; ///< largest PAIRLIST / stack / heap size seen
+  std::size_t peak_list_size = 0;  ///< largest PAIRLIST / stack / heap size seen
 };
 
 /// Collides sphere tree `a` with sphere tree `b` (current spheres) under the
@@ -111,7 +113,8 @@ struct CollisionResult {
 /// process calibrates its clocks (~20 ms) before its budget starts.
 /// Throws ParameterError for an invalid request (bad budget, interval, cap,
 /// start_front index out of range). Trees are assumed valid (see validate()).
-void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request, CollisionResult& result);
+void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request,
+             CollisionResult& result);
 
 /// Convenience overload returning a fresh result.
 CollisionResult collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request);

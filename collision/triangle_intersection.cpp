@@ -22,7 +22,8 @@ int orient_k(int k, const Vec& a, const Vec& b, const Vec& c) {
 int projection_axis(const Vec& p, const Vec& q, const Vec& r) {
   const Vec n = (q - p).cross(r - p);
   std::array<int, 3> order{0, 1, 2};
-  std::sort(order.begin(), order.end(), [&](int i, int j) { return std::abs(n[i]) > std::abs(n[j]); });
+  std::sort(order.begin(), order.end(),
+            [&](int i, int j) { return std::abs(n[i]) > std::abs(n[j]); });
   for (int k : order)
     if (orient_k(k, p, q, r) != 0) return k;
   return -1;
@@ -31,8 +32,8 @@ int projection_axis(const Vec& p, const Vec& q, const Vec& r) {
 // c lies in the bounding box of collinear a, b (in projection k).
 bool on_segment_k(int k, const Vec& a, const Vec& b, const Vec& c) {
   const int u = (k + 1) % 3, v = (k + 2) % 3;
-  return std::min(a[u], b[u]) <= c[u] && c[u] <= std::max(a[u], b[u]) && std::min(a[v], b[v]) <= c[v] &&
-         c[v] <= std::max(a[v], b[v]);
+  return std::min(a[u], b[u]) <= c[u] && c[u] <= std::max(a[u], b[u]) &&
+         std::min(a[v], b[v]) <= c[v] && c[v] <= std::max(a[v], b[v]);
 }
 
 // Closed 2D segment-segment test in projection k.
@@ -57,7 +58,8 @@ bool point_in_triangle_k(int k, const Vec& x, const Vec& p, const Vec& q, const 
 bool segments_meet_3d(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
   if (orient3d(a, b, c, d) != 0) return false;
   for (int k = 0; k < 3; ++k)
-    if (orient_k(k, a, b, c) != 0 || orient_k(k, a, b, d) != 0 || orient_k(k, c, d, a) != 0 || orient_k(k, c, d, b) != 0)
+    if (orient_k(k, a, b, c) != 0 || orient_k(k, a, b, d) != 0 || orient_k(k, c, d, a) != 0 ||
+        orient_k(k, c, d, b) != 0)
       return segments_meet_k(k, a, b, c, d);
   // All four points on one line (or coincident): compare along the axis of
   // largest extent, where the order along the line is the coordinate order.
@@ -65,23 +67,31 @@ bool segments_meet_3d(const Vec& a, const Vec& b, const Vec& c, const Vec& d) {
   double best = -1;
   for (int i = 0; i < 3; ++i) {
     const double ext = std::max(std::abs(b[i] - a[i]), std::abs(d[i] - c[i]));
-    if (ext > best) { best = ext; k = i; }
+    if (ext > best) {
+      best = ext;
+      k = i;
+    }
   }
   if (best == 0.0) return a == c;
-  return std::max(std::min(a[k], b[k]), std::min(c[k], d[k])) <= std::min(std::max(a[k], b[k]), std::max(c[k], d[k]));
+  return std::max(std::min(a[k], b[k]), std::min(c[k], d[k])) <=
+         std::min(std::max(a[k], b[k]), std::max(c[k], d[k]));
 }
 
-bool coplanar_segment_triangle(const Vec& s0, const Vec& s1, const Vec& p, const Vec& q, const Vec& r) {
+bool coplanar_segment_triangle(const Vec& s0, const Vec& s1, const Vec& p, const Vec& q,
+                               const Vec& r) {
   const int k = projection_axis(p, q, r);
   if (k < 0)  // zero-area triangle: the union of its edges
-    return segments_meet_3d(s0, s1, p, q) || segments_meet_3d(s0, s1, q, r) || segments_meet_3d(s0, s1, r, p);
+    return segments_meet_3d(s0, s1, p, q) || segments_meet_3d(s0, s1, q, r) ||
+           segments_meet_3d(s0, s1, r, p);
   if (point_in_triangle_k(k, s0, p, q, r) || point_in_triangle_k(k, s1, p, q, r)) return true;
-  return segments_meet_k(k, s0, s1, p, q) || segments_meet_k(k, s0, s1, q, r) || segments_meet_k(k, s0, s1, r, p);
+  return segments_meet_k(k, s0, s1, p, q) || segments_meet_k(k, s0, s1, q, r) ||
+         segments_meet_k(k, s0, s1, r, p);
 }
 
 }  // namespace
 
-bool segment_triangle_intersect(const Vec& s0, const Vec& s1, const Vec& p, const Vec& q, const Vec& r) {
+bool segment_triangle_intersect(const Vec& s0, const Vec& s1, const Vec& p, const Vec& q,
+                                const Vec& r) {
   const int o0 = orient3d(p, q, r, s0), o1 = orient3d(p, q, r, s1);
   if (o0 * o1 > 0) return false;
   if (o0 == 0 && o1 == 0) return coplanar_segment_triangle(s0, s1, p, q, r);
@@ -90,11 +100,14 @@ bool segment_triangle_intersect(const Vec& s0, const Vec& s1, const Vec& p, cons
   return (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
 }
 
-bool triangles_intersect(const Vec& a0, const Vec& a1, const Vec& a2, const Vec& b0, const Vec& b1, const Vec& b2) {
+bool triangles_intersect(const Vec& a0, const Vec& a1, const Vec& a2, const Vec& b0, const Vec& b1,
+                         const Vec& b2) {
   // Quick rejection: all of one triangle strictly on one side of the other's plane.
-  const int sa0 = orient3d(b0, b1, b2, a0), sa1 = orient3d(b0, b1, b2, a1), sa2 = orient3d(b0, b1, b2, a2);
+  const int sa0 = orient3d(b0, b1, b2, a0), sa1 = orient3d(b0, b1, b2, a1),
+            sa2 = orient3d(b0, b1, b2, a2);
   if ((sa0 > 0 && sa1 > 0 && sa2 > 0) || (sa0 < 0 && sa1 < 0 && sa2 < 0)) return false;
-  const int sb0 = orient3d(a0, a1, a2, b0), sb1 = orient3d(a0, a1, a2, b1), sb2 = orient3d(a0, a1, a2, b2);
+  const int sb0 = orient3d(a0, a1, a2, b0), sb1 = orient3d(a0, a1, a2, b1),
+            sb2 = orient3d(a0, a1, a2, b2);
   if ((sb0 > 0 && sb1 > 0 && sb2 > 0) || (sb0 < 0 && sb1 < 0 && sb2 < 0)) return false;
   const std::array<const Vec*, 3> A{&a0, &a1, &a2}, B{&b0, &b1, &b2};
   for (int e = 0; e < 3; ++e) {
@@ -104,8 +117,8 @@ bool triangles_intersect(const Vec& a0, const Vec& a1, const Vec& a2, const Vec&
   return false;
 }
 
-std::vector<Vec> triangle_intersection_points(const Vec& a0, const Vec& a1, const Vec& a2, const Vec& b0, const Vec& b1,
-                                              const Vec& b2) {
+std::vector<Vec> triangle_intersection_points(const Vec& a0, const Vec& a1, const Vec& a2,
+                                              const Vec& b0, const Vec& b1, const Vec& b2) {
   std::vector<Vec> pts;
   if (!triangles_intersect(a0, a1, a2, b0, b1, b2)) return pts;
   const std::array<Vec, 3> A{a0, a1, a2}, B{b0, b1, b2};
@@ -142,7 +155,8 @@ std::vector<Vec> triangle_intersection_points(const Vec& a0, const Vec& a1, cons
             if (on_segment_k(k, s0, s1, *x)) pts.push_back(*x);
           continue;
         }
-        const double t = std::clamp(((c[u] - s0[u]) * (d[v] - c[v]) - (c[v] - s0[v]) * (d[u] - c[u])) / den, 0.0, 1.0);
+        const double t = std::clamp(
+            ((c[u] - s0[u]) * (d[v] - c[v]) - (c[v] - s0[v]) * (d[u] - c[u])) / den, 0.0, 1.0);
         pts.push_back(s0 + t * (s1 - s0));
       }
     }

@@ -15,8 +15,8 @@ namespace icd::coupling {
 /// 1), so that dense = W * coarse for any coarse positions (#M x 3).
 struct BarycentricEmbedding {
   Eigen::SparseMatrix<double, Eigen::RowMajor> W;
-  Eigen::VectorXi tet;         ///< #N: the coarse tet each vertex is expressed in
-  int num_outside = 0;         ///< vertices not inside any tet (extrapolated)
+  Eigen::VectorXi tet;  ///< #N: the coarse tet each vertex is expressed in
+  int num_outside = 0;  ///< vertices not inside any tet (extrapolated)
 };
 
 /// Builds the embedding of P (#N x 3) in the tet mesh (V #M x 3, T #T x 4,

@@ -31,16 +31,20 @@ struct Accumulator {
   Eigen::Ref<MatX3d> out;
   const SphereTree& tree;
   ContactDistribution mode;
-  std::vector<int> count;      // PaperAverage: forces received per node
-  MatX3d received;             // PaperAverage: sum of received forces
-  Eigen::VectorXd stiffness;   // added stiffness per node
+  std::vector<int> count;     // PaperAverage: forces received per node
+  MatX3d received;            // PaperAverage: sum of received forces
+  Eigen::VectorXd stiffness;  // added stiffness per node
 
   const Eigen::VectorXd* mass;  // node masses, or null
   Eigen::VectorXd rate;         // per node: sum of k * share / m_n (1/s^2)
 
   Accumulator(Eigen::Ref<MatX3d> o, const SphereTree& t, ContactDistribution m,
               const Eigen::VectorXd* node_mass)
-      : out(o), tree(t), mode(m), stiffness(Eigen::VectorXd::Zero(o.rows())), mass(node_mass),
+      : out(o),
+        tree(t),
+        mode(m),
+        stiffness(Eigen::VectorXd::Zero(o.rows())),
+        mass(node_mass),
         rate(Eigen::VectorXd::Zero(node_mass ? o.rows() : 0)) {
     if (mode == ContactDistribution::PaperAverage) {
       count.assign(static_cast<size_t>(o.rows()), 0);
@@ -57,7 +61,8 @@ struct Accumulator {
     for (int32_t j = begin; j < end; ++j) {
       const int32_t node = tree.assoc_nodes[j];
       if (mode == ContactDistribution::MassWeighted) share = (*mass)[node] / total_mass;
-      if (mass) rate[node] += k * (mode == ContactDistribution::PaperAverage ? 1.0 : share) / (*mass)[node];
+      if (mass)
+        rate[node] += k * (mode == ContactDistribution::PaperAverage ? 1.0 : share) / (*mass)[node];
       if (mode != ContactDistribution::PaperAverage) {
         out.row(node) += share * f.transpose();
         stiffness[node] += share * k;
@@ -120,7 +125,8 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
   check_mass(options.mass_b, forces_b.rows(), "b");
   if (options.distribution == ContactDistribution::MassWeighted &&
       (!options.mass_a || !options.mass_b))
-    throw ParameterError("contact response: the mass-weighted distribution needs mass_a and mass_b");
+    throw ParameterError(
+        "contact response: the mass-weighted distribution needs mass_a and mass_b");
   Eigen::Vector3d fallback = options.coincident_direction;
   fallback = fallback.allFinite() && fallback.norm() > 0 ? fallback.normalized()
                                                          : Eigen::Vector3d::UnitZ();
@@ -160,9 +166,8 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
   }
   if (options.mass_a && options.mass_b && stats.active_pairs > 0)
     stats.max_rate = acc_a.rate.maxCoeff() + acc_b.rate.maxCoeff();
-  stats.max_node_stiffness =
-      std::max(acc_a.stiffness.size() ? acc_a.stiffness.maxCoeff() : 0.0,
-               acc_b.stiffness.size() ? acc_b.stiffness.maxCoeff() : 0.0);
+  stats.max_node_stiffness = std::max(acc_a.stiffness.size() ? acc_a.stiffness.maxCoeff() : 0.0,
+                                      acc_b.stiffness.size() ? acc_b.stiffness.maxCoeff() : 0.0);
   return stats;
 }
 

@@ -59,8 +59,8 @@ struct ContactOptions {
 
 /// What the response did.
 struct ContactStats {
-  int active_pairs = 0;         ///< pairs with positive penetration
-  double max_penetration = 0;   ///< largest delta (model units)
+  int active_pairs = 0;        ///< pairs with positive penetration
+  double max_penetration = 0;  ///< largest delta (model units)
   /// Energy stored in the penalty springs, sum of k delta^2 / 2 over the
   /// active pairs (J when lengths are in m).
   double penalty_energy = 0;

@@ -7,9 +7,11 @@
 
 namespace icd::fem {
 
-NewtonReport BackwardEulerStepper::step(Model& model, State& s, double h, const NewtonOptions& options) {
+NewtonReport BackwardEulerStepper::step(Model& model, State& s, double h,
+                                        const NewtonOptions& options) {
   if (!(h > 0) || !std::isfinite(h))
-    throw ParameterError("fem::BackwardEulerStepper::step: h = " + std::to_string(h) + " must be > 0");
+    throw ParameterError("fem::BackwardEulerStepper::step: h = " + std::to_string(h) +
+                         " must be > 0");
   const int n = model.num_nodes();
   const Eigen::VectorXd& m = model.mass();
   const auto fixed = model.fixed_dofs();
@@ -18,8 +20,9 @@ NewtonReport BackwardEulerStepper::step(Model& model, State& s, double h, const 
 
   auto residual = [&](const MatX3d& x, const MatX3d& v, MatX3d& out) {
     model.total_force(x, v, f);
-    for (int i = 0; i < n; ++i) out.row(i) = model.fixed_nodes()[i] ? Eigen::RowVector3d::Zero().eval()
-                                                                      : (m[i] * (v.row(i) - s.v.row(i)) - h * f.row(i)).eval();
+    for (int i = 0; i < n; ++i)
+      out.row(i) = model.fixed_nodes()[i] ? Eigen::RowVector3d::Zero().eval()
+                                          : (m[i] * (v.row(i) - s.v.row(i)) - h * f.row(i)).eval();
     return flat(out).norm();
   };
   NewtonReport rep;
@@ -46,9 +49,10 @@ NewtonReport BackwardEulerStepper::step(Model& model, State& s, double h, const 
     Eigen::Map<Eigen::VectorXd>(m_A.valuePtr(), m_A.nonZeros()) =
         ck * Eigen::Map<const Eigen::VectorXd>(K.valuePtr(), K.nonZeros());
     for (int i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c) m_A.coeffRef(3 * i + c, 3 * i + c) += m[i] * (1.0 + h * damp.alpha);
-    add_strain_rate_damping_matrix(model.mesh(), model.elastic().pattern(), model.strain_rate_damping(), x1, h,
-                                   m_A);
+      for (int c = 0; c < 3; ++c)
+        m_A.coeffRef(3 * i + c, 3 * i + c) += m[i] * (1.0 + h * damp.alpha);
+    add_strain_rate_damping_matrix(model.mesh(), model.elastic().pattern(),
+                                   model.strain_rate_damping(), x1, h, m_A);
     apply_dirichlet(m_A, fixed);
     const Eigen::VectorXd rhs = -flat(r);
     rep.max_shift = std::max(rep.max_shift, solve_with_shift(m_solver, m_A, m_shifted, rhs, dv));

@@ -17,9 +17,9 @@ struct NewtonOptions {
 struct NewtonReport {
   bool converged = false;
   int iterations = 0;
-  double residual = 0;        ///< final residual norm (free dofs)
-  double reference = 0;       ///< the scale the tolerance was relative to
-  double max_shift = 0;       ///< largest diagonal shift needed for positive definiteness
+  double residual = 0;   ///< final residual norm (free dofs)
+  double reference = 0;  ///< the scale the tolerance was relative to
+  double max_shift = 0;  ///< largest diagonal shift needed for positive definiteness
 };
 
 /// Backward Euler: find v1 with M (v1 - v0) = h f(x0 + h v1, v1), x1 = x0 + h v1.

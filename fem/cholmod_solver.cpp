@@ -36,8 +36,8 @@ cholmod_sparse view(const Eigen::SparseMatrix<double>& A) {
 
 void check_status(const cholmod_common& c, const char* call) {
   if (c.status < 0)
-    throw NumericalError(std::string("fem::CholmodSolver: ") + call + " failed with CHOLMOD status " +
-                         std::to_string(c.status));
+    throw NumericalError(std::string("fem::CholmodSolver: ") + call +
+                         " failed with CHOLMOD status " + std::to_string(c.status));
 }
 
 }  // namespace
@@ -47,11 +47,13 @@ CholmodSolver::CholmodSolver(CholmodOrdering ordering) : m_impl(new Impl) {
   // (measured: 3x the wall time, most of it in sched_yield, on 2 shared cores).
   // OpenBLAS is CHOLMOD's BLAS on Debian; looked up at run time, absent elsewhere.
   using SetThreads = void (*)(int);
-  if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) set(1);
+  if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
+    set(1);
   cholmod_start(&m_impl->common);
   if (ordering != CholmodOrdering::Default) {
     m_impl->common.nmethods = 1;
-    m_impl->common.method[0].ordering = ordering == CholmodOrdering::Amd ? CHOLMOD_AMD : CHOLMOD_METIS;
+    m_impl->common.method[0].ordering =
+        ordering == CholmodOrdering::Amd ? CHOLMOD_AMD : CHOLMOD_METIS;
     m_impl->common.postorder = 1;
   }
   m_impl->common.print = 0;
@@ -70,9 +72,10 @@ CholmodSolver::~CholmodSolver() {
 
 void CholmodSolver::analyze(const Eigen::SparseMatrix<double>& A) {
   if (A.rows() != A.cols() || A.rows() == 0)
-    throw ParameterError("fem::CholmodSolver::analyze: matrix is " + std::to_string(A.rows()) + " x " +
-                         std::to_string(A.cols()) + ", expected square and non-empty");
-  if (!A.isCompressed()) throw ParameterError("fem::CholmodSolver::analyze: matrix is not compressed");
+    throw ParameterError("fem::CholmodSolver::analyze: matrix is " + std::to_string(A.rows()) +
+                         " x " + std::to_string(A.cols()) + ", expected square and non-empty");
+  if (!A.isCompressed())
+    throw ParameterError("fem::CholmodSolver::analyze: matrix is not compressed");
   if (m_factor) {
     auto* L = static_cast<cholmod_factor*>(m_factor);
     cholmod_free_factor(&L, &m_impl->common);
@@ -105,8 +108,8 @@ bool CholmodSolver::factorize(const Eigen::SparseMatrix<double>& A) {
 Eigen::VectorXd CholmodSolver::solve(const Eigen::VectorXd& b) {
   if (!m_factorized) throw NumericalError("fem::CholmodSolver::solve: no successful factorisation");
   if (b.size() != m_rows)
-    throw ParameterError("fem::CholmodSolver::solve: right-hand side has " + std::to_string(b.size()) +
-                         " entries, expected " + std::to_string(m_rows));
+    throw ParameterError("fem::CholmodSolver::solve: right-hand side has " +
+                         std::to_string(b.size()) + " entries, expected " + std::to_string(m_rows));
   cholmod_dense d{};
   d.nrow = static_cast<size_t>(b.size());
   d.ncol = 1;
@@ -115,7 +118,8 @@ Eigen::VectorXd CholmodSolver::solve(const Eigen::VectorXd& b) {
   d.x = const_cast<double*>(b.data());
   d.xtype = CHOLMOD_REAL;
   d.dtype = CHOLMOD_DOUBLE;
-  cholmod_dense* x = cholmod_solve(CHOLMOD_A, static_cast<cholmod_factor*>(m_factor), &d, &m_impl->common);
+  cholmod_dense* x =
+      cholmod_solve(CHOLMOD_A, static_cast<cholmod_factor*>(m_factor), &d, &m_impl->common);
   check_status(m_impl->common, "cholmod_solve");
   if (!x) throw NumericalError("fem::CholmodSolver: cholmod_solve returned no solution");
   Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(static_cast<double*>(x->x), b.size());

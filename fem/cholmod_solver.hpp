@@ -11,7 +11,7 @@ namespace icd::fem {
 enum class CholmodOrdering {
   Default,  ///< CHOLMOD's strategy: AMD, METIS tried when AMD's fill is poor
   Amd,
-  Metis     ///< METIS nested dissection (least fill on 3D meshes)
+  Metis  ///< METIS nested dissection (least fill on 3D meshes)
 };
 
 /// Sparse symmetric positive definite solver. The matrix is given with both

@@ -32,7 +32,8 @@ struct LinearLaw {
     P.diagonal().array() += lambda * (F.trace() - 3.0) - 2.0 * mu;
     return P;
   }
-  Eigen::Matrix3d stress_differential(const Eigen::Matrix3d& /*F*/, const Eigen::Matrix3d& dF) const {
+  Eigen::Matrix3d stress_differential(const Eigen::Matrix3d& /*F*/,
+                                      const Eigen::Matrix3d& dF) const {
     Eigen::Matrix3d dP = mu * (dF + dF.transpose());
     dP.diagonal().array() += lambda * dF.trace();
     return dP;
@@ -119,7 +120,8 @@ struct CorotationalLaw {
     const double trS = A.trace();
     N.diagonal().array() += trS;
     const Eigen::Matrix3d RtdF = R.transpose() * dF;
-    const Eigen::Vector3d a(RtdF(2, 1) - RtdF(1, 2), RtdF(0, 2) - RtdF(2, 0), RtdF(1, 0) - RtdF(0, 1));
+    const Eigen::Vector3d a(RtdF(2, 1) - RtdF(1, 2), RtdF(0, 2) - RtdF(2, 0),
+                            RtdF(1, 0) - RtdF(0, 1));
     const Eigen::Vector3d w = N.inverse() * a;
     Eigen::Matrix3d W;
     W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;

@@ -83,7 +83,8 @@ inline void write_element(const Matrix3d& H, double* out) {
 
 }  // namespace
 
-ElasticForces::ElasticForces(TetMeshData mesh, const Material& material, const ForceOptions& options)
+ElasticForces::ElasticForces(TetMeshData mesh, const Material& material,
+                             const ForceOptions& options)
     : m_mesh(std::move(mesh)),
       m_material(material),
       m_options(options),
@@ -93,8 +94,9 @@ ElasticForces::ElasticForces(TetMeshData mesh, const Material& material, const F
   m_lambda = l.lambda;
   set_num_threads(options.num_threads);
   if (options.polar_max_iterations < 1)
-    throw ParameterError("fem::ForceOptions.polar_max_iterations = " +
-                         std::to_string(options.polar_max_iterations) + " is invalid: expected >= 1");
+    throw ParameterError(
+        "fem::ForceOptions.polar_max_iterations = " + std::to_string(options.polar_max_iterations) +
+        " is invalid: expected >= 1");
   m_stiffness = m_pattern.zero_matrix();
   m_rotations.assign(m_mesh.num_tets(), Eigen::Quaterniond::Identity());
   m_element_forces.resize(12 * static_cast<size_t>(m_mesh.num_tets()));
@@ -109,7 +111,8 @@ ElasticForces::ElasticForces(TetMeshData mesh, const Material& material, const F
   m_chunk_sum.resize((m_mesh.num_tets() + kChunk - 1) / kChunk);
   m_chunk_health.resize(m_chunk_sum.size());
   static_assert(kChunk % lanes::kLanes == 0, "chunks hold whole lane blocks");
-  static_assert(sizeof(lanes::Block) == sizeof(double) * 10 * lanes::kLanes, "Block is plain doubles");
+  static_assert(sizeof(lanes::Block) == sizeof(double) * 10 * lanes::kLanes,
+                "Block is plain doubles");
   const int nblocks = (m_mesh.num_tets() + lanes::kLanes - 1) / lanes::kLanes;
   m_lane_blocks.assign(static_cast<size_t>(nblocks) * 10 * lanes::kLanes, 0.0);
   for (int e = 0; e < m_mesh.num_tets(); ++e) {
@@ -130,8 +133,8 @@ void ElasticForces::set_num_threads(int num_threads) {
 void ElasticForces::check_shape(const Eigen::Ref<const MatX3d>& x, const char* what) const {
   if (x.rows() != m_mesh.num_nodes)
     throw ParameterError(std::string("fem::ElasticForces: ") + what + " has " +
-                         std::to_string(x.rows()) + " rows, expected #V = " +
-                         std::to_string(m_mesh.num_nodes));
+                         std::to_string(x.rows()) +
+                         " rows, expected #V = " + std::to_string(m_mesh.num_nodes));
 }
 
 template <class Op>
@@ -139,7 +142,8 @@ void ElasticForces::for_chunks(Op&& op) {
   const int nt = m_mesh.num_tets();
   const int nchunks = static_cast<int>(m_chunk_sum.size());
   if (m_options.num_threads == 1) {
-    for (int c = 0; c < nchunks; ++c) m_chunk_sum[c] = op(c * kChunk, std::min(nt, (c + 1) * kChunk));
+    for (int c = 0; c < nchunks; ++c)
+      m_chunk_sum[c] = op(c * kChunk, std::min(nt, (c + 1) * kChunk));
     return;
   }
 #pragma omp parallel for schedule(static) num_threads(m_options.num_threads)
@@ -165,26 +169,28 @@ void ElasticForces::gather(double* f) {
 }
 
 // Calls fn(eval) with the evaluator of the current material.
-#define ICD_FEM_DISPATCH(fn)                                                                   \
-  switch (m_material.model) {                                                                  \
-    case MaterialModel::Linear: {                                                              \
-      const PlainEval<LinearLaw> ev{{m_mu, m_lambda}};                                         \
-      return fn(ev);                                                                           \
-    }                                                                                          \
-    case MaterialModel::StVK: {                                                                \
-      const PlainEval<StVKLaw> ev{{m_mu, m_lambda}};                                           \
-      return fn(ev);                                                                           \
-    }                                                                                          \
-    case MaterialModel::StableNeoHookean: {                                                    \
-      const PlainEval<StableNeoHookeanLaw> ev{{m_mu, m_lambda}};                               \
-      return fn(ev);                                                                           \
-    }                                                                                          \
-    case MaterialModel::Corotational: {                                                        \
-      const CorotationalEval ev{{m_mu, m_lambda}, m_rotations.data(),                          \
-                                m_options.polar_max_iterations, m_options.polar_tolerance};    \
-      return fn(ev);                                                                           \
-    }                                                                                          \
-  }                                                                                            \
+#define ICD_FEM_DISPATCH(fn)                                     \
+  switch (m_material.model) {                                    \
+    case MaterialModel::Linear: {                                \
+      const PlainEval<LinearLaw> ev{{m_mu, m_lambda}};           \
+      return fn(ev);                                             \
+    }                                                            \
+    case MaterialModel::StVK: {                                  \
+      const PlainEval<StVKLaw> ev{{m_mu, m_lambda}};             \
+      return fn(ev);                                             \
+    }                                                            \
+    case MaterialModel::StableNeoHookean: {                      \
+      const PlainEval<StableNeoHookeanLaw> ev{{m_mu, m_lambda}}; \
+      return fn(ev);                                             \
+    }                                                            \
+    case MaterialModel::Corotational: {                          \
+      const CorotationalEval ev{{m_mu, m_lambda},                \
+                                m_rotations.data(),              \
+                                m_options.polar_max_iterations,  \
+                                m_options.polar_tolerance};      \
+      return fn(ev);                                             \
+    }                                                            \
+  }                                                              \
   throw ParameterError("fem::ElasticForces: unknown material model");
 
 template <bool kEnergy>
@@ -252,7 +258,8 @@ void ElasticForces::compute(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d
   compute_fast<lanes::LaneCheck::None>(x, f, nullptr);
 }
 
-ElementHealth ElasticForces::compute_with_health(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
+ElementHealth ElasticForces::compute_with_health(const Eigen::Ref<const MatX3d>& x,
+                                                 Eigen::Ref<MatX3d> f) {
   check_shape(x, "positions");
   check_shape(f, "forces");
   if (x.outerStride() != 3 || f.outerStride() != 3) {
@@ -264,7 +271,8 @@ ElementHealth ElasticForces::compute_with_health(const Eigen::Ref<const MatX3d>&
   return h;
 }
 
-bool ElasticForces::compute_with_orientation_check(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f) {
+bool ElasticForces::compute_with_orientation_check(const Eigen::Ref<const MatX3d>& x,
+                                                   Eigen::Ref<MatX3d> f) {
   check_shape(x, "positions");
   check_shape(f, "forces");
   if (x.outerStride() != 3 || f.outerStride() != 3) {
@@ -278,8 +286,8 @@ bool ElasticForces::compute_with_orientation_check(const Eigen::Ref<const MatX3d
 }
 
 template <lanes::LaneCheck kCheck>
-void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f, ElementHealth* health,
-                                 bool* oriented) {
+void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f,
+                                 ElementHealth* health, bool* oriented) {
   constexpr bool kHealth = kCheck == lanes::LaneCheck::Full;
   constexpr bool kOrientation = kCheck == lanes::LaneCheck::Orientation;
   // The hot path: 8-lane SoA kernels (lane_kernels.hpp) or, for corotational,
@@ -336,7 +344,8 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
         const int* t = T + 4 * e;
         const double* D = dinv + 9 * static_cast<size_t>(e);
         double F[9], P[9], H[9], R[9];
-        kernels::deformation_gradient(xp + 3 * t[0], xp + 3 * t[1], xp + 3 * t[2], xp + 3 * t[3], D, F);
+        kernels::deformation_gradient(xp + 3 * t[0], xp + 3 * t[1], xp + 3 * t[2], xp + 3 * t[3], D,
+                                      F);
         kernels::corotational_stress(F, mu, lambda, rot[e], max_it, tol, P, R);
         if constexpr (kHealth) {
           const double J = kernels::determinant(F);
@@ -367,9 +376,15 @@ void ElasticForces::compute_fast(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<M
   };
   if (direct) f.setZero();
   switch (m_material.model) {
-    case MaterialModel::Linear: run(std::integral_constant<MaterialModel, MaterialModel::Linear>{}); break;
-    case MaterialModel::Corotational: run(std::integral_constant<MaterialModel, MaterialModel::Corotational>{}); break;
-    case MaterialModel::StVK: run(std::integral_constant<MaterialModel, MaterialModel::StVK>{}); break;
+    case MaterialModel::Linear:
+      run(std::integral_constant<MaterialModel, MaterialModel::Linear>{});
+      break;
+    case MaterialModel::Corotational:
+      run(std::integral_constant<MaterialModel, MaterialModel::Corotational>{});
+      break;
+    case MaterialModel::StVK:
+      run(std::integral_constant<MaterialModel, MaterialModel::StVK>{});
+      break;
     case MaterialModel::StableNeoHookean:
       run(std::integral_constant<MaterialModel, MaterialModel::StableNeoHookean>{});
       break;
@@ -413,7 +428,9 @@ ElementHealth ElasticForces::health(const Eigen::Ref<const MatX3d>& x) {
   const double* dinv = m_mesh.dm_inv.data()->data();
   ElementHealth h;
   h.min_det_f = std::numeric_limits<double>::infinity();
-  const CorotationalEval corot{{m_mu, m_lambda}, m_rotations.data(), m_options.polar_max_iterations,
+  const CorotationalEval corot{{m_mu, m_lambda},
+                               m_rotations.data(),
+                               m_options.polar_max_iterations,
                                m_options.polar_tolerance};
   // Sequential; energies summed per chunk in the chunk order of the force loop.
   for (int c = 0; c * kChunk < m_mesh.num_tets(); ++c) {
@@ -430,9 +447,15 @@ ElementHealth ElasticForces::health(const Eigen::Ref<const MatX3d>& x) {
       }
       double psi = 0;
       switch (m_material.model) {
-        case MaterialModel::Linear: psi = kernels::linear_energy(F, m_mu, m_lambda); break;
-        case MaterialModel::StVK: psi = kernels::stvk_energy(F, m_mu, m_lambda); break;
-        case MaterialModel::StableNeoHookean: psi = kernels::stable_neo_hookean_energy(F, J, m_mu, m_lambda); break;
+        case MaterialModel::Linear:
+          psi = kernels::linear_energy(F, m_mu, m_lambda);
+          break;
+        case MaterialModel::StVK:
+          psi = kernels::stvk_energy(F, m_mu, m_lambda);
+          break;
+        case MaterialModel::StableNeoHookean:
+          psi = kernels::stable_neo_hookean_energy(F, J, m_mu, m_lambda);
+          break;
         case MaterialModel::Corotational:
           psi = corot.energy(e, Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(F));
           break;
@@ -446,8 +469,8 @@ ElementHealth ElasticForces::health(const Eigen::Ref<const MatX3d>& x) {
   return h;
 }
 
-void ElasticForces::differential(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& dx,
-                                 Eigen::Ref<MatX3d> df) {
+void ElasticForces::differential(const Eigen::Ref<const MatX3d>& x,
+                                 const Eigen::Ref<const MatX3d>& dx, Eigen::Ref<MatX3d> df) {
   check_shape(x, "positions");
   check_shape(dx, "displacements");
   check_shape(df, "force differential");
@@ -456,7 +479,8 @@ void ElasticForces::differential(const Eigen::Ref<const MatX3d>& x, const Eigen:
   const long xs = x.outerStride(), ds = dx.outerStride();
   const int* T = m_mesh.tets.data();
   double* buf = m_element_forces.data();
-  if (xs == 3 && ds == 3 && df.outerStride() == 3 && m_material.model != MaterialModel::Corotational) {
+  if (xs == 3 && ds == 3 && df.outerStride() == 3 &&
+      m_material.model != MaterialModel::Corotational) {
     differential_fast(xp, dp, df.data());
     return;
   }
@@ -467,7 +491,8 @@ void ElasticForces::differential(const Eigen::Ref<const MatX3d>& x, const Eigen:
         const Matrix3d F = edge_matrix(xp, xs, T + 4 * e) * Dinv;
         const Matrix3d dF = edge_matrix(dp, ds, T + 4 * e) * Dinv;
         const Matrix3d dP = ev.tangent(e, F)(dF);
-        write_element((-m_mesh.rest_volume[e]) * (dP * Dinv.transpose()), buf + 12 * static_cast<size_t>(e));
+        write_element((-m_mesh.rest_volume[e]) * (dP * Dinv.transpose()),
+                      buf + 12 * static_cast<size_t>(e));
       }
       return 0.0;
     });
@@ -508,12 +533,18 @@ void ElasticForces::differential_fast(const double* xp, const double* dp, double
   };
   if (direct) std::fill_n(df, 3 * static_cast<size_t>(m_mesh.num_nodes), 0.0);
   switch (m_material.model) {
-    case MaterialModel::Linear: run(std::integral_constant<MaterialModel, MaterialModel::Linear>{}); break;
-    case MaterialModel::StVK: run(std::integral_constant<MaterialModel, MaterialModel::StVK>{}); break;
+    case MaterialModel::Linear:
+      run(std::integral_constant<MaterialModel, MaterialModel::Linear>{});
+      break;
+    case MaterialModel::StVK:
+      run(std::integral_constant<MaterialModel, MaterialModel::StVK>{});
+      break;
     case MaterialModel::StableNeoHookean:
       run(std::integral_constant<MaterialModel, MaterialModel::StableNeoHookean>{});
       break;
-    case MaterialModel::Corotational: assert(false && "corotational uses the Eigen path"); break;
+    case MaterialModel::Corotational:
+      assert(false && "corotational uses the Eigen path");
+      break;
   }
   if (!direct) gather(df);
 }
@@ -538,7 +569,8 @@ const Eigen::SparseMatrix<double>& ElasticForces::stiffness(const Eigen::Ref<con
           double col[12];  // column (b, c) of K_e = V dP Dm^-T, node 0 = -sum
           write_element((-m_mesh.rest_volume[e]) * (dP(dF) * Dinv.transpose()), col);
           for (int a = 0; a < 4; ++a) {
-            double* block = val + m_pattern.block_offset(e, a, b) + c * m_pattern.column_length(t[b]);
+            double* block =
+                val + m_pattern.block_offset(e, a, b) + c * m_pattern.column_length(t[b]);
             // K = -df/dx, and write_element wrote -(V dP Dm^-T) columns.
             block[0] -= col[3 * a];
             block[1] -= col[3 * a + 1];

@@ -16,7 +16,7 @@ namespace icd::fem {
 namespace lanes {
 struct LaneLoopInput;
 enum class LaneCheck;
-}
+}  // namespace lanes
 
 /// Options of the element loops.
 struct ForceOptions {
@@ -31,9 +31,9 @@ struct ForceOptions {
 
 /// Energy and inversion state of a configuration.
 struct ElementHealth {
-  double energy = 0;          ///< total elastic energy W(x), J
-  double min_det_f = 0;       ///< smallest det F over the elements (J = current/rest volume)
-  int min_det_f_element = -1; ///< element where it occurs
+  double energy = 0;                 ///< total elastic energy W(x), J
+  double min_det_f = 0;              ///< smallest det F over the elements (J = current/rest volume)
+  int min_det_f_element = -1;        ///< element where it occurs
   int first_nonfinite_element = -1;  ///< first element whose energy is NaN/Inf, -1 if none
 };
 
@@ -83,10 +83,12 @@ class ElasticForces {
   const StiffnessPattern& pattern() const { return m_pattern; }
 
  private:
-  template <class Op> void for_chunks(Op&& op);
+  template <class Op>
+  void for_chunks(Op&& op);
   void check_shape(const Eigen::Ref<const MatX3d>& x, const char* what) const;
   void gather(double* f);
-  template <bool kEnergy> double compute_impl(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
+  template <bool kEnergy>
+  double compute_impl(const Eigen::Ref<const MatX3d>& x, Eigen::Ref<MatX3d> f);
   void differential_fast(const double* x, const double* dx, double* df);
   /// Lane-loop input at positions x: element forces go to `forces` directly
   /// with one thread, else to the per-element scratch for gather().
@@ -113,7 +115,7 @@ class ElasticForces {
   std::vector<int> m_node_offset, m_node_slot;  // node -> element slots (CSR, ascending element)
   std::vector<double> m_chunk_sum;
   std::vector<ChunkHealth> m_chunk_health;
-  std::vector<double> m_lane_blocks;            // lanes::Block per 8 elements (SoA Dm^-1, volume)
+  std::vector<double> m_lane_blocks;  // lanes::Block per 8 elements (SoA Dm^-1, volume)
 };
 
 }  // namespace icd::fem

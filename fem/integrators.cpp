@@ -11,9 +11,12 @@ namespace icd::fem {
 
 const char* to_string(Integrator integrator) {
   switch (integrator) {
-    case Integrator::RK4: return "rk4";
-    case Integrator::SymplecticEuler: return "symplectic_euler";
-    case Integrator::BackwardEuler: return "backward_euler";
+    case Integrator::RK4:
+      return "rk4";
+    case Integrator::SymplecticEuler:
+      return "symplectic_euler";
+    case Integrator::BackwardEuler:
+      return "backward_euler";
   }
   return "unknown";
 }
@@ -96,9 +99,9 @@ namespace {
 template <bool kEnergies, int kCount>
 [[gnu::always_inline]] inline void symplectic_euler_dofs(
     int count, double alpha, double h, const double* __restrict m, const double* __restrict w,
-    const std::uint64_t* __restrict free_mask, const double* __restrict load, const double* __restrict x,
-    const double* __restrict v, const double* __restrict f, double* __restrict x1, double* __restrict v1,
-    EnergySums& sums) {
+    const std::uint64_t* __restrict free_mask, const double* __restrict load,
+    const double* __restrict x, const double* __restrict v, const double* __restrict f,
+    double* __restrict x1, double* __restrict v1, EnergySums& sums) {
   for (int j = 0; j < (kCount > 0 ? kCount : count); ++j) {
     if constexpr (kEnergies) sums.add(j, m[j], v[j], load[j], x[j]);
     const double a_free = w[j] * (f[j] + load[j] - m[j] * alpha * v[j]);
@@ -125,10 +128,12 @@ template <bool kEnergies>
   EnergySums sums;
   long k = 0;
   for (; k + 4 <= p.nd; k += 4)
-    symplectic_euler_dofs<kEnergies, 4>(4, p.alpha, p.h, p.m + k, p.w + k, p.free_mask + k, p.load + k, p.x + k,
-                                        p.v + k, p.f + k, p.x1 + k, p.v1 + k, sums);
-  symplectic_euler_dofs<kEnergies, 0>(static_cast<int>(p.nd - k), p.alpha, p.h, p.m + k, p.w + k, p.free_mask + k,
-                                      p.load + k, p.x + k, p.v + k, p.f + k, p.x1 + k, p.v1 + k, sums);
+    symplectic_euler_dofs<kEnergies, 4>(4, p.alpha, p.h, p.m + k, p.w + k, p.free_mask + k,
+                                        p.load + k, p.x + k, p.v + k, p.f + k, p.x1 + k, p.v1 + k,
+                                        sums);
+  symplectic_euler_dofs<kEnergies, 0>(static_cast<int>(p.nd - k), p.alpha, p.h, p.m + k, p.w + k,
+                                      p.free_mask + k, p.load + k, p.x + k, p.v + k, p.f + k,
+                                      p.x1 + k, p.v1 + k, sums);
   return sums.result();
 }
 
@@ -148,10 +153,19 @@ __attribute__((target("avx2"))) StateEnergies symplectic_euler_nodes_avx2(const 
 #endif
 
 template <bool kEnergies>
-StateEnergies symplectic_euler_nodes(const Model& model, const double* x, const double* v, const double* f,
-                                     double h, double* x1, double* v1) {
-  const NodePass p{3L * model.num_nodes(), model.damping().alpha, h, model.dof_mass().data(),
-                   model.dof_inverse_mass().data(), model.dof_free_mask().data(), model.loads().data(), x, v, f, x1,
+StateEnergies symplectic_euler_nodes(const Model& model, const double* x, const double* v,
+                                     const double* f, double h, double* x1, double* v1) {
+  const NodePass p{3L * model.num_nodes(),
+                   model.damping().alpha,
+                   h,
+                   model.dof_mass().data(),
+                   model.dof_inverse_mass().data(),
+                   model.dof_free_mask().data(),
+                   model.loads().data(),
+                   x,
+                   v,
+                   f,
+                   x1,
                    v1};
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
   if (lanes::lane_isa() == lanes::LaneIsa::AVX2) return symplectic_euler_nodes_avx2<kEnergies>(p);
@@ -169,10 +183,11 @@ void ExplicitStepper::symplectic_euler(Model& model, const State& in, State& out
   fit(out, n);
   model.element_forces(in.x, in.v, m_a, extras.health, extras.elastic, extras.oriented);
   if (extras.energies)
-    *extras.energies =
-        symplectic_euler_nodes<true>(model, in.x.data(), in.v.data(), m_a.data(), h, out.x.data(), out.v.data());
+    *extras.energies = symplectic_euler_nodes<true>(model, in.x.data(), in.v.data(), m_a.data(), h,
+                                                    out.x.data(), out.v.data());
   else
-    symplectic_euler_nodes<false>(model, in.x.data(), in.v.data(), m_a.data(), h, out.x.data(), out.v.data());
+    symplectic_euler_nodes<false>(model, in.x.data(), in.v.data(), m_a.data(), h, out.x.data(),
+                                  out.v.data());
 }
 
 void ExplicitStepper::rk4(Model& model, State& s, double h) {
@@ -181,13 +196,15 @@ void ExplicitStepper::rk4(Model& model, State& s, double h) {
   s.v.swap(m_out.v);
 }
 
-void ExplicitStepper::rk4(Model& model, const State& in, State& out, double h, ElementHealth* start_health) {
+void ExplicitStepper::rk4(Model& model, const State& in, State& out, double h,
+                          ElementHealth* start_health) {
   StepExtras extras;
   extras.health = start_health;
   rk4(model, in, out, h, extras);
 }
 
-void ExplicitStepper::rk4(Model& model, const State& in, State& out, double h, const StepExtras& extras) {
+void ExplicitStepper::rk4(Model& model, const State& in, State& out, double h,
+                          const StepExtras& extras) {
   assert(&in != &out);
   const int n = model.num_nodes();
   resize(n);

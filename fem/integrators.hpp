@@ -65,11 +65,14 @@ class ExplicitStepper {
   /// v1, x1 and the extras' energies of the input (bitwise the state of
   /// Model::acceleration followed by the update formula).
   void symplectic_euler(Model& model, State& s, double h);
-  void symplectic_euler(Model& model, const State& in, State& out, double h, ElementHealth* start_health = nullptr);
-  void symplectic_euler(Model& model, const State& in, State& out, double h, const StepExtras& extras);
+  void symplectic_euler(Model& model, const State& in, State& out, double h,
+                        ElementHealth* start_health = nullptr);
+  void symplectic_euler(Model& model, const State& in, State& out, double h,
+                        const StepExtras& extras);
   /// One classical RK4 step of size h on y = (x, v), y' = (v, a(x, v)): four evaluations.
   void rk4(Model& model, State& s, double h);
-  void rk4(Model& model, const State& in, State& out, double h, ElementHealth* start_health = nullptr);
+  void rk4(Model& model, const State& in, State& out, double h,
+           ElementHealth* start_health = nullptr);
   void rk4(Model& model, const State& in, State& out, double h, const StepExtras& extras);
 
  private:

@@ -61,7 +61,8 @@ struct LaneHealth {
     }
   }
   // A full block of 8 elements starting at e0: no per-lane condition.
-  [[gnu::always_inline]] void add_full(int e0, const double* volume, const double* psi, const double* det) {
+  [[gnu::always_inline]] void add_full(int e0, const double* volume, const double* psi,
+                                       const double* det) {
     const double b = static_cast<double>(e0);
     for (int k = 0; k < kVectors; ++k) {
       Vec2 v, p, d;
@@ -91,7 +92,8 @@ struct LaneHealth {
     for (int l = 0; l < kLanes; ++l) {
       const double lane_min = min[l / 2][l % 2], lane_arg = arg[l / 2][l % 2];
       h.energy += sum[l / 2][l % 2];
-      if (lane_arg >= 0 && (lane_min < h.min_det || (lane_min == h.min_det && lane_arg < h.min_element))) {
+      if (lane_arg >= 0 &&
+          (lane_min < h.min_det || (lane_min == h.min_det && lane_arg < h.min_element))) {
         h.min_det = lane_min;
         h.min_element = static_cast<int>(lane_arg);
       }
@@ -142,13 +144,18 @@ template <MaterialModel kModel, LaneCheck kCheck>
     const Block& block = in.blocks[e0 / kLanes];
     double out[kLanes][12];
     double psi[kLanes], det[kLanes];
-    block_forces<kModel, kCheck>(in.x, in.tets + 4 * e0, count, block, in.mu, in.lambda, out, psi, det);
+    block_forces<kModel, kCheck>(in.x, in.tets + 4 * e0, count, block, in.mu, in.lambda, out, psi,
+                                 det);
     if constexpr (kCheck == LaneCheck::Full) {
-      if (count == kLanes) lane_health.add_full(e0, block.volume, psi, det);
-      else lane_health.add_partial(e0, count, block.volume, psi, det);
+      if (count == kLanes)
+        lane_health.add_full(e0, block.volume, psi, det);
+      else
+        lane_health.add_partial(e0, count, block.volume, psi, det);
     } else if constexpr (kCheck == LaneCheck::Orientation) {
-      if (count == kLanes) lane_orientation.add_full(det);
-      else lane_orientation.add_partial(count, det);
+      if (count == kLanes)
+        lane_orientation.add_full(det);
+      else
+        lane_orientation.add_partial(count, det);
     }
     for (int l = 0; l < count; ++l) scatter(in, e0 + l, out[l]);
   }
@@ -218,11 +225,13 @@ void differential_range(const LaneLoopInput& in, const double* dx, int begin, in
   differential_baseline<kModel>(in, dx, begin, end);
 }
 
-#define ICD_FEM_LANE_INSTANTIATE(M)                                                                           \
-  template void force_range<MaterialModel::M, LaneCheck::None>(const LaneLoopInput&, int, int, LaneRangeHealth*); \
-  template void force_range<MaterialModel::M, LaneCheck::Full>(const LaneLoopInput&, int, int, LaneRangeHealth*); \
-  template void force_range<MaterialModel::M, LaneCheck::Orientation>(const LaneLoopInput&, int, int,             \
-                                                                       LaneRangeHealth*);                         \
+#define ICD_FEM_LANE_INSTANTIATE(M)                                                              \
+  template void force_range<MaterialModel::M, LaneCheck::None>(const LaneLoopInput&, int, int,   \
+                                                               LaneRangeHealth*);                \
+  template void force_range<MaterialModel::M, LaneCheck::Full>(const LaneLoopInput&, int, int,   \
+                                                               LaneRangeHealth*);                \
+  template void force_range<MaterialModel::M, LaneCheck::Orientation>(const LaneLoopInput&, int, \
+                                                                      int, LaneRangeHealth*);    \
   template void differential_range<MaterialModel::M>(const LaneLoopInput&, const double*, int, int);
 ICD_FEM_LANE_INSTANTIATE(Linear)
 ICD_FEM_LANE_INSTANTIATE(StVK)

@@ -9,10 +9,14 @@ namespace icd::fem {
 
 const char* to_string(MaterialModel model) {
   switch (model) {
-    case MaterialModel::Linear: return "linear";
-    case MaterialModel::Corotational: return "corotational";
-    case MaterialModel::StVK: return "stvk";
-    case MaterialModel::StableNeoHookean: return "stable_neo_hookean";
+    case MaterialModel::Linear:
+      return "linear";
+    case MaterialModel::Corotational:
+      return "corotational";
+    case MaterialModel::StVK:
+      return "stvk";
+    case MaterialModel::StableNeoHookean:
+      return "stable_neo_hookean";
   }
   return "unknown";
 }

@@ -57,7 +57,8 @@ void Model::update_dofs() {
 void Model::update_load() {
   m_load.resize(num_nodes(), 3);
   for (int i = 0; i < num_nodes(); ++i)
-    for (int c = 0; c < 3; ++c) m_load(i, c) = m_fixed[i] ? 0.0 : m_external(i, c) + m_mass[i] * m_gravity[c];
+    for (int c = 0; c < 3; ++c)
+      m_load(i, c) = m_fixed[i] ? 0.0 : m_external(i, c) + m_mass[i] * m_gravity[c];
 }
 
 std::vector<char> Model::fixed_dofs() const {
@@ -108,12 +109,14 @@ void Model::total_force(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<cons
       continue;
     }
     const double m = m_mass[i];
-    for (int c = 0; c < 3; ++c) f(i, c) += m_external(i, c) + m * (m_gravity[c] - m_damping.alpha * v(i, c));
+    for (int c = 0; c < 3; ++c)
+      f(i, c) += m_external(i, c) + m * (m_gravity[c] - m_damping.alpha * v(i, c));
   }
 }
 
 void Model::element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                           Eigen::Ref<MatX3d> f, ElementHealth* health, const MatX3d* elastic, bool* oriented) {
+                           Eigen::Ref<MatX3d> f, ElementHealth* health, const MatX3d* elastic,
+                           bool* oriented) {
   if (elastic) {
     assert(!health && !oriented && elastic->rows() == num_nodes());
     f = *elastic;
@@ -133,7 +136,8 @@ void Model::element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<c
 }
 
 void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                         Eigen::Ref<MatX3d> a, ElementHealth* health, const MatX3d* elastic, bool* oriented) {
+                         Eigen::Ref<MatX3d> a, ElementHealth* health, const MatX3d* elastic,
+                         bool* oriented) {
   element_forces(x, v, a, health, elastic, oriented);
   const int n = num_nodes();
   const double alpha = m_damping.alpha;
@@ -147,8 +151,7 @@ void Model::acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<con
       ai[0] = ai[1] = ai[2] = 0.0;
       continue;
     }
-    for (int c = 0; c < 3; ++c)
-      ai[c] = w * (ai[c] + load[3 * i + c] - m * alpha * vp[vs * i + c]);
+    for (int c = 0; c < 3; ++c) ai[c] = w * (ai[c] + load[3 * i + c] - m * alpha * vp[vs * i + c]);
   }
 }
 

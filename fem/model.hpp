@@ -74,8 +74,8 @@ class Model {
   /// elastic (optional): f_int(x) already computed, see element_forces().
   /// oriented (optional): see element_forces().
   void acceleration(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                    Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr,
-                    bool* oriented = nullptr);
+                    Eigen::Ref<MatX3d> a, ElementHealth* health = nullptr,
+                    const MatX3d* elastic = nullptr, bool* oriented = nullptr);
   /// The element part of total_force (#V x 3, N, overwritten): f_int(x) - beta
   /// K(x) v + the strain-rate damping force, at every node (fixed ones
   /// included); the nodal part, loads() - alpha m v at free nodes, is left to
@@ -86,8 +86,8 @@ class Model {
   /// x is > 0, from the same element pass
   /// (ElasticForces::compute_with_orientation_check).
   void element_forces(const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                      Eigen::Ref<MatX3d> f, ElementHealth* health = nullptr, const MatX3d* elastic = nullptr,
-                      bool* oriented = nullptr);
+                      Eigen::Ref<MatX3d> f, ElementHealth* health = nullptr,
+                      const MatX3d* elastic = nullptr, bool* oriented = nullptr);
   /// Conservative nodal loads f_ext + m g at free nodes, 0 at fixed ones (#V x 3), N.
   const MatX3d& loads() const { return m_load; }
   /// 1 / lumped mass per node (#V), 1/kg.
@@ -112,7 +112,7 @@ class Model {
   Eigen::VectorXd m_inv_mass;  ///< 1/m (#V)
   std::vector<char> m_fixed;
   Eigen::VectorXd m_dof_mass, m_dof_inv_mass;  ///< 3#V each
-  std::vector<std::uint64_t> m_dof_free;      ///< 3#V
+  std::vector<std::uint64_t> m_dof_free;       ///< 3#V
   void update_load();
   void update_dofs();
   MatX3d m_external;

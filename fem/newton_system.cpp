@@ -20,8 +20,9 @@ double solve_with_shift(CholmodSolver& solver, const Eigen::SparseMatrix<double>
       return s * dmax;
     }
   }
-  throw NumericalError("fem Newton solver: tangent matrix is not positive definite even with a diagonal shift of " +
-                       std::to_string(dmax) + " (the largest diagonal entry)");
+  throw NumericalError(
+      "fem Newton solver: tangent matrix is not positive definite even with a diagonal shift of " +
+      std::to_string(dmax) + " (the largest diagonal entry)");
 }
 
 }  // namespace icd::fem

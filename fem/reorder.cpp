@@ -12,7 +12,8 @@ namespace {
 // BFS levels from `start` over unvisited-in-component nodes; returns the order
 // and writes the last level's minimum-degree node into `far`.
 std::vector<int> bfs(int start, const std::vector<int>& off, const std::vector<int>& adj,
-                     const std::vector<int>& degree, std::vector<char>& mark, int& far, int& depth) {
+                     const std::vector<int>& degree, std::vector<char>& mark, int& far,
+                     int& depth) {
   std::vector<int> order{start};
   mark[start] = 1;
   size_t level_begin = 0;
@@ -44,13 +45,15 @@ std::vector<int> bfs(int start, const std::vector<int>& off, const std::vector<i
 
 }  // namespace
 
-ReorderedMesh reorder_for_locality(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX4i>& T) {
+ReorderedMesh reorder_for_locality(const Eigen::Ref<const MatX3d>& V,
+                                   const Eigen::Ref<const MatX4i>& T) {
   const int nv = static_cast<int>(V.rows()), nt = static_cast<int>(T.rows());
   for (int e = 0; e < nt; ++e)
     for (int a = 0; a < 4; ++a)
       if (T(e, a) < 0 || T(e, a) >= nv)
-        throw InputError("fem::reorder_for_locality: tet " + std::to_string(e) + " vertex " + std::to_string(a) +
-                         " = " + std::to_string(T(e, a)) + " is out of range [0, " + std::to_string(nv) + ")");
+        throw InputError("fem::reorder_for_locality: tet " + std::to_string(e) + " vertex " +
+                         std::to_string(a) + " = " + std::to_string(T(e, a)) +
+                         " is out of range [0, " + std::to_string(nv) + ")");
   // Node graph (CSR, unique neighbours).
   std::vector<std::vector<int>> lists(nv);
   for (int e = 0; e < nt; ++e)

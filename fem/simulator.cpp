@@ -17,9 +17,12 @@ Simulator::Simulator(Model model, const SimulatorOptions& options)
     os << "fem::SimulatorOptions." << field << " = " << value << " is invalid: expected " << range;
     throw ParameterError(os.str());
   };
-  if (!(options.safety_factor > 0 && options.safety_factor <= 1)) bad("safety_factor", options.safety_factor, "(0, 1]");
-  if (!(options.fixed_step >= 0) || !std::isfinite(options.fixed_step)) bad("fixed_step", options.fixed_step, ">= 0 s");
-  if (!(options.max_step > 0) || !std::isfinite(options.max_step)) bad("max_step", options.max_step, "> 0 s");
+  if (!(options.safety_factor > 0 && options.safety_factor <= 1))
+    bad("safety_factor", options.safety_factor, "(0, 1]");
+  if (!(options.fixed_step >= 0) || !std::isfinite(options.fixed_step))
+    bad("fixed_step", options.fixed_step, ">= 0 s");
+  if (!(options.max_step > 0) || !std::isfinite(options.max_step))
+    bad("max_step", options.max_step, "> 0 s");
   if (options.frequency_refresh_iterations < 1)
     bad("frequency_refresh_iterations", options.frequency_refresh_iterations, ">= 1");
   if (options.check_interval < 1) bad("check_interval", options.check_interval, ">= 1");
@@ -54,16 +57,19 @@ void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
 }
 
 double Simulator::stable_step_limit() {
-  if (m_options.integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
+  if (m_options.integrator == Integrator::BackwardEuler)
+    return std::numeric_limits<double>::infinity();
   // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time).
-  const bool fresh = m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
+  const bool fresh =
+      m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
   m_last_products = 0;
   if (fresh) return m_cached_limit;
   FrequencyOptions fo = m_options.frequency;
   if (m_warm_mode.size() == 3 * m_model.num_nodes()) {
     fo.max_iterations = std::min(fo.max_iterations, m_options.frequency_refresh_iterations);
     fo.tolerance = std::max(fo.tolerance, m_options.frequency_refresh_tolerance);
-    fo.finite_difference_products = fo.finite_difference_products || m_options.frequency_refresh_finite_differences;
+    fo.finite_difference_products =
+        fo.finite_difference_products || m_options.frequency_refresh_finite_differences;
   }
   m_frequency = estimate_max_frequency(m_model, m_state.x, fo, &m_warm_mode,
                                        m_end_force_valid ? &m_end_force : nullptr);
@@ -81,8 +87,8 @@ double Simulator::stable_step_limit() {
   m_estimate_time = m_time;
   m_cached_limit = m_frequency.omega_bound <= 0  // all fixed
                        ? std::numeric_limits<double>::infinity()
-                       : fem::stable_step_limit(m_options.integrator, m_frequency.omega_bound, m_model.damping(),
-                                                m_damping_rate);
+                       : fem::stable_step_limit(m_options.integrator, m_frequency.omega_bound,
+                                                m_model.damping(), m_damping_rate);
   return m_cached_limit;
 }
 
@@ -94,26 +100,33 @@ double Simulator::total_energy() {
 void Simulator::refuse_if_above_limit(double h, double limit, const char* what) const {
   if (h <= limit) return;
   std::ostringstream os;
-  os << "fem::Simulator: " << what << " " << h << " s exceeds the stable step limit " << limit << " s of "
-     << to_string(m_options.integrator) << " for the current state (largest eigenfrequency "
-     << m_frequency.omega_bound << " rad/s, Rayleigh alpha " << m_model.damping().alpha << ", beta "
-     << m_model.damping().beta << ", strain-rate damping rate up to " << m_damping_rate << " 1/s, contact stiffness " << m_options.frequency.contact_stiffness
-     << " N/m); use a step <= " << limit << " s or automatic stepping (fixed_step = 0)";
+  os << "fem::Simulator: " << what << " " << h << " s exceeds the stable step limit " << limit
+     << " s of " << to_string(m_options.integrator)
+     << " for the current state (largest eigenfrequency " << m_frequency.omega_bound
+     << " rad/s, Rayleigh alpha " << m_model.damping().alpha << ", beta " << m_model.damping().beta
+     << ", strain-rate damping rate up to " << m_damping_rate << " 1/s, contact stiffness "
+     << m_options.frequency.contact_stiffness << " N/m); use a step <= " << limit
+     << " s or automatic stepping (fixed_step = 0)";
   throw ParameterError(os.str());
 }
 
 std::string Simulator::integrate(double h, const StepExtras& extras) {
   switch (m_options.integrator) {
-    case Integrator::RK4: m_explicit.rk4(m_model, m_state, m_next, h, extras); break;
-    case Integrator::SymplecticEuler: m_explicit.symplectic_euler(m_model, m_state, m_next, h, extras); break;
+    case Integrator::RK4:
+      m_explicit.rk4(m_model, m_state, m_next, h, extras);
+      break;
+    case Integrator::SymplecticEuler:
+      m_explicit.symplectic_euler(m_model, m_state, m_next, h, extras);
+      break;
     case Integrator::BackwardEuler: {
       assert(!extras.health && !extras.energies && !extras.elastic);
       m_next = m_state;
       const NewtonReport rep = m_implicit.step(m_model, m_next, h, m_options.newton);
       if (!rep.converged) {
         std::ostringstream os;
-        os << "backward Euler Newton did not converge in " << rep.iterations << " iterations: residual "
-           << rep.residual << " N s, reference " << rep.reference << " N s";
+        os << "backward Euler Newton did not converge in " << rep.iterations
+           << " iterations: residual " << rep.residual << " N s, reference " << rep.reference
+           << " N s";
         return os.str();
       }
       break;
@@ -129,7 +142,8 @@ Simulator::Check Simulator::nonfinite_state(const State& s) const {
   for (int i = 0; i < n; ++i)
     if (!s.x.row(i).allFinite() || !s.v.row(i).allFinite()) {
       std::ostringstream os;
-      os << "node " << i << " has a non-finite state: x = (" << s.x.row(i) << "), v = (" << s.v.row(i) << ")";
+      os << "node " << i << " has a non-finite state: x = (" << s.x.row(i) << "), v = ("
+         << s.v.row(i) << ")";
       c.message = os.str();
       return c;
     }
@@ -138,15 +152,18 @@ Simulator::Check Simulator::nonfinite_state(const State& s) const {
 }
 
 bool Simulator::bound_checks() const {
-  if (m_options.integrator == Integrator::BackwardEuler || m_options.energy_check == EnergyCheck::Full) return false;
+  if (m_options.integrator == Integrator::BackwardEuler ||
+      m_options.energy_check == EnergyCheck::Full)
+    return false;
   const MaterialModel mm = m_model.material().model;
   const bool nonnegative_energy =
       mm == MaterialModel::Linear || mm == MaterialModel::Corotational || mm == MaterialModel::StVK;
-  return nonnegative_energy && m_options.inversion != InversionPolicy::Allow;  // Auto: inversion checked for these
+  return nonnegative_energy &&
+         m_options.inversion != InversionPolicy::Allow;  // Auto: inversion checked for these
 }
 
-Simulator::Check Simulator::evaluate_bound(const Check& before, const State& s, const StateEnergies& energies,
-                                           bool oriented) {
+Simulator::Check Simulator::evaluate_bound(const Check& before, const State& s,
+                                           const StateEnergies& energies, bool oriented) {
   // Every entry of x and v enters the energy sums (0 * NaN = NaN): finite sums, finite state.
   if (!std::isfinite(energies.kinetic) || !std::isfinite(energies.load)) return nonfinite_state(s);
   Check c;
@@ -183,20 +200,21 @@ Simulator::Check Simulator::evaluate_bound(const Check& before, const State& s, 
 }
 
 double Simulator::allowed_growth(const Check& before, double load) const {
-  return m_options.max_energy_growth * (before.kinetic + before.elastic + std::abs(load - before.load)) +
+  return m_options.max_energy_growth *
+             (before.kinetic + before.elastic + std::abs(load - before.load)) +
          m_energy_floor;
 }
 
-Simulator::Check Simulator::evaluate(const Check& before, const State& s, const StateEnergies& energies,
-                                     const ElementHealth& h) const {
+Simulator::Check Simulator::evaluate(const Check& before, const State& s,
+                                     const StateEnergies& energies, const ElementHealth& h) const {
   Check c;
   c.kinetic = energies.kinetic;
   c.load = energies.load;
   // Every entry of x and v enters these sums (0 * NaN = NaN): finite sums, finite state.
   if (!std::isfinite(c.kinetic) || !std::isfinite(c.load)) return nonfinite_state(s);
-  const bool allow_inversion =
-      m_options.inversion == InversionPolicy::Allow ||
-      (m_options.inversion == InversionPolicy::Auto && m_model.material().model == MaterialModel::StableNeoHookean);
+  const bool allow_inversion = m_options.inversion == InversionPolicy::Allow ||
+                               (m_options.inversion == InversionPolicy::Auto &&
+                                m_model.material().model == MaterialModel::StableNeoHookean);
   if (h.first_nonfinite_element >= 0 || (!allow_inversion && h.min_det_f <= 0)) {
     const int e = h.first_nonfinite_element >= 0 ? h.first_nonfinite_element : h.min_det_f_element;
     std::ostringstream os;
@@ -208,13 +226,14 @@ Simulator::Check Simulator::evaluate(const Check& before, const State& s, const 
     return c;
   }
   c.elastic = h.energy;
-  const double growth = (c.kinetic + c.elastic) - (before.kinetic + before.elastic) + (c.load - before.load);
+  const double growth =
+      (c.kinetic + c.elastic) - (before.kinetic + before.elastic) + (c.load - before.load);
   const double allowed = allowed_growth(before, c.load);
   if (!(growth <= allowed)) {
     std::ostringstream os;
     os << "total energy grew by " << growth << " J (allowed " << allowed << " J): kinetic "
-       << before.kinetic << " -> " << c.kinetic << " J, elastic " << before.elastic << " -> " << c.elastic
-       << " J, load potential " << before.load << " -> " << c.load << " J";
+       << before.kinetic << " -> " << c.kinetic << " J, elastic " << before.elastic << " -> "
+       << c.elastic << " J, load potential " << before.load << " -> " << c.load << " J";
     c.ok = false;
     c.message = os.str();
   }
@@ -270,9 +289,9 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
   auto reject = [&](const Check& c) {
     if (rep.retries >= m_options.max_retries) {
       std::ostringstream os;
-      os << "fem::Simulator: " << to_string(m_options.integrator) << " failed the health check after "
-         << rep.retries << " retries at t = " << m_time + t << " s (step reduced from " << h0 << " to " << hh
-         << " s): " << c.message;
+      os << "fem::Simulator: " << to_string(m_options.integrator)
+         << " failed the health check after " << rep.retries << " retries at t = " << m_time + t
+         << " s (step reduced from " << h0 << " to " << hh << " s): " << c.message;
       m_state = m_good;
       m_time += t_good;
       throw NumericalError(os.str());
@@ -319,8 +338,10 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
     const bool check_now = pending;
     StepExtras extras;
     if (check_now) {
-      if (bound) extras.oriented = &oriented;
-      else extras.health = &health;
+      if (bound)
+        extras.oriented = &oriented;
+      else
+        extras.health = &health;
       extras.energies = &energies;
     } else if (start_force) {
       extras.elastic = start_force;  // only at the call's start state, never due a check
@@ -367,7 +388,8 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
 
 AdvanceReport Simulator::advance(double frame_dt) {
   if (!(frame_dt > 0) || !std::isfinite(frame_dt))
-    throw ParameterError("fem::Simulator::advance: frame_dt = " + std::to_string(frame_dt) + " must be > 0");
+    throw ParameterError("fem::Simulator::advance: frame_dt = " + std::to_string(frame_dt) +
+                         " must be > 0");
   AdvanceReport rep;
   rep.step_limit = stable_step_limit();
   rep.omega_max = m_frequency.omega_bound;

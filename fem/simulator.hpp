@@ -12,7 +12,7 @@ namespace icd::fem {
 
 /// Whether an inverted element (det F <= 0) fails the health check.
 enum class InversionPolicy {
-  Auto,   ///< allowed only for the inversion-safe StableNeoHookean model
+  Auto,  ///< allowed only for the inversion-safe StableNeoHookean model
   Allow,
   Fail
 };
@@ -88,8 +88,8 @@ struct SimulatorOptions {
   /// taken as Full where it is not sound.
   EnergyCheck energy_check = EnergyCheck::Auto;
   InversionPolicy inversion = InversionPolicy::Auto;
-  int max_retries = 6;  ///< halvings of the step before giving up
-  NewtonOptions newton; ///< backward Euler
+  int max_retries = 6;   ///< halvings of the step before giving up
+  NewtonOptions newton;  ///< backward Euler
 };
 
 /// What advance() did.
@@ -98,7 +98,8 @@ struct AdvanceReport {
   int retries = 0;        ///< rollbacks
   double step = 0;        ///< last sub-step used, s
   double step_limit = 0;  ///< stable limit at the start of the frame, s (inf for backward Euler)
-  double omega_max = 0;   ///< largest eigenfrequency bound at the start (FrequencyEstimate::omega_bound), rad/s
+  double omega_max =
+      0;  ///< largest eigenfrequency bound at the start (FrequencyEstimate::omega_bound), rad/s
   /// Lanczos products spent on that bound in this call (0: reused, see
   /// frequency_reuse_time), rate of the strain-rate damping excluded.
   int frequency_products = 0;
@@ -148,11 +149,13 @@ class Simulator {
   };
   /// Health check of state s with its energies and the element health h of
   /// s.x, against the last accepted check.
-  Check evaluate(const Check& before, const State& s, const StateEnergies& energies, const ElementHealth& h) const;
+  Check evaluate(const Check& before, const State& s, const StateEnergies& energies,
+                 const ElementHealth& h) const;
   /// The EnergyCheck::Bound check of state s (energies and the orientation
   /// test of s.x) against the last full check; names the element by a
   /// separate health pass when the orientation test fails.
-  Check evaluate_bound(const Check& before, const State& s, const StateEnergies& energies, bool oriented);
+  Check evaluate_bound(const Check& before, const State& s, const StateEnergies& energies,
+                       bool oriented);
   /// Whether the checks inside a frame use EnergyCheck::Bound.
   bool bound_checks() const;
   /// The total-energy growth a step may show over the accepted check before
@@ -179,10 +182,10 @@ class Simulator {
   Eigen::VectorXd m_warm_mode, m_warm_damping;
   double m_damping_rate = 0;  ///< estimate_max_damping_rate() of the last estimate, 1/s
   double m_energy_floor = 0;
-  double m_estimate_time = -1;  ///< simulated time of the last frequency estimate (-1: none)
-  double m_cached_limit = 0;    ///< stable step limit of that estimate, s
-  int m_last_products = 0;      ///< Lanczos products of the last stable_step_limit()
-  bool m_checked_valid = false; ///< m_checked_elastic is the elastic energy of m_state
+  double m_estimate_time = -1;   ///< simulated time of the last frequency estimate (-1: none)
+  double m_cached_limit = 0;     ///< stable step limit of that estimate, s
+  int m_last_products = 0;       ///< Lanczos products of the last stable_step_limit()
+  bool m_checked_valid = false;  ///< m_checked_elastic is the elastic energy of m_state
   double m_checked_elastic = 0;
   /// f_int(m_state.x) from the health check that ended the last run()
   /// (explicit integrators): the next frame's estimate and first step use it

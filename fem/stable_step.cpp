@@ -52,8 +52,8 @@ double stable_step_limit(Integrator integrator, double omega_max, const Rayleigh
     throw ParameterError("fem::stable_step_limit: omega_max = " + std::to_string(omega_max) +
                          " must be finite and > 0");
   if (!(max_damping_rate >= 0) || !std::isfinite(max_damping_rate))
-    throw ParameterError("fem::stable_step_limit: max_damping_rate = " + std::to_string(max_damping_rate) +
-                         " must be finite and >= 0");
+    throw ParameterError("fem::stable_step_limit: max_damping_rate = " +
+                         std::to_string(max_damping_rate) + " must be finite and >= 0");
   if (integrator == Integrator::BackwardEuler) return std::numeric_limits<double>::infinity();
   double limit = std::numeric_limits<double>::infinity();
   // Extra modal damping in [0, max_damping_rate]: 9 levels (0 and the maximum included).
@@ -61,7 +61,8 @@ double stable_step_limit(Integrator integrator, double omega_max, const Rayleigh
   for (int k = 0; k <= 96; ++k) {  // omega_max * 10^(-6 .. 0)
     const double omega = omega_max * std::pow(10.0, -6.0 * (96 - k) / 96.0);
     for (int j = 0; j <= levels; ++j) {
-      const double c = damping.alpha + damping.beta * omega * omega + (levels ? max_damping_rate * j / levels : 0.0);
+      const double c = damping.alpha + damping.beta * omega * omega +
+                       (levels ? max_damping_rate * j / levels : 0.0);
       const double h = integrator == Integrator::RK4 ? rk4_mode_limit(omega, c)
                                                      : symplectic_euler_mode_limit(omega, c);
       limit = std::min(limit, h);
@@ -75,8 +76,9 @@ namespace {
 // Top eigenpair of a symmetric operator on the free dofs by Lanczos with full
 // reorthogonalisation; apply(q, out) computes out = A q for A = M^-1/2 B M^-1/2.
 template <class Apply>
-FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free, const FrequencyOptions& options,
-                              Eigen::VectorXd* warm, double* theta_out) {
+FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free,
+                              const FrequencyOptions& options, Eigen::VectorXd* warm,
+                              double* theta_out) {
   const int ndof = static_cast<int>(free.size());
   const int nfree = static_cast<int>(free.sum());
   FrequencyEstimate est;
@@ -138,8 +140,9 @@ FrequencyEstimate lanczos_top(Apply&& apply, const Eigen::VectorXd& free, const 
 void check_options(const FrequencyOptions& options) {
   if (options.max_iterations < 1 || !(options.contact_stiffness >= 0) || !(options.tolerance > 0) ||
       options.warm_modes < 1)
-    throw ParameterError("fem::FrequencyOptions: expected max_iterations >= 1, tolerance > 0, "
-                         "contact_stiffness >= 0 and warm_modes >= 1");
+    throw ParameterError(
+        "fem::FrequencyOptions: expected max_iterations >= 1, tolerance > 0, "
+        "contact_stiffness >= 0 and warm_modes >= 1");
 }
 
 // Free-dof mask and M^-1/2 per dof.
@@ -172,7 +175,8 @@ FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const Ma
     xe.resize(n, 3);
     if (forces_at_x) {
       if (forces_at_x->rows() != n)
-        throw ParameterError("fem::estimate_max_frequency: forces_at_x has " + std::to_string(forces_at_x->rows()) +
+        throw ParameterError("fem::estimate_max_frequency: forces_at_x has " +
+                             std::to_string(forces_at_x->rows()) +
                              " rows, expected #V = " + std::to_string(n));
       f0 = *forces_at_x;
     } else {
@@ -200,14 +204,15 @@ FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const Ma
   double theta = 0;
   FrequencyEstimate est = lanczos_top(apply, free, options, warm, &theta);
   if (!std::isfinite(theta))
-    throw NumericalError("fem::estimate_max_frequency: the stiffness of the current state is not finite");
+    throw NumericalError(
+        "fem::estimate_max_frequency: the stiffness of the current state is not finite");
   est.omega_max = std::sqrt(std::max(theta, 0.0));
   est.omega_bound = est.omega_max * std::sqrt(1.0 + est.residual);
   return est;
 }
 
-double estimate_max_damping_rate(Model& model, const Eigen::Ref<const MatX3d>& x, const FrequencyOptions& options,
-                                 Eigen::VectorXd* warm) {
+double estimate_max_damping_rate(Model& model, const Eigen::Ref<const MatX3d>& x,
+                                 const FrequencyOptions& options, Eigen::VectorXd* warm) {
   check_options(options);
   if (!model.strain_rate_damping().enabled()) return 0;
   const int n = model.num_nodes();
@@ -219,12 +224,14 @@ double estimate_max_damping_rate(Model& model, const Eigen::Ref<const MatX3d>& x
     Eigen::Map<Eigen::VectorXd>(u.data(), ndof) = inv_sqrt_m.cwiseProduct(q).cwiseProduct(free);
     fd.setZero();
     add_strain_rate_damping_forces(model.mesh(), model.strain_rate_damping(), x, u, fd);  // -D u
-    out = (-inv_sqrt_m.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(fd.data(), ndof))).cwiseProduct(free);
+    out = (-inv_sqrt_m.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(fd.data(), ndof)))
+              .cwiseProduct(free);
   };
   double theta = 0;
   const FrequencyEstimate est = lanczos_top(apply, free, options, warm, &theta);
   if (!std::isfinite(theta))
-    throw NumericalError("fem::estimate_max_damping_rate: the damping matrix of the current state is not finite");
+    throw NumericalError(
+        "fem::estimate_max_damping_rate: the damping matrix of the current state is not finite");
   return std::max(theta, 0.0) * (1.0 + est.residual);
 }
 

@@ -9,8 +9,8 @@ namespace icd::fem {
 
 /// Options of the largest-eigenfrequency estimate.
 struct FrequencyOptions {
-  int max_iterations = 60;   ///< Lanczos iterations (>= 1)
-  double tolerance = 1e-5;   ///< stop when the Ritz residual <= tolerance * Ritz value
+  int max_iterations = 60;  ///< Lanczos iterations (>= 1)
+  double tolerance = 1e-5;  ///< stop when the Ritz residual <= tolerance * Ritz value
   /// Extra stiffness per node dof (N/m) that contact adds on top of K(x); the
   /// coupling layer sets it to its penalty stiffness. >= 0.
   double contact_stiffness = 0;
@@ -37,7 +37,7 @@ struct FrequencyEstimate {
   double omega_max = 0;  ///< largest circular eigenfrequency sqrt(lambda_max(M^-1 K)), rad/s
   int iterations = 0;    ///< Lanczos iterations used
   bool converged = false;
-  double residual = 0;   ///< Ritz residual / Ritz value at exit
+  double residual = 0;  ///< Ritz residual / Ritz value at exit
   /// sqrt(theta + |r|) = omega_max sqrt(1 + residual), rad/s: the Ritz value
   /// theta is a lower bound of lambda_max and some eigenvalue lies within the
   /// residual norm |r| of it, so this bounds omega_max from above once the
@@ -57,7 +57,8 @@ struct FrequencyEstimate {
 /// forces_at_x (optional): f_int(x) (#V x 3, N) already computed, used as the
 /// base point of the forward-difference products instead of evaluating it.
 FrequencyEstimate estimate_max_frequency(Model& model, const Eigen::Ref<const MatX3d>& x,
-                                         const FrequencyOptions& options, Eigen::VectorXd* warm = nullptr,
+                                         const FrequencyOptions& options,
+                                         Eigen::VectorXd* warm = nullptr,
                                          const MatX3d* forces_at_x = nullptr);
 
 /// Largest stable step (s) of an integrator for modes with circular frequency
@@ -81,7 +82,7 @@ double stable_step_limit(Integrator integrator, double omega_max, const Rayleigh
 /// forces at positions x: the largest modal damping rate. Lanczos as in
 /// estimate_max_frequency (options.contact_stiffness unused); returns the
 /// residual upper bound theta (1 + residual). 0 when the damping is off.
-double estimate_max_damping_rate(Model& model, const Eigen::Ref<const MatX3d>& x, const FrequencyOptions& options,
-                                 Eigen::VectorXd* warm = nullptr);
+double estimate_max_damping_rate(Model& model, const Eigen::Ref<const MatX3d>& x,
+                                 const FrequencyOptions& options, Eigen::VectorXd* warm = nullptr);
 
 }  // namespace icd::fem

@@ -18,11 +18,16 @@ NewtonReport StaticSolver::solve(Model& model, MatX3d& x, const NewtonOptions& o
   NewtonReport rep;
   for (int i = 0; i < n; ++i)
     if (!model.fixed_nodes()[i])
-      rep.reference += (model.external_forces().row(i) + model.mass()[i] * model.gravity().transpose()).squaredNorm();
+      rep.reference +=
+          (model.external_forces().row(i) + model.mass()[i] * model.gravity().transpose())
+              .squaredNorm();
   rep.reference = std::sqrt(rep.reference);
   const double size = (model.mesh().rest_positions.colwise().maxCoeff() -
-                       model.mesh().rest_positions.colwise().minCoeff()).norm();
-  auto potential = [&](const MatX3d& y) { return model.elastic().energy(y) + model.load_potential(y); };
+                       model.mesh().rest_positions.colwise().minCoeff())
+                          .norm();
+  auto potential = [&](const MatX3d& y) {
+    return model.elastic().energy(y) + model.load_potential(y);
+  };
 
   model.total_force(x, zero, g);
   double gn = flat(g).norm(), pot = potential(x);
@@ -34,7 +39,8 @@ NewtonReport StaticSolver::solve(Model& model, MatX3d& x, const NewtonOptions& o
     }
     m_A = model.elastic().stiffness(x);
     apply_dirichlet(m_A, fixed);
-    rep.max_shift = std::max(rep.max_shift, solve_with_shift(m_solver, m_A, m_shifted, flat(g), dx));
+    rep.max_shift =
+        std::max(rep.max_shift, solve_with_shift(m_solver, m_A, m_shifted, flat(g), dx));
     if (dx.cwiseAbs().maxCoeff() <= 1e-14 * size) {
       rep.converged = true;
       break;

@@ -48,7 +48,8 @@ StiffnessPattern::StiffnessPattern(int num_nodes, const Eigen::Ref<const MatX4i>
       for (int a = 0; a < 4; ++a) {
         const auto it = std::lower_bound(list.begin(), list.end(), tets(e, a));
         assert(it != list.end() && *it == tets(e, a));
-        m_block_offset[16 * e + 4 * b + a] = col_start[tets(e, b)] + 3 * static_cast<int>(it - list.begin());
+        m_block_offset[16 * e + 4 * b + a] =
+            col_start[tets(e, b)] + 3 * static_cast<int>(it - list.begin());
       }
     }
 }

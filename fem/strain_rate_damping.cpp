@@ -10,8 +10,8 @@ namespace icd::fem {
 namespace {
 
 // F, Fdot (row-major) of element e.
-inline void rates(const TetMeshData& mesh, const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                  int e, double* F, double* Fdot) {
+inline void rates(const TetMeshData& mesh, const Eigen::Ref<const MatX3d>& x,
+                  const Eigen::Ref<const MatX3d>& v, int e, double* F, double* Fdot) {
   const int* t = mesh.tets.data() + 4 * e;
   const double* D = mesh.dm_inv[e].data();
   double p[4][3], q[4][3];
@@ -28,8 +28,8 @@ inline void rates(const TetMeshData& mesh, const Eigen::Ref<const MatX3d>& x, co
 inline void strain_rate(const double* F, const double* Fdot, double* Edot) {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
-      Edot[3 * r + c] = 0.5 * (F[r] * Fdot[c] + F[3 + r] * Fdot[3 + c] + F[6 + r] * Fdot[6 + c] + Fdot[r] * F[c] +
-                               Fdot[3 + r] * F[3 + c] + Fdot[6 + r] * F[6 + c]);
+      Edot[3 * r + c] = 0.5 * (F[r] * Fdot[c] + F[3 + r] * Fdot[3 + c] + F[6 + r] * Fdot[6 + c] +
+                               Fdot[r] * F[c] + Fdot[3 + r] * F[3 + c] + Fdot[6 + r] * F[6 + c]);
 }
 
 // Nodal damping forces out[12] (nodes 0..3) of one element with F, Fdot,
@@ -44,7 +44,8 @@ inline void element_forces(const StrainRateDamping& damping, const double* F, co
   S[4] += t;
   S[8] += t;
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) P[3 * r + c] = F[3 * r] * S[c] + F[3 * r + 1] * S[3 + c] + F[3 * r + 2] * S[6 + c];
+    for (int c = 0; c < 3; ++c)
+      P[3 * r + c] = F[3 * r] * S[c] + F[3 * r + 1] * S[3 + c] + F[3 * r + 2] * S[6 + c];
   kernels::nodal_forces(P, dinv, volume, H);
   for (int r = 0; r < 3; ++r) {
     out[3 + r] = H[3 * r];
@@ -58,7 +59,8 @@ inline void element_forces(const StrainRateDamping& damping, const double* F, co
 
 void validate(const StrainRateDamping& damping) {
   auto bad = [](const char* field, double value) {
-    throw ParameterError(std::string("fem::StrainRateDamping.") + field + " = " + std::to_string(value) +
+    throw ParameterError(std::string("fem::StrainRateDamping.") + field + " = " +
+                         std::to_string(value) +
                          " is invalid: expected a finite value >= 0 (Pa s)");
   };
   if (!(damping.phi >= 0) || !std::isfinite(damping.phi)) bad("phi", damping.phi);
@@ -66,8 +68,8 @@ void validate(const StrainRateDamping& damping) {
 }
 
 void add_strain_rate_damping_forces(const TetMeshData& mesh, const StrainRateDamping& damping,
-                                    const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                                    Eigen::Ref<MatX3d> f) {
+                                    const Eigen::Ref<const MatX3d>& x,
+                                    const Eigen::Ref<const MatX3d>& v, Eigen::Ref<MatX3d> f) {
   if (x.rows() != mesh.num_nodes || v.rows() != mesh.num_nodes || f.rows() != mesh.num_nodes)
     throw ParameterError("fem::add_strain_rate_damping_forces: x, v and f must have #V = " +
                          std::to_string(mesh.num_nodes) + " rows");
@@ -83,8 +85,9 @@ void add_strain_rate_damping_forces(const TetMeshData& mesh, const StrainRateDam
 }
 
 void add_strain_rate_damping_matrix(const TetMeshData& mesh, const StiffnessPattern& pattern,
-                                    const StrainRateDamping& damping, const Eigen::Ref<const MatX3d>& x,
-                                    double scale, Eigen::SparseMatrix<double>& A) {
+                                    const StrainRateDamping& damping,
+                                    const Eigen::Ref<const MatX3d>& x, double scale,
+                                    Eigen::SparseMatrix<double>& A) {
   if (x.rows() != mesh.num_nodes || A.rows() != 3 * mesh.num_nodes || A.cols() != A.rows())
     throw ParameterError("fem::add_strain_rate_damping_matrix: expected x with #V = " +
                          std::to_string(mesh.num_nodes) + " rows and a 3#V x 3#V matrix");
@@ -98,7 +101,8 @@ void add_strain_rate_damping_matrix(const TetMeshData& mesh, const StiffnessPatt
     const Eigen::Matrix<double, 4, 3> G = mesh.shape_gradients(e);
     for (int b = 0; b < 4; ++b)
       for (int c = 0; c < 3; ++c) {
-        double Fdot[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};  // unit velocity of dof (b, c): row c of Fdot is grad N_b
+        double Fdot[9] = {0, 0, 0, 0, 0,
+                          0, 0, 0, 0};  // unit velocity of dof (b, c): row c of Fdot is grad N_b
         for (int k = 0; k < 3; ++k) Fdot[3 * c + k] = G(b, k);
         double col[12];
         element_forces(damping, F, Fdot, mesh.dm_inv[e].data(), mesh.rest_volume[e], col);
@@ -113,10 +117,11 @@ void add_strain_rate_damping_matrix(const TetMeshData& mesh, const StiffnessPatt
 }
 
 double strain_rate_dissipation(const TetMeshData& mesh, const StrainRateDamping& damping,
-                               const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v) {
+                               const Eigen::Ref<const MatX3d>& x,
+                               const Eigen::Ref<const MatX3d>& v) {
   if (x.rows() != mesh.num_nodes || v.rows() != mesh.num_nodes)
-    throw ParameterError("fem::strain_rate_dissipation: x and v must have #V = " + std::to_string(mesh.num_nodes) +
-                         " rows");
+    throw ParameterError("fem::strain_rate_dissipation: x and v must have #V = " +
+                         std::to_string(mesh.num_nodes) + " rows");
   double R = 0;
   for (int e = 0; e < mesh.num_tets(); ++e) {
     double F[9], Fdot[9], Edot[9];

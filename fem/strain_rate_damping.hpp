@@ -30,20 +30,22 @@ void validate(const StrainRateDamping& damping);
 /// dissipation function R(v) = 1/2 sum_e V_e (2 psi |Edot|^2 + phi tr(Edot)^2),
 /// f_d = -dR/dv. Sequential (deterministic).
 void add_strain_rate_damping_forces(const TetMeshData& mesh, const StrainRateDamping& damping,
-                                    const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v,
-                                    Eigen::Ref<MatX3d> f);
+                                    const Eigen::Ref<const MatX3d>& x,
+                                    const Eigen::Ref<const MatX3d>& v, Eigen::Ref<MatX3d> f);
 
 /// Adds scale x D(x) to A, D = -df_d/dv (3#V x 3#V, symmetric positive
 /// semi-definite, N s/m) the damping matrix at positions x, written in place
 /// into A's values; A must have the layout of `pattern` (e.g. a copy of
 /// ElasticForces::stiffness()). Backward Euler's Newton matrix uses it.
 void add_strain_rate_damping_matrix(const TetMeshData& mesh, const StiffnessPattern& pattern,
-                                    const StrainRateDamping& damping, const Eigen::Ref<const MatX3d>& x,
-                                    double scale, Eigen::SparseMatrix<double>& A);
+                                    const StrainRateDamping& damping,
+                                    const Eigen::Ref<const MatX3d>& x, double scale,
+                                    Eigen::SparseMatrix<double>& A);
 
 /// The Rayleigh dissipation function R(v) above, W (J/s): half the power the
 /// damping forces dissipate.
 double strain_rate_dissipation(const TetMeshData& mesh, const StrainRateDamping& damping,
-                               const Eigen::Ref<const MatX3d>& x, const Eigen::Ref<const MatX3d>& v);
+                               const Eigen::Ref<const MatX3d>& x,
+                               const Eigen::Ref<const MatX3d>& v);
 
 }  // namespace icd::fem

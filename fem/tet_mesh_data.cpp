@@ -26,13 +26,15 @@ TetMeshData make_tet_mesh_data(const Eigen::Ref<const MatX3d>& rest_positions,
                                const Eigen::Ref<const MatX4i>& tets) {
   const int nv = static_cast<int>(rest_positions.rows());
   const int nt = static_cast<int>(tets.rows());
-  if (nv == 0 || nt == 0) throw InputError("fem::make_tet_mesh_data: empty mesh (#V = " +
-                                           std::to_string(nv) + ", #T = " + std::to_string(nt) + ")");
+  if (nv == 0 || nt == 0)
+    throw InputError("fem::make_tet_mesh_data: empty mesh (#V = " + std::to_string(nv) +
+                     ", #T = " + std::to_string(nt) + ")");
   for (int i = 0; i < nv; ++i)
     if (!rest_positions.row(i).allFinite())
       throw InputError("fem::make_tet_mesh_data: rest position of node " + std::to_string(i) +
                        " is not finite");
-  const double diag = (rest_positions.colwise().maxCoeff() - rest_positions.colwise().minCoeff()).norm();
+  const double diag =
+      (rest_positions.colwise().maxCoeff() - rest_positions.colwise().minCoeff()).norm();
   const double min_volume = 1e-14 * diag * diag * diag;
 
   TetMeshData d;

@@ -89,10 +89,17 @@ struct Metrics {
 
 class Evaluator {
  public:
-  Evaluator(const SphereTree& a, const SphereTree& b, const coupling::ContactOptions& contact, int na,
-            int nb, std::vector<Tri> tri_a, std::vector<Tri> tri_b)
-      : m_a(a), m_b(b), m_contact(contact), m_na(na), m_nb(nb), m_tri_a(std::move(tri_a)),
-        m_tri_b(std::move(tri_b)), m_parent_a(collision::parents(a)), m_parent_b(collision::parents(b)) {
+  Evaluator(const SphereTree& a, const SphereTree& b, const coupling::ContactOptions& contact,
+            int na, int nb, std::vector<Tri> tri_a, std::vector<Tri> tri_b)
+      : m_a(a),
+        m_b(b),
+        m_contact(contact),
+        m_na(na),
+        m_nb(nb),
+        m_tri_a(std::move(tri_a)),
+        m_tri_b(std::move(tri_b)),
+        m_parent_a(collision::parents(a)),
+        m_parent_b(collision::parents(b)) {
     CollisionRequest full;
     m_full = collision::collide(a, b, full);
     m_force_full = force(m_full, nullptr);
@@ -112,20 +119,24 @@ class Evaluator {
     const Vector3d f = force(r, &m.response_seconds);
     const double nf = m_force_full.norm();
     m.force_rel_error = nf > 0 ? (f - m_force_full).norm() / nf : (f.norm() > 0 ? 1.0 : 0.0);
-    m.force_angle_deg = (nf > 0 && f.norm() > 0)
-                            ? std::acos(std::clamp(f.dot(m_force_full) / (f.norm() * nf), -1.0, 1.0)) * 180 / std::numbers::pi
-                            : (nf > 0 || f.norm() > 0 ? 180.0 : 0.0);
+    m.force_angle_deg =
+        (nf > 0 && f.norm() > 0)
+            ? std::acos(std::clamp(f.dot(m_force_full) / (f.norm() * nf), -1.0, 1.0)) * 180 /
+                  std::numbers::pi
+            : (nf > 0 || f.norm() > 0 ? 180.0 : 0.0);
     std::vector<NodePair> rep(r.colliding);
     rep.insert(rep.end(), r.untested.begin(), r.untested.end());
     // Recall against the full traversal.
     int covered = 0;
     for (const NodePair& leaf : m_full.colliding)
       for (const NodePair& p : rep)
-        if (is_ancestor_or_self(m_parent_a, p.a, leaf.a) && is_ancestor_or_self(m_parent_b, p.b, leaf.b)) {
+        if (is_ancestor_or_self(m_parent_a, p.a, leaf.a) &&
+            is_ancestor_or_self(m_parent_b, p.b, leaf.b)) {
           ++covered;
           break;
         }
-    m.recall_full = m_full.colliding.empty() ? 1.0 : double(covered) / double(m_full.colliding.size());
+    m.recall_full =
+        m_full.colliding.empty() ? 1.0 : double(covered) / double(m_full.colliding.size());
     // Recall of the exact triangle pairs, and false positives.
     std::vector<char> useful(rep.size(), 0);
     int exact_covered = 0;
@@ -151,8 +162,10 @@ class Evaluator {
   Vector3d force(const CollisionResult& r, double* seconds) const {
     MatX3d fa = MatX3d::Zero(m_na, 3), fb = MatX3d::Zero(m_nb, 3);
     const auto t0 = std::chrono::steady_clock::now();
-    const coupling::ContactStats st = coupling::apply_contact_forces(m_a, m_b, r, m_contact, fa, fb);
-    if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const coupling::ContactStats st =
+        coupling::apply_contact_forces(m_a, m_b, r, m_contact, fa, fb);
+    if (seconds)
+      *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return st.total_force_a;
   }
   double volume(const CollisionResult& r) const {
@@ -180,7 +193,8 @@ class Evaluator {
 
 void usage() {
   std::printf(
-      "usage: contact_error [--out DIR] [--scene FILE] [--budgets s1,s2,...] [--test-budgets n1,...]\n"
+      "usage: contact_error [--out DIR] [--scene FILE] [--budgets s1,s2,...] [--test-budgets "
+      "n1,...]\n"
       "                     [--reps N] [--after N] [--max-frames N]\n"
       "  Default scene experiments/scenes/bunny_dragon.json; writes DIR/contact_error.csv.\n");
 }
@@ -195,13 +209,20 @@ int main(int argc, char** argv) {
   int reps = 5, after = 3, max_frames = 200;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc) scene_path = argv[++i];
-    else if (a == "--budgets" && i + 1 < argc) budgets_text = argv[++i];
-    else if (a == "--test-budgets" && i + 1 < argc) tests_text = argv[++i];
-    else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--after" && i + 1 < argc) after = std::stoi(argv[++i]);
-    else if (a == "--max-frames" && i + 1 < argc) max_frames = std::stoi(argv[++i]);
+    if (a == "--out" && i + 1 < argc)
+      out = argv[++i];
+    else if (a == "--scene" && i + 1 < argc)
+      scene_path = argv[++i];
+    else if (a == "--budgets" && i + 1 < argc)
+      budgets_text = argv[++i];
+    else if (a == "--test-budgets" && i + 1 < argc)
+      tests_text = argv[++i];
+    else if (a == "--reps" && i + 1 < argc)
+      reps = std::max(1, std::stoi(argv[++i]));
+    else if (a == "--after" && i + 1 < argc)
+      after = std::stoi(argv[++i]);
+    else if (a == "--max-frames" && i + 1 < argc)
+      max_frames = std::stoi(argv[++i]);
     else {
       usage();
       return a == "--help" || a == "-h" ? 0 : 2;
@@ -215,28 +236,34 @@ int main(int argc, char** argv) {
     scene.target_fps = 0;
     scene.collision.budget_tests = -1;
     scene.collision.budget_seconds = std::numeric_limits<double>::infinity();
-    World world(scene, fs::path(ICD_SOURCE_DIR) / "assets", fs::canonical("/proc/self/exe").parent_path());
+    World world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
+                fs::canonical("/proc/self/exe").parent_path());
     if (world.plan().pairs.empty()) throw InputError(scene_path.string() + ": no collision pair");
     const experiments::ContactMoment cm = experiments::run_to_contact(world, max_frames, after);
-    if (cm.contact_frame < 0) throw InputError(scene_path.string() + ": no contact within --max-frames");
+    if (cm.contact_frame < 0)
+      throw InputError(scene_path.string() + ": no contact within --max-frames");
     const auto [ia, ib] = world.plan().pairs[0];
     const RuntimeObject& oa = world.objects()[ia];
     const RuntimeObject& ob = world.objects()[ib];
     const MatX3d da = experiments::dense_positions(oa), db = experiments::dense_positions(ob);
     const collision::AabbTree ta(da, oa.asset.dense.F), tb(db, ob.asset.dense.F);
-    const auto exact = collision::intersecting_triangle_pairs(ta, da, oa.asset.dense.F, tb, db, ob.asset.dense.F);
+    const auto exact =
+        collision::intersecting_triangle_pairs(ta, da, oa.asset.dense.F, tb, db, ob.asset.dense.F);
     std::vector<Tri> tri_a, tri_b;
     for (const auto& [f, g] : exact) {
       tri_a.push_back(make_tri(da, oa.asset.dense.F, f));
       tri_b.push_back(make_tri(db, ob.asset.dense.F, g));
     }
     const Evaluator ev(oa.asset.spheres, ob.asset.spheres, scene.collision.contact,
-                       static_cast<int>(oa.positions.rows()), static_cast<int>(ob.positions.rows()), tri_a, tri_b);
+                       static_cast<int>(oa.positions.rows()), static_cast<int>(ob.positions.rows()),
+                       tri_a, tri_b);
     const Metrics full = ev.evaluate(ev.full());
-    std::printf("%s: frame %d (contact at %d): %zu exact triangle pairs, full traversal %zu leaf pairs, "
-                "%lld tests, |F_full| = %.4g N, exact recall of the full traversal %.3f\n",
-                scene.name.c_str(), cm.last_frame, cm.contact_frame, exact.size(), ev.full().colliding.size(),
-                static_cast<long long>(ev.full().tests), ev.force_full().norm(), full.recall_exact);
+    std::printf(
+        "%s: frame %d (contact at %d): %zu exact triangle pairs, full traversal %zu leaf pairs, "
+        "%lld tests, |F_full| = %.4g N, exact recall of the full traversal %.3f\n",
+        scene.name.c_str(), cm.last_frame, cm.contact_frame, exact.size(),
+        ev.full().colliding.size(), static_cast<long long>(ev.full().tests), ev.force_full().norm(),
+        full.recall_exact);
 
     std::vector<Mode> modes;
     const CollisionSpec& cs = scene.collision;
@@ -259,7 +286,8 @@ int main(int argc, char** argv) {
 
     std::ostringstream csv;
     csv << "scene,frame,mode,budget_kind,budget,seconds,response_seconds,tests,reported_pairs,"
-           "colliding_pairs,completed_level,interrupted,force_rel_error,force_angle_deg,recall_full,"
+           "colliding_pairs,completed_level,interrupted,force_rel_error,force_angle_deg,recall_"
+           "full,"
            "recall_exact,false_positive,volume_ratio,exact_pairs,full_leaf_pairs,full_seconds\n";
     for (const Mode& mode : modes)
       for (int kind = 0; kind < 2; ++kind)
@@ -275,20 +303,23 @@ int main(int argc, char** argv) {
             collision::collide(oa.asset.spheres, ob.asset.spheres, req, run);
           }
           std::sort(runs.begin(), runs.end(),
-                    [](const CollisionResult& x, const CollisionResult& y) { return x.seconds < y.seconds; });
+                    [](const CollisionResult& x, const CollisionResult& y) {
+                      return x.seconds < y.seconds;
+                    });
           const Metrics m = ev.evaluate(runs[runs.size() / 2]);
           csv << scene.name << ',' << cm.last_frame << ',' << mode.name << ','
               << (kind == 0 ? "seconds" : "tests") << ',' << budget << ',' << m.seconds << ','
-              << m.response_seconds << ',' << m.tests << ',' << m.reported << ',' << m.colliding << ','
-              << m.completed_level << ',' << m.interrupted << ',' << m.force_rel_error << ','
+              << m.response_seconds << ',' << m.tests << ',' << m.reported << ',' << m.colliding
+              << ',' << m.completed_level << ',' << m.interrupted << ',' << m.force_rel_error << ','
               << m.force_angle_deg << ',' << m.recall_full << ',' << m.recall_exact << ','
               << m.false_positive << ',' << m.volume_ratio << ',' << exact.size() << ','
               << ev.full().colliding.size() << ',' << full.seconds << '\n';
-          std::printf("%-18s %-7s %-8g: %9.2e s, %7lld tests, force err %.3f, recall full %.3f exact %.3f, "
-                      "false pos %.3f\n",
-                      mode.name.c_str(), kind == 0 ? "seconds" : "tests", budget, m.seconds,
-                      static_cast<long long>(m.tests), m.force_rel_error, m.recall_full, m.recall_exact,
-                      m.false_positive);
+          std::printf(
+              "%-18s %-7s %-8g: %9.2e s, %7lld tests, force err %.3f, recall full %.3f exact %.3f, "
+              "false pos %.3f\n",
+              mode.name.c_str(), kind == 0 ? "seconds" : "tests", budget, m.seconds,
+              static_cast<long long>(m.tests), m.force_rel_error, m.recall_full, m.recall_exact,
+              m.false_positive);
         }
     fs::create_directories(out);
     write_file_atomically(out / "contact_error.csv", csv.str());

@@ -50,7 +50,8 @@ Error compare(const MatX3d& x, const MatX3d& y) {
 }
 
 void links_vs_barycentric(const Scene& scene, int frames, int reps, std::ostringstream& csv) {
-  World world(scene, fs::path(ICD_SOURCE_DIR) / "assets", fs::canonical("/proc/self/exe").parent_path());
+  World world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
+              fs::canonical("/proc/self/exe").parent_path());
   std::vector<coupling::BarycentricEmbedding> emb;
   std::vector<double> diag;
   for (const RuntimeObject& o : world.objects()) {
@@ -82,9 +83,9 @@ void links_vs_barycentric(const Scene& scene, int frames, int reps, std::ostring
       }
       const Error e = compare(links, bary);
       csv << scene.name << ',' << f << ',' << o.spec.name << ',' << o.asset.dense.V.rows() << ','
-          << o.rest.rows() << ',' << emb[k].num_outside << ',' << median(tl) << ',' << median(tb) << ','
-          << e.rms << ',' << e.max << ',' << 100 * e.rms / diag[k] << ',' << 100 * e.max / diag[k] << ','
-          << m.active_pairs << '\n';
+          << o.rest.rows() << ',' << emb[k].num_outside << ',' << median(tl) << ',' << median(tb)
+          << ',' << e.rms << ',' << e.max << ',' << 100 * e.rms / diag[k] << ','
+          << 100 * e.max / diag[k] << ',' << m.active_pairs << '\n';
     }
   }
 }
@@ -97,10 +98,12 @@ struct Run {
 
 Run run_resolution(Scene scene, int cells, int frames) {
   for (ObjectSpec& o : scene.objects) {
-    if (!o.primitive) throw InputError("deformation_error: the resolution scene must use primitive objects");
+    if (!o.primitive)
+      throw InputError("deformation_error: the resolution scene must use primitive objects");
     o.primitive->cells = cells;
   }
-  World world(scene, fs::path(ICD_SOURCE_DIR) / "assets", fs::canonical("/proc/self/exe").parent_path());
+  World world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
+              fs::canonical("/proc/self/exe").parent_path());
   Run run;
   run.nodes = static_cast<int>(world.objects()[0].rest.rows());
   run.tets = static_cast<int>(world.objects()[0].asset.coarse.T.rows());
@@ -131,13 +134,20 @@ int main(int argc, char** argv) {
   int frames = 60, reps = 5, fine = 12;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc) scene_path = argv[++i];
-    else if (a == "--resolution-scene" && i + 1 < argc) res_path = argv[++i];
-    else if (a == "--cells" && i + 1 < argc) cells_text = argv[++i];
-    else if (a == "--fine" && i + 1 < argc) fine = std::stoi(argv[++i]);
-    else if (a == "--frames" && i + 1 < argc) frames = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::stoi(argv[++i]));
+    if (a == "--out" && i + 1 < argc)
+      out = argv[++i];
+    else if (a == "--scene" && i + 1 < argc)
+      scene_path = argv[++i];
+    else if (a == "--resolution-scene" && i + 1 < argc)
+      res_path = argv[++i];
+    else if (a == "--cells" && i + 1 < argc)
+      cells_text = argv[++i];
+    else if (a == "--fine" && i + 1 < argc)
+      fine = std::stoi(argv[++i]);
+    else if (a == "--frames" && i + 1 < argc)
+      frames = std::max(1, std::stoi(argv[++i]));
+    else if (a == "--reps" && i + 1 < argc)
+      reps = std::max(1, std::stoi(argv[++i]));
     else {
       usage();
       return a == "--help" || a == "-h" ? 0 : 2;
@@ -153,14 +163,16 @@ int main(int argc, char** argv) {
     };
     std::ostringstream links;
     links << "scene,frame,object,dense_vertices,coarse_nodes,outside_vertices,links_seconds,"
-             "barycentric_seconds,rms_error,max_error,rms_error_pct_bbox,max_error_pct_bbox,active_pairs\n";
+             "barycentric_seconds,rms_error,max_error,rms_error_pct_bbox,max_error_pct_bbox,active_"
+             "pairs\n";
     links_vs_barycentric(prepare(scene_path), frames, reps, links);
 
     const Scene res_scene = prepare(res_path);
     const Run ref = run_resolution(res_scene, fine, frames);
     const double diag = bbox_diagonal(ref.dense[0]);
     std::ostringstream res;
-    res << "scene,cells,coarse_nodes,coarse_tets,frame_seconds,rms_error,max_error,rms_error_pct_bbox,"
+    res << "scene,cells,coarse_nodes,coarse_tets,frame_seconds,rms_error,max_error,rms_error_pct_"
+           "bbox,"
            "max_error_pct_bbox,fine_cells,fine_coarse_tets,fine_frame_seconds\n";
     for (double c : cells) {
       const Run run = run_resolution(res_scene, static_cast<int>(c), frames);
@@ -171,13 +183,15 @@ int main(int argc, char** argv) {
         mx = std::max(mx, e.max);
       }
       rms = std::sqrt(rms);
-      res << res_scene.name << ',' << c << ',' << run.nodes << ',' << run.tets << ',' << run.frame_seconds
-          << ',' << rms << ',' << mx << ',' << 100 * rms / diag << ',' << 100 * mx / diag << ',' << fine
-          << ',' << ref.tets << ',' << ref.frame_seconds << '\n';
-      std::printf("cells %2g (%5d tets): %.3g ms/frame, RMS error %.3g%% of bbox, max %.3g%% (fine %d: %d tets, "
-                  "%.3g ms/frame)\n",
-                  c, run.tets, 1e3 * run.frame_seconds, 100 * rms / diag, 100 * mx / diag, fine, ref.tets,
-                  1e3 * ref.frame_seconds);
+      res << res_scene.name << ',' << c << ',' << run.nodes << ',' << run.tets << ','
+          << run.frame_seconds << ',' << rms << ',' << mx << ',' << 100 * rms / diag << ','
+          << 100 * mx / diag << ',' << fine << ',' << ref.tets << ',' << ref.frame_seconds << '\n';
+      std::printf(
+          "cells %2g (%5d tets): %.3g ms/frame, RMS error %.3g%% of bbox, max %.3g%% (fine %d: %d "
+          "tets, "
+          "%.3g ms/frame)\n",
+          c, run.tets, 1e3 * run.frame_seconds, 100 * rms / diag, 100 * mx / diag, fine, ref.tets,
+          1e3 * ref.frame_seconds);
       std::fflush(stdout);
     }
     fs::create_directories(out);

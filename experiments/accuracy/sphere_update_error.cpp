@@ -53,9 +53,10 @@ double leaf_volume(const collision::SphereTree& t) {
 }
 
 void usage() {
-  std::printf("usage: sphere_update_error [--out DIR] [--scene FILE] [--frames N] [--every N] [--reps N]\n"
-              "  Default scene experiments/scenes/two_spheres.json (octree trees, so the rebuilt tree\n"
-              "  uses the same builder), 60 frames, every frame.\n");
+  std::printf(
+      "usage: sphere_update_error [--out DIR] [--scene FILE] [--frames N] [--every N] [--reps N]\n"
+      "  Default scene experiments/scenes/two_spheres.json (octree trees, so the rebuilt tree\n"
+      "  uses the same builder), 60 frames, every frame.\n");
 }
 
 }  // namespace
@@ -66,11 +67,16 @@ int main(int argc, char** argv) {
   int frames = 60, every = 1, reps = 5;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc) scene_path = argv[++i];
-    else if (a == "--frames" && i + 1 < argc) frames = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--every" && i + 1 < argc) every = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::stoi(argv[++i]));
+    if (a == "--out" && i + 1 < argc)
+      out = argv[++i];
+    else if (a == "--scene" && i + 1 < argc)
+      scene_path = argv[++i];
+    else if (a == "--frames" && i + 1 < argc)
+      frames = std::max(1, std::stoi(argv[++i]));
+    else if (a == "--every" && i + 1 < argc)
+      every = std::max(1, std::stoi(argv[++i]));
+    else if (a == "--reps" && i + 1 < argc)
+      reps = std::max(1, std::stoi(argv[++i]));
     else {
       usage();
       return a == "--help" || a == "-h" ? 0 : 2;
@@ -83,7 +89,8 @@ int main(int argc, char** argv) {
     Scene scene = load_scene(scene_path);
     scene.output = OutputSpec{};
     scene.target_fps = 0;
-    World world(scene, fs::path(ICD_SOURCE_DIR) / "assets", fs::canonical("/proc/self/exe").parent_path());
+    World world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
+                fs::canonical("/proc/self/exe").parent_path());
     for (int f = 0; f < frames; ++f) {
       world.step();
       if (f % every) continue;
@@ -101,12 +108,13 @@ int main(int argc, char** argv) {
           int leaves = 0;
           for (int i = 0; i < t.num_nodes(); ++i) leaves += t.is_leaf(i);
           csv << scene.name << ',' << f << ',' << o.spec.name << ',' << method << ',' << secs << ','
-              << cov.uncovered_fraction << ',' << cov.max_gap << ',' << leaf_volume(t) / volume << ','
-              << leaves << ',' << max_disp << '\n';
+              << cov.uncovered_fraction << ',' << cov.max_gap << ',' << leaf_volume(t) / volume
+              << ',' << leaves << ',' << max_disp << '\n';
         };
-        for (const auto& [name, mode] : {std::pair{"update_paper_ratio", collision::SphereUpdateMode::PaperRatio},
-                                         std::pair{"update_displacement_bound",
-                                                   collision::SphereUpdateMode::DisplacementBound}}) {
+        for (const auto& [name, mode] :
+             {std::pair{"update_paper_ratio", collision::SphereUpdateMode::PaperRatio},
+              std::pair{"update_displacement_bound",
+                        collision::SphereUpdateMode::DisplacementBound}}) {
           collision::SphereTree t = o.asset.spheres;
           collision::SphereUpdateOptions opt;
           opt.mode = mode;

@@ -30,17 +30,21 @@ namespace {
 
 // Number of points inside at least one of the spheres (uniform grid).
 long long points_covered(const std::vector<Sphere>& spheres, const icd::MatX3d& P, double h) {
-  auto key = [](long long a, long long b, long long c) { return (a * 73856093LL) ^ (b * 19349663LL) ^ (c * 83492791LL); };
+  auto key = [](long long a, long long b, long long c) {
+    return (a * 73856093LL) ^ (b * 19349663LL) ^ (c * 83492791LL);
+  };
   std::unordered_map<long long, std::vector<int>> grid;
   for (int i = 0; i < static_cast<int>(spheres.size()); ++i) {
     const Sphere& s = spheres[i];
     for (long long a = std::floor((s.x - s.r) / h); a <= std::floor((s.x + s.r) / h); ++a)
       for (long long b = std::floor((s.y - s.r) / h); b <= std::floor((s.y + s.r) / h); ++b)
-        for (long long c = std::floor((s.z - s.r) / h); c <= std::floor((s.z + s.r) / h); ++c) grid[key(a, b, c)].push_back(i);
+        for (long long c = std::floor((s.z - s.r) / h); c <= std::floor((s.z + s.r) / h); ++c)
+          grid[key(a, b, c)].push_back(i);
   }
   long long n = 0;
   for (int v = 0; v < P.rows(); ++v) {
-    auto it = grid.find(key(std::floor(P(v, 0) / h), std::floor(P(v, 1) / h), std::floor(P(v, 2) / h)));
+    auto it =
+        grid.find(key(std::floor(P(v, 0) / h), std::floor(P(v, 1) / h), std::floor(P(v, 2) / h)));
     if (it == grid.end()) continue;
     for (int i : it->second) {
       const Sphere& s = spheres[i];
@@ -68,11 +72,14 @@ long long suspected_vertices(const Object& a, const CollisionResult& r) {
 
 void coverage_experiment(const std::string& file, int levels) {
   Object o = load_object(file, {0, 0, 0}, levels);
-  std::printf("\n[1] %s, octree %d levels (%d spheres), %ld coarse nodes (nearest-node association):\n", file.c_str(),
-              levels, o.tree.num_nodes(), (long)o.coarse_rest.rows());
-  std::printf("%10s %28s %28s %28s\n", "amplitude", "paper ratio: uncovered/gap", "conservative: uncov./gap",
-              "conservative+0.01: uncov.");
-  std::printf("  (model side 2; gap = largest distance of an uncovered dense vertex outside the leaf spheres)\n");
+  std::printf(
+      "\n[1] %s, octree %d levels (%d spheres), %ld coarse nodes (nearest-node association):\n",
+      file.c_str(), levels, o.tree.num_nodes(), (long)o.coarse_rest.rows());
+  std::printf("%10s %28s %28s %28s\n", "amplitude", "paper ratio: uncovered/gap",
+              "conservative: uncov./gap", "conservative+0.01: uncov.");
+  std::printf(
+      "  (model side 2; gap = largest distance of an uncovered dense vertex outside the leaf "
+      "spheres)\n");
   for (double amp : {0.0, 0.05, 0.1, 0.2, 0.3, 0.5}) {
     const icd::MatX3d x = deform(o.coarse_rest, amp, 0.5), V = deform(o.dense.V, amp, 0.5);
     SphereUpdateOptions opt;
@@ -84,8 +91,9 @@ void coverage_experiment(const std::string& file, int levels) {
     opt.margin = 0.01;
     update_spheres(o.tree, o.coarse_rest, x, opt);
     const CoverageReport m = measure_coverage(o.tree, V);
-    std::printf("%10.2f %18.4f%% / %6.4f %18.4f%% / %6.4f %27.4f%%\n", amp, 100 * p.uncovered_fraction, p.max_gap,
-                100 * c.uncovered_fraction, c.max_gap, 100 * m.uncovered_fraction);
+    std::printf("%10.2f %18.4f%% / %6.4f %18.4f%% / %6.4f %27.4f%%\n", amp,
+                100 * p.uncovered_fraction, p.max_gap, 100 * c.uncovered_fraction, c.max_gap,
+                100 * m.uncovered_fraction);
   }
 }
 
@@ -95,10 +103,13 @@ void modes_experiment(int levels) {
   CollisionResult full;
   collide(a.tree, b.tree, CollisionRequest{}, full);
   const double full_count = static_cast<double>(suspected_vertices(a, full));
-  std::printf("\n[2] two dragons, octree %d levels (%d spheres each): full traversal %lld tests, %zu leaf pairs, "
-              "%.0f dense vertices of A suspected\n",
-              levels, a.tree.num_nodes(), (long long)full.tests, full.colliding.size(), full_count);
-  std::printf("%-28s %9s %10s %12s %10s %8s\n", "mode", "tests", "time us", "suspected/full", "peak list", "level");
+  std::printf(
+      "\n[2] two dragons, octree %d levels (%d spheres each): full traversal %lld tests, %zu leaf "
+      "pairs, "
+      "%.0f dense vertices of A suspected\n",
+      levels, a.tree.num_nodes(), (long long)full.tests, full.colliding.size(), full_count);
+  std::printf("%-28s %9s %10s %12s %10s %8s\n", "mode", "tests", "time us", "suspected/full",
+              "peak list", "level");
   struct Mode {
     const char* name;
     CollisionRequest r;
@@ -135,8 +146,9 @@ void modes_experiment(int levels) {
         collide(a.tree, b.tree, r, res);
         times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
       }
-      std::printf("%-28s %9lld %10.1f %14.2f %10zu %8d\n", m.name, (long long)res.tests, 1e6 * median(times),
-                  suspected_vertices(a, res) / full_count, res.peak_list_size, res.completed_level);
+      std::printf("%-28s %9lld %10.1f %14.2f %10zu %8d\n", m.name, (long long)res.tests,
+                  1e6 * median(times), suspected_vertices(a, res) / full_count, res.peak_list_size,
+                  res.completed_level);
     }
   }
 }
@@ -148,9 +160,12 @@ void coherence_experiment(int levels) {
     CollisionResult full;
     collide(a.tree, b.tree, CollisionRequest{}, full);
     const int64_t budget = static_cast<int64_t>(fraction * full.tests);
-    std::printf("\n[3] temporal coherence, two dragons moving slowly, budget %lld tests (%.2f of a full traversal):\n",
-                (long long)budget, fraction);
-    std::printf("%6s %22s %22s %12s\n", "frame", "from roots: susp/full", "from front: susp/full", "front size");
+    std::printf(
+        "\n[3] temporal coherence, two dragons moving slowly, budget %lld tests (%.2f of a full "
+        "traversal):\n",
+        (long long)budget, fraction);
+    std::printf("%6s %22s %22s %12s\n", "frame", "from roots: susp/full", "from front: susp/full",
+                "front size");
     CollisionRequest r;
     r.budget_tests = budget;
     r.record_front = true;
@@ -176,7 +191,8 @@ void coherence_experiment(int levels) {
 int main(int argc, char** argv) {
   int levels = 6;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--levels") && i + 1 < argc) levels = std::atoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--levels") && i + 1 < argc)
+      levels = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: %s [--levels L]\n", argv[0]);
       return 2;

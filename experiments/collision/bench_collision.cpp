@@ -83,8 +83,10 @@ void BM_FullTraversal(benchmark::State& state) {
     state.SkipWithError(e.what());
     return;
   }
-  CollisionRequest r = state.range(0) == 0 ? CollisionRequest::paper_reference(std::numeric_limits<double>::infinity())
-                                           : CollisionRequest{};
+  CollisionRequest r =
+      state.range(0) == 0
+          ? CollisionRequest::paper_reference(std::numeric_limits<double>::infinity())
+          : CollisionRequest{};
   if (state.range(0) == 2) r.mode = TraversalMode::DepthFirst;
   if (state.range(0) == 3) r.mode = TraversalMode::Priority;
   CollisionResult res;
@@ -117,7 +119,13 @@ void BM_QueryBudget(benchmark::State& state) {
   state.counters["tests"] = double(tests) / state.iterations();
   state.counters["completed_level"] = res.completed_level;
 }
-BENCHMARK(BM_QueryBudget)->Arg(10)->Arg(30)->Arg(100)->Arg(300)->Arg(1000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_QueryBudget)
+    ->Arg(10)
+    ->Arg(30)
+    ->Arg(100)
+    ->Arg(300)
+    ->Arg(1000)
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

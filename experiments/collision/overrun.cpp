@@ -29,7 +29,9 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 void spin_for(double s) {
   const auto t0 = Clock::now();
@@ -57,7 +59,8 @@ struct Floor {
     while (!stop.load(std::memory_order_relaxed)) {
       const int k = bin.load(std::memory_order_relaxed);
       const double wait = (k < 0 ? 10e-6 : budgets[k]) + jitter(rng);
-      const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait));
+      const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                               std::chrono::duration<double>(wait));
       for (;;) {
         const auto now = Clock::now();
         const double gap = std::chrono::duration<double>(now - prev).count();
@@ -85,9 +88,12 @@ int main(int argc, char** argv) {
   double max_seconds = 4.0;
   std::string csv_path;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--queries") && i + 1 < argc) max_queries = std::atoll(argv[++i]);
-    else if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc) max_seconds = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) csv_path = argv[++i];
+    if (!std::strcmp(argv[i], "--queries") && i + 1 < argc)
+      max_queries = std::atoll(argv[++i]);
+    else if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc)
+      max_seconds = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc)
+      csv_path = argv[++i];
     else {
       std::fprintf(stderr, "usage: %s [--queries N] [--max-seconds S] [--csv FILE]\n", argv[0]);
       return 2;
@@ -102,9 +108,10 @@ int main(int argc, char** argv) {
   {
     const auto t0 = Clock::now();
     collide(a.tree, b.tree, CollisionRequest{}, result);
-    std::printf("trees: %d and %d spheres; full fast traversal: %lld tests, %zu leaf pairs, %.1f ms\n",
-                a.tree.num_nodes(), b.tree.num_nodes(), (long long)result.tests, result.colliding.size(),
-                1e3 * seconds_since(t0));
+    std::printf(
+        "trees: %d and %d spheres; full fast traversal: %lld tests, %zu leaf pairs, %.1f ms\n",
+        a.tree.num_nodes(), b.tree.num_nodes(), (long long)result.tests, result.colliding.size(),
+        1e3 * seconds_since(t0));
   }
   // Costs measured in this run.
   {
@@ -113,11 +120,13 @@ int main(int argc, char** argv) {
     Clock::rep sink = 0;
     for (int i = 0; i < n; ++i) sink += Clock::now().time_since_epoch().count();
     const double clock_ns = 1e9 * seconds_since(t0) / n;
-    std::printf("steady_clock::now(): %.1f ns per read (sink %lld)\n", clock_ns, (long long)(sink & 1));
+    std::printf("steady_clock::now(): %.1f ns per read (sink %lld)\n", clock_ns,
+                (long long)(sink & 1));
   }
 
   std::vector<Config> configs;
-  configs.push_back({"paper Fig.7 literal, clock every test", CollisionRequest::paper_reference(1)});
+  configs.push_back(
+      {"paper Fig.7 literal, clock every test", CollisionRequest::paper_reference(1)});
   {
     CollisionRequest r;
     r.clock_check_interval = 16;
@@ -146,8 +155,8 @@ int main(int argc, char** argv) {
     r.budget_seconds = 0.1;
     collide(a.tree, b.tree, r, result);
   }
-  std::printf("\n%-40s %9s %7s %6s %9s %9s %9s %9s %10s\n", "configuration", "budget", "queries", "intr%", "p50 us",
-              "p99 us", "p99.9 us", "max us", "tests p50");
+  std::printf("\n%-40s %9s %7s %6s %9s %9s %9s %9s %10s\n", "configuration", "budget", "queries",
+              "intr%", "p50 us", "p99 us", "p99.9 us", "max us", "tests p50");
   for (const Config& c : configs) {
     for (std::size_t bi = 0; bi < budgets.size(); ++bi) {
       const double budget = budgets[bi];
@@ -169,32 +178,40 @@ int main(int argc, char** argv) {
         tests.push_back(static_cast<double>(result.tests));
       }
       const double n = static_cast<double>(tests.size());
-      std::printf("%-40s %8.0fus %7.0f %6.1f %9.2f %9.2f %9.2f %9.1f %10.0f\n", c.name.c_str(), budget * 1e6, n,
-                  100.0 * interrupted / n, 1e6 * quantile(over, 0.5), 1e6 * quantile(over, 0.99),
-                  1e6 * quantile(over, 0.999), 1e6 * quantile(over, 1.0), median(tests));
+      std::printf("%-40s %8.0fus %7.0f %6.1f %9.2f %9.2f %9.2f %9.1f %10.0f\n", c.name.c_str(),
+                  budget * 1e6, n, 100.0 * interrupted / n, 1e6 * quantile(over, 0.5),
+                  1e6 * quantile(over, 0.99), 1e6 * quantile(over, 0.999),
+                  1e6 * quantile(over, 1.0), median(tests));
       std::fflush(stdout);
       if (csv)
-        csv << '"' << c.name << "\"," << budget << ',' << n << ',' << interrupted << ',' << 1e6 * quantile(over, 0.5)
-            << ',' << 1e6 * quantile(over, 0.99) << ',' << 1e6 * quantile(over, 0.999) << ','
-            << 1e6 * quantile(over, 1.0) << ',' << median(tests) << '\n';
+        csv << '"' << c.name << "\"," << budget << ',' << n << ',' << interrupted << ','
+            << 1e6 * quantile(over, 0.5) << ',' << 1e6 * quantile(over, 0.99) << ','
+            << 1e6 * quantile(over, 0.999) << ',' << 1e6 * quantile(over, 1.0) << ','
+            << median(tests) << '\n';
     }
   }
   floor.bin = -1;
   floor.stop = true;
   floor_thread.join();
-  std::printf("\nfloor (other thread, same run, %.1f s): lateness past deadlines of the same length, per budget:\n",
-              floor.spun);
-  std::printf("%9s %9s %9s %9s %9s %9s\n", "budget", "deadlines", "p50 us", "p99 us", "p99.9 us", "max us");
+  std::printf(
+      "\nfloor (other thread, same run, %.1f s): lateness past deadlines of the same length, per "
+      "budget:\n",
+      floor.spun);
+  std::printf("%9s %9s %9s %9s %9s %9s\n", "budget", "deadlines", "p50 us", "p99 us", "p99.9 us",
+              "max us");
   for (std::size_t bi = 0; bi < budgets.size(); ++bi) {
     const auto& l = floor.lateness[bi];
-    std::printf("%8.0fus %9zu %9.2f %9.2f %9.2f %9.1f\n", budgets[bi] * 1e6, l.size(), 1e6 * quantile(l, 0.5),
-                1e6 * quantile(l, 0.99), 1e6 * quantile(l, 0.999), 1e6 * quantile(l, 1.0));
+    std::printf("%8.0fus %9zu %9.2f %9.2f %9.2f %9.1f\n", budgets[bi] * 1e6, l.size(),
+                1e6 * quantile(l, 0.5), 1e6 * quantile(l, 0.99), 1e6 * quantile(l, 0.999),
+                1e6 * quantile(l, 1.0));
     if (csv)
       csv << "floor," << budgets[bi] << ',' << l.size() << ",0," << 1e6 * quantile(l, 0.5) << ','
-          << 1e6 * quantile(l, 0.99) << ',' << 1e6 * quantile(l, 0.999) << ',' << 1e6 * quantile(l, 1.0) << ",0\n";
+          << 1e6 * quantile(l, 0.99) << ',' << 1e6 * quantile(l, 0.999) << ','
+          << 1e6 * quantile(l, 1.0) << ",0\n";
   }
-  std::printf("floor: %zu clock gaps > 1 us (%.0f per second), gap p50 %.1f us, p99 %.1f us, max %.1f us\n",
-              floor.gaps.size(), floor.gaps.size() / floor.spun, 1e6 * quantile(floor.gaps, 0.5),
-              1e6 * quantile(floor.gaps, 0.99), 1e6 * quantile(floor.gaps, 1.0));
+  std::printf(
+      "floor: %zu clock gaps > 1 us (%.0f per second), gap p50 %.1f us, p99 %.1f us, max %.1f us\n",
+      floor.gaps.size(), floor.gaps.size() / floor.spun, 1e6 * quantile(floor.gaps, 0.5),
+      1e6 * quantile(floor.gaps, 0.99), 1e6 * quantile(floor.gaps, 1.0));
   return 0;
 }

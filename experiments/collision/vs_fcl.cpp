@@ -60,10 +60,13 @@ std::shared_ptr<Model> make_model(const icd::SurfaceMesh& m) {
 void run_scene(const std::string& file, int frames, int levels) {
   Object a = load_object(file, {0, 0, 0}, levels);
   Object b = load_object(file, {0.45, 0.15, 0.05}, levels);
-  std::printf("\n== %s: %ld vertices, %ld triangles per copy; octree sphere trees (%d levels): %d spheres each "
-              "(%d leaves); %ld coarse nodes\n",
-              file.c_str(), (long)a.dense.V.rows(), (long)a.dense.F.rows(), levels, a.tree.num_nodes(),
-              a.tree.level_offset.back() - a.tree.level_offset[a.tree.num_levels() - 1], (long)a.coarse_rest.rows());
+  std::printf(
+      "\n== %s: %ld vertices, %ld triangles per copy; octree sphere trees (%d levels): %d spheres "
+      "each "
+      "(%d leaves); %ld coarse nodes\n",
+      file.c_str(), (long)a.dense.V.rows(), (long)a.dense.F.rows(), levels, a.tree.num_nodes(),
+      a.tree.level_offset.back() - a.tree.level_offset[a.tree.num_levels() - 1],
+      (long)a.coarse_rest.rows());
   auto ma = make_model(a.dense), mb = make_model(b.dense);
   fcl::CollisionObjectd oa(ma, fcl::Transform3d::Identity()), ob(mb, fcl::Transform3d::Identity());
 
@@ -75,7 +78,8 @@ void run_scene(const std::string& file, int frames, int levels) {
   CollisionResult res;
   for (int frame = 0; frame < frames; ++frame) {
     const double t = 0.2 * frame;
-    const icd::MatX3d xa = deform(a.coarse_rest, 0.05, t), xb = deform(b.coarse_rest, 0.05, t + 1.0);
+    const icd::MatX3d xa = deform(a.coarse_rest, 0.05, t),
+                      xb = deform(b.coarse_rest, 0.05, t + 1.0);
     const icd::MatX3d Va = deform(a.dense.V, 0.05, t), Vb = deform(b.dense.V, 0.05, t + 1.0);
     const auto pa = to_points(Va), pb = to_points(Vb);
 
@@ -101,7 +105,8 @@ void run_scene(const std::string& file, int frames, int levels) {
     tests.push_back(static_cast<double>(res.tests));
     leaf_pairs.push_back(static_cast<double>(res.colliding.size()));
     t_literal.push_back(time_min3([&] {
-      collide(a.tree, b.tree, CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()), res);
+      collide(a.tree, b.tree,
+              CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()), res);
     }));
     t_fcl_first.push_back(time_min3([&] {
       fcl::CollisionRequestd req(1, false);
@@ -122,30 +127,34 @@ void run_scene(const std::string& file, int frames, int levels) {
     }));
     tri_pairs.push_back(static_cast<double>(np));
   }
-  const double upd = median(t_upd), refit = median(t_refit), fast = median(t_fast), all = median(t_fcl_all);
+  const double upd = median(t_upd), refit = median(t_refit), fast = median(t_fast),
+               all = median(t_fcl_all);
   const int spheres = a.tree.num_nodes() + b.tree.num_nodes();
   std::printf("%-52s %12s %10s\n", "operation (both objects), median over frames", "time", "ratio");
   std::printf("%-52s %10.1f us %10s\n", "ours: sphere update, paper ratio", 1e6 * upd, "1");
-  std::printf("%-52s %10.1f us %10.2f\n", "ours: sphere update, conservative bound", 1e6 * median(t_upd_cons),
-              median(t_upd_cons) / upd);
-  std::printf("%-52s %10.1f us %10.1f  (FCL / ours)\n", "FCL: refit BVHModel<AABBd> (replace + bottom-up)",
-              1e6 * refit, refit / upd);
+  std::printf("%-52s %10.1f us %10.2f\n", "ours: sphere update, conservative bound",
+              1e6 * median(t_upd_cons), median(t_upd_cons) / upd);
+  std::printf("%-52s %10.1f us %10.1f  (FCL / ours)\n",
+              "FCL: refit BVHModel<AABBd> (replace + bottom-up)", 1e6 * refit, refit / upd);
   std::printf("  update cost per sphere: %.1f ns\n", 1e9 * upd / spheres);
-  std::printf("%-52s %10.1f us %10s  (%.0f sphere tests, %.0f leaf pairs)\n", "ours: full traversal, fast path",
-              1e6 * fast, "1", median(tests), median(leaf_pairs));
-  std::printf("%-52s %10.1f us %10.2f\n", "ours: full traversal, literal Fig. 7", 1e6 * median(t_literal),
-              median(t_literal) / fast);
-  std::printf("%-52s %10.1f us %10.1f  (FCL / ours)\n", "FCL: collide, first contact", 1e6 * median(t_fcl_first),
-              median(t_fcl_first) / fast);
-  std::printf("%-52s %10.1f us %10.1f  (FCL / ours; %.0f contacts)\n", "FCL: collide, all contacts", 1e6 * all,
-              all / fast, median(fcl_contacts));
+  std::printf("%-52s %10.1f us %10s  (%.0f sphere tests, %.0f leaf pairs)\n",
+              "ours: full traversal, fast path", 1e6 * fast, "1", median(tests),
+              median(leaf_pairs));
+  std::printf("%-52s %10.1f us %10.2f\n", "ours: full traversal, literal Fig. 7",
+              1e6 * median(t_literal), median(t_literal) / fast);
+  std::printf("%-52s %10.1f us %10.1f  (FCL / ours)\n", "FCL: collide, first contact",
+              1e6 * median(t_fcl_first), median(t_fcl_first) / fast);
+  std::printf("%-52s %10.1f us %10.1f  (FCL / ours; %.0f contacts)\n", "FCL: collide, all contacts",
+              1e6 * all, all / fast, median(fcl_contacts));
   std::printf("%-52s %10.1f us %10.1f  (%.0f intersecting triangle pairs)\n",
-              "ours: exact reference (AABB refit + tri-tri)", 1e6 * median(t_aabb), median(t_aabb) / fast,
-              median(tri_pairs));
+              "ours: exact reference (AABB refit + tri-tri)", 1e6 * median(t_aabb),
+              median(t_aabb) / fast, median(tri_pairs));
   int agree = 0;
   for (std::size_t k = 0; k < tri_pairs.size(); ++k) agree += tri_pairs[k] == fcl_contacts[3 * k];
-  std::printf("  exact reference and FCL report the same number of intersecting triangle pairs in %d of %zu frames\n",
-              agree, tri_pairs.size());
+  std::printf(
+      "  exact reference and FCL report the same number of intersecting triangle pairs in %d of "
+      "%zu frames\n",
+      agree, tri_pairs.size());
 }
 
 }  // namespace
@@ -153,8 +162,10 @@ void run_scene(const std::string& file, int frames, int levels) {
 int main(int argc, char** argv) {
   int frames = 20, levels = 4;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc) levels = std::atoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
+      frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc)
+      levels = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: %s [--frames N] [--levels L]\n", argv[0]);
       return 2;

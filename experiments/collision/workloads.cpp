@@ -19,8 +19,8 @@ std::string data_path(const std::string& file) {
 
 namespace {
 
-Object finish(std::string name, SurfaceMesh m, const Eigen::Vector3d& center, double target_side, int levels,
-              int coarse_nodes) {
+Object finish(std::string name, SurfaceMesh m, const Eigen::Vector3d& center, double target_side,
+              int levels, int coarse_nodes) {
   const Eigen::RowVector3d lo = m.V.colwise().minCoeff(), hi = m.V.colwise().maxCoeff();
   const double s = target_side / (hi - lo).maxCoeff();
   const Eigen::RowVector3d mid = 0.5 * (lo + hi);
@@ -32,7 +32,8 @@ Object finish(std::string name, SurfaceMesh m, const Eigen::Vector3d& center, do
   std::vector<int> rows;
   for (int i = 0; i < o.dense.V.rows(); i += step) rows.push_back(i);
   o.coarse_rest.resize(static_cast<int>(rows.size()), 3);
-  for (std::size_t k = 0; k < rows.size(); ++k) o.coarse_rest.row(static_cast<int>(k)) = o.dense.V.row(rows[k]);
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    o.coarse_rest.row(static_cast<int>(k)) = o.dense.V.row(rows[k]);
   OctreeTreeOptions opt;
   opt.levels = levels;
   o.tree = build_octree_tree(o.dense.V, o.dense.F, opt);
@@ -45,12 +46,15 @@ Object finish(std::string name, SurfaceMesh m, const Eigen::Vector3d& center, do
 
 }  // namespace
 
-Object load_object(const std::string& file, const Eigen::Vector3d& center, int levels, int coarse_nodes) {
+Object load_object(const std::string& file, const Eigen::Vector3d& center, int levels,
+                   int coarse_nodes) {
   return finish(file, read_surface_mesh(data_path(file)), center, 2.0, levels, coarse_nodes);
 }
 
-Object icosphere_object(int subdivisions, double radius, const Eigen::Vector3d& center, int levels) {
-  return finish("icosphere", make_icosphere(subdivisions, radius), center, 2.0 * radius, levels, 800);
+Object icosphere_object(int subdivisions, double radius, const Eigen::Vector3d& center,
+                        int levels) {
+  return finish("icosphere", make_icosphere(subdivisions, radius), center, 2.0 * radius, levels,
+                800);
 }
 
 MatX3d deform(const MatX3d& X, double amplitude, double t) {
@@ -67,7 +71,8 @@ double median(std::vector<double> v) { return quantile(std::move(v), 0.5); }
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return NAN;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * v.size())) - (q > 0 ? 1 : 0));
+  const std::size_t k =
+      std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * v.size())) - (q > 0 ? 1 : 0));
   std::nth_element(v.begin(), v.begin() + k, v.end());
   return v[k];
 }

@@ -21,7 +21,8 @@ struct Object {
 /// scales it so its longest bounding-box side is 2 and centres it at `center`,
 /// builds an octree tree with `levels` levels and associates ~`coarse_nodes`
 /// coarse nodes (every k-th vertex). Throws InputError if the file is missing.
-Object load_object(const std::string& file, const Eigen::Vector3d& center, int levels, int coarse_nodes = 800);
+Object load_object(const std::string& file, const Eigen::Vector3d& center, int levels,
+                   int coarse_nodes = 800);
 
 /// A deep-tree object from an icosphere (for long traversals).
 Object icosphere_object(int subdivisions, double radius, const Eigen::Vector3d& center, int levels);

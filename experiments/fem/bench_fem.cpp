@@ -49,9 +49,9 @@ Material material(int model) {
 }
 
 void set_per_tet(benchmark::State& state, long tets, double evaluations_per_iteration = 1) {
-  state.counters["per_tet"] = benchmark::Counter(static_cast<double>(tets) * evaluations_per_iteration,
-                                                 benchmark::Counter::kIsIterationInvariantRate |
-                                                     benchmark::Counter::kInvert);
+  state.counters["per_tet"] = benchmark::Counter(
+      static_cast<double>(tets) * evaluations_per_iteration,
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["tets"] = static_cast<double>(tets);
 }
 
@@ -60,10 +60,12 @@ void BM_Forces(benchmark::State& state) {
   const TetMesh m = bar(static_cast<int>(state.range(1)));
   ForceOptions fo;
   fo.num_threads = static_cast<int>(state.range(2));
-  ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(state.range(0))), fo);
+  ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(state.range(0))),
+                       fo);
   // A mildly deformed state (so corotational needs real polar iterations).
   MatX3d x = m.V;
-  for (int i = 0; i < x.rows(); ++i) x(i, 2) += 0.05 * x(i, 0) * x(i, 0) + 0.001 * std::sin(37.0 * i);
+  for (int i = 0; i < x.rows(); ++i)
+    x(i, 2) += 0.05 * x(i, 0) * x(i, 0) + 0.001 * std::sin(37.0 * i);
   MatX3d f(x.rows(), 3);
   for (auto _ : state) {
     forces.compute(x, f);
@@ -88,15 +90,22 @@ void BM_Step(benchmark::State& state) {
   model.set_fixed_nodes(fixed);
   State s{m.V, MatX3d::Zero(m.V.rows(), 3)};
   const double omega = estimate_max_frequency(model, s.x, {}).omega_max;
-  const double h = integ == Integrator::BackwardEuler ? 1.0 / 60
-                                                      : 0.9 * stable_step_limit(integ, omega, model.damping());
+  const double h = integ == Integrator::BackwardEuler
+                       ? 1.0 / 60
+                       : 0.9 * stable_step_limit(integ, omega, model.damping());
   ExplicitStepper ex;
   BackwardEulerStepper be;
   for (auto _ : state) {
     switch (integ) {
-      case Integrator::RK4: ex.rk4(model, s, h); break;
-      case Integrator::SymplecticEuler: ex.symplectic_euler(model, s, h); break;
-      case Integrator::BackwardEuler: be.step(model, s, h); break;
+      case Integrator::RK4:
+        ex.rk4(model, s, h);
+        break;
+      case Integrator::SymplecticEuler:
+        ex.symplectic_euler(model, s, h);
+        break;
+      case Integrator::BackwardEuler:
+        be.step(model, s, h);
+        break;
     }
     benchmark::DoNotOptimize(s.x.data());
   }
@@ -130,7 +139,8 @@ void BM_ForcesOrdering(benchmark::State& state) {
     m.V = r.V;
     m.T = r.T;
   }
-  ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(MaterialModel::StVK)));
+  ElasticForces forces(make_tet_mesh_data(m.V, m.T),
+                       material(static_cast<int>(MaterialModel::StVK)));
   MatX3d x = m.V;
   for (int i = 0; i < x.rows(); ++i) x(i, 2) += 0.05 * x(i, 0) * x(i, 0);
   MatX3d f(x.rows(), 3);
@@ -139,7 +149,9 @@ void BM_ForcesOrdering(benchmark::State& state) {
     benchmark::DoNotOptimize(f.data());
     benchmark::ClobberMemory();
   }
-  state.SetLabel(state.range(0) == 0 ? "generator order" : state.range(0) == 1 ? "shuffled" : "shuffled + RCM");
+  state.SetLabel(state.range(0) == 0   ? "generator order"
+                 : state.range(0) == 1 ? "shuffled"
+                                       : "shuffled + RCM");
   set_per_tet(state, m.T.rows());
   state.counters["bandwidth"] = node_bandwidth(m.T);
 }
@@ -182,7 +194,10 @@ void BM_ForcesAsset(benchmark::State& state) {
   set_per_tet(state, m.T.rows());
   state.counters["bandwidth"] = node_bandwidth(m.T);
 }
-BENCHMARK(BM_ForcesAsset)->ArgsProduct({{0, 1, 2, 3}, {0, 1}})->ArgNames({"model", "asset"})->MinTime(0.2);
+BENCHMARK(BM_ForcesAsset)
+    ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})
+    ->ArgNames({"model", "asset"})
+    ->MinTime(0.2);
 
 // Args: kind (0 compute, 1 compute_with_health, 2 health, 3 differential, 4
 // compute_with_orientation_check), model; the ~4k-tet bar.
@@ -198,21 +213,33 @@ void BM_Kernels(benchmark::State& state) {
   const TetMesh m = bar(1);
   ElasticForces forces(make_tet_mesh_data(m.V, m.T), material(static_cast<int>(state.range(1))));
   MatX3d x = m.V;
-  for (int i = 0; i < x.rows(); ++i) x(i, 2) += 0.05 * x(i, 0) * x(i, 0) + 0.001 * std::sin(37.0 * i);
+  for (int i = 0; i < x.rows(); ++i)
+    x(i, 2) += 0.05 * x(i, 0) * x(i, 0) + 0.001 * std::sin(37.0 * i);
   const MatX3d dx = MatX3d::Constant(x.rows(), 3, 1e-3);
   MatX3d f(x.rows(), 3);
   for (auto _ : state) {
     switch (kind) {
-      case 0: forces.compute(x, f); break;
-      case 1: benchmark::DoNotOptimize(forces.compute_with_health(x, f)); break;
-      case 2: benchmark::DoNotOptimize(forces.health(x)); break;
-      case 3: forces.differential(x, dx, f); break;
-      case 4: benchmark::DoNotOptimize(forces.compute_with_orientation_check(x, f)); break;
+      case 0:
+        forces.compute(x, f);
+        break;
+      case 1:
+        benchmark::DoNotOptimize(forces.compute_with_health(x, f));
+        break;
+      case 2:
+        benchmark::DoNotOptimize(forces.health(x));
+        break;
+      case 3:
+        forces.differential(x, dx, f);
+        break;
+      case 4:
+        benchmark::DoNotOptimize(forces.compute_with_orientation_check(x, f));
+        break;
     }
     benchmark::DoNotOptimize(f.data());
     benchmark::ClobberMemory();
   }
-  const char* names[5] = {"forces", "forces + health", "health", "differential", "forces + orientation"};
+  const char* names[5] = {"forces", "forces + health", "health", "differential",
+                          "forces + orientation"};
   state.SetLabel(std::string(names[kind]) + " " + to_string(forces.material().model) + " " +
                  lanes::to_string(isa));
   lanes::set_lane_isa(before);
@@ -234,7 +261,10 @@ BENCHMARK(BM_Forces)
     ->ArgNames({"model", "mesh", "threads"})
     ->MinTime(0.2)
     ->UseRealTime();
-BENCHMARK(BM_Step)->ArgsProduct({{0, 1, 2}, {0, 1, 2}})->ArgNames({"integrator", "mesh"})->MinTime(0.2);
+BENCHMARK(BM_Step)
+    ->ArgsProduct({{0, 1, 2}, {0, 1, 2}})
+    ->ArgNames({"integrator", "mesh"})
+    ->MinTime(0.2);
 
 }  // namespace
 

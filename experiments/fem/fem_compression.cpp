@@ -34,11 +34,14 @@ double lateral_stress(const Material& mat, double a, double c) {
   const Lame l = lame_parameters(mat);
   const Eigen::Matrix3d F = Eigen::Vector3d(a, a, c).asDiagonal();
   switch (mat.model) {
-    case MaterialModel::Linear: return LinearLaw{l.mu, l.lambda}.stress(F)(0, 0);
+    case MaterialModel::Linear:
+      return LinearLaw{l.mu, l.lambda}.stress(F)(0, 0);
     case MaterialModel::Corotational:
       return CorotationalLaw{l.mu, l.lambda}.stress(F, Eigen::Matrix3d::Identity())(0, 0);
-    case MaterialModel::StVK: return StVKLaw{l.mu, l.lambda}.stress(F)(0, 0);
-    case MaterialModel::StableNeoHookean: return StableNeoHookeanLaw{l.mu, l.lambda}.stress(F)(0, 0);
+    case MaterialModel::StVK:
+      return StVKLaw{l.mu, l.lambda}.stress(F)(0, 0);
+    case MaterialModel::StableNeoHookean:
+      return StableNeoHookeanLaw{l.mu, l.lambda}.stress(F)(0, 0);
   }
   return 0;
 }
@@ -86,15 +89,16 @@ int main(int argc, char** argv) {
   const TetMesh m = make_box_tet_mesh(bo);
   char line[512];
   std::snprintf(line, sizeof line,
-                "free cube 0.3 m, %ld tets, %ld dofs, E = 1e6 Pa, F = diag(a, a, 0.3); omega ratios compressed/rest "
+                "free cube 0.3 m, %ld tets, %ld dofs, E = 1e6 Pa, F = diag(a, a, 0.3); omega "
+                "ratios compressed/rest "
                 "by a dense generalized eigensolver (reference) and Lanczos (ours, cold start)\n",
                 static_cast<long>(m.T.rows()), static_cast<long>(3 * m.V.rows()));
   emit(line);
-  std::snprintf(line, sizeof line, "%-19s %5s %-10s %7s %10s %10s %10s %13s %13s\n", "material", "nu", "case", "a",
-                "dense", "Lanczos", "bound", "Lanczos/dense", "bound/dense");
+  std::snprintf(line, sizeof line, "%-19s %5s %-10s %7s %10s %10s %10s %13s %13s\n", "material",
+                "nu", "case", "a", "dense", "Lanczos", "bound", "Lanczos/dense", "bound/dense");
   emit(line);
-  const MaterialModel models[4] = {MaterialModel::Linear, MaterialModel::Corotational, MaterialModel::StVK,
-                                   MaterialModel::StableNeoHookean};
+  const MaterialModel models[4] = {MaterialModel::Linear, MaterialModel::Corotational,
+                                   MaterialModel::StVK, MaterialModel::StableNeoHookean};
   double worst = 0;
   for (MaterialModel mm : models)
     for (double nu : {0.3, 0.45, 0.49}) {
@@ -116,14 +120,17 @@ int main(int argc, char** argv) {
         const FrequencyEstimate est = estimate_max_frequency(model, x, {});
         const double diff = est.omega_max / dense - 1;
         worst = std::max(worst, std::abs(diff));
-        std::snprintf(line, sizeof line, "%-19s %5.2f %-10s %7.4f %9.3fx %9.3fx %9.3fx %+13.1e %+13.1e%s\n",
-                      to_string(mm), nu, names[k], stretch[k], dense / rest_dense, est.omega_max / rest_lanczos,
-                      est.omega_bound / rest_lanczos, diff, est.omega_bound / dense - 1,
+        std::snprintf(line, sizeof line,
+                      "%-19s %5.2f %-10s %7.4f %9.3fx %9.3fx %9.3fx %+13.1e %+13.1e%s\n",
+                      to_string(mm), nu, names[k], stretch[k], dense / rest_dense,
+                      est.omega_max / rest_lanczos, est.omega_bound / rest_lanczos, diff,
+                      est.omega_bound / dense - 1,
                       est.converged ? "" : " (60 iterations, not converged to 1e-5)");
         emit(line);
       }
     }
-  std::snprintf(line, sizeof line, "largest |Lanczos / dense - 1| over all compressed states: %.1e\n", worst);
+  std::snprintf(line, sizeof line,
+                "largest |Lanczos / dense - 1| over all compressed states: %.1e\n", worst);
   emit(line);
   if (out) std::fclose(out);
   return 0;

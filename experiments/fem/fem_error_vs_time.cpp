@@ -65,7 +65,8 @@ double static_tip(int r, MaterialModel mm) {
   MatX3d x = model.mesh().rest_positions;
   StaticSolver solver;
   const NewtonReport rep = solver.solve(model, x);
-  if (!rep.converged) std::fprintf(stderr, "warning: static r=%d %s did not converge\n", r, to_string(mm));
+  if (!rep.converged)
+    std::fprintf(stderr, "warning: static r=%d %s did not converge\n", r, to_string(mm));
   return tip(model, x);
 }
 
@@ -75,10 +76,13 @@ int main(int argc, char** argv) {
   std::string out = "fem_error_vs_time.csv";
   bool quick = false;
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--quick") == 0) quick = true;
-    else out = argv[i];
+    if (std::strcmp(argv[i], "--quick") == 0)
+      quick = true;
+    else
+      out = argv[i];
   }
-  const double G = kYoung / (2 * (1 + kPoisson)), A = 0.01, I = 1e-4 / 12, q = kDensity * kGravity * A;
+  const double G = kYoung / (2 * (1 + kPoisson)), A = 0.01, I = 1e-4 / 12,
+               q = kDensity * kGravity * A;
   const double kappa = 10 * (1 + kPoisson) / (12 + 11 * kPoisson);
   const double delta = -(q / (8 * kYoung * I) + q / (2 * kappa * G * A));  // L = 1
   const double f1 = 1.8751 * 1.8751 / (2 * M_PI) * std::sqrt(kYoung * I / (kDensity * A));
@@ -90,18 +94,20 @@ int main(int argc, char** argv) {
   const double sim_time = 0.4;
 
   const std::vector<int> levels = quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 4};
-  const std::vector<MaterialModel> models{MaterialModel::Linear, MaterialModel::Corotational, MaterialModel::StVK,
-                                          MaterialModel::StableNeoHookean};
-  const std::vector<Integrator> integrators{Integrator::RK4, Integrator::SymplecticEuler, Integrator::BackwardEuler};
+  const std::vector<MaterialModel> models{MaterialModel::Linear, MaterialModel::Corotational,
+                                          MaterialModel::StVK, MaterialModel::StableNeoHookean};
+  const std::vector<Integrator> integrators{Integrator::RK4, Integrator::SymplecticEuler,
+                                            Integrator::BackwardEuler};
 
   std::ofstream csv(out);
   csv << "tets,r,material,integrator,step_s,substeps,sim_time_s,wall_s,wall_per_sim_s,tip_m,"
-         "analytic_tip_m,fine_static_tip_m,same_mesh_static_tip_m,err_analytic,err_fine_static,err_same_mesh_static\n";
+         "analytic_tip_m,fine_static_tip_m,same_mesh_static_tip_m,err_analytic,err_fine_static,err_"
+         "same_mesh_static\n";
   std::printf("Timoshenko tip %.6e m, beam f1 %.3f Hz\n", delta, f1);
   for (MaterialModel mm : models) {
     const double fine = static_tip(8, mm);
-    std::printf("%s: fine (30720 tets) static tip %.6e m (%.2f%% from Timoshenko)\n", to_string(mm), fine,
-                100 * std::abs(fine / delta - 1));
+    std::printf("%s: fine (30720 tets) static tip %.6e m (%.2f%% from Timoshenko)\n", to_string(mm),
+                fine, 100 * std::abs(fine / delta - 1));
     for (int r : levels) {
       const double same = static_tip(r, mm);
       for (Integrator integ : integrators) {
@@ -118,17 +124,20 @@ int main(int argc, char** argv) {
           substeps += rep.substeps;
           step = rep.step;
         }
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double wall =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const double t = tip(sim.model(), sim.positions());
         const long tets = sim.model().mesh().num_tets();
-        csv << tets << ',' << r << ',' << to_string(mm) << ',' << to_string(integ) << ',' << step << ','
-            << substeps << ',' << sim_time << ',' << wall << ',' << wall / sim_time << ',' << t << ',' << delta
-            << ',' << fine << ',' << same << ',' << std::abs(t / delta - 1) << ',' << std::abs(t / fine - 1) << ','
-            << std::abs(t / same - 1) << '\n';
+        csv << tets << ',' << r << ',' << to_string(mm) << ',' << to_string(integ) << ',' << step
+            << ',' << substeps << ',' << sim_time << ',' << wall << ',' << wall / sim_time << ','
+            << t << ',' << delta << ',' << fine << ',' << same << ',' << std::abs(t / delta - 1)
+            << ',' << std::abs(t / fine - 1) << ',' << std::abs(t / same - 1) << '\n';
         csv.flush();
-        std::printf("  %6ld tets %-18s %-16s step %.2e s  wall/sim %.3f  err analytic %.4f  fine %.4f  same-mesh %.2e\n",
-                    tets, to_string(mm), to_string(integ), step, wall / sim_time, std::abs(t / delta - 1),
-                    std::abs(t / fine - 1), std::abs(t / same - 1));
+        std::printf(
+            "  %6ld tets %-18s %-16s step %.2e s  wall/sim %.3f  err analytic %.4f  fine %.4f  "
+            "same-mesh %.2e\n",
+            tets, to_string(mm), to_string(integ), step, wall / sim_time, std::abs(t / delta - 1),
+            std::abs(t / fine - 1), std::abs(t / same - 1));
         std::fflush(stdout);
       }
     }

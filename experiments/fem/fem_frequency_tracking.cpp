@@ -42,8 +42,10 @@ int main() {
   };
   const Config configs[] = {{1, 4, 1e-5}, {1, 4, 1e-2}, {1, 6, 1e-3}, {2, 5, 1e-3},
                             {3, 4, 1e-2}, {3, 5, 1e-3}, {3, 6, 1e-3}, {3, 8, 1e-4}};
-  std::printf("bar 3840 tets, RK4, %d frames of 1/60 s; omega bound of the per-frame re-estimate vs converged\n",
-              frames);
+  std::printf(
+      "bar 3840 tets, RK4, %d frames of 1/60 s; omega bound of the per-frame re-estimate vs "
+      "converged\n",
+      frames);
   for (const Config& c : configs) {
     Model reference = clamped_stvk_model(m);
     SimulatorOptions so;
@@ -69,10 +71,12 @@ int main() {
         worst_frame = f;
       }
     }
-    std::printf("warm Ritz vectors %d, <= %d iterations, tolerance %.0e: %.2f products per frame, worst bound / "
-                "truth %.4f (frame %d); converged omega_max %.0f .. %.0f rad/s\n",
-                c.warm_modes, c.iterations, c.tolerance, static_cast<double>(products) / (frames - 1), worst,
-                worst_frame, lo, hi);
+    std::printf(
+        "warm Ritz vectors %d, <= %d iterations, tolerance %.0e: %.2f products per frame, worst "
+        "bound / "
+        "truth %.4f (frame %d); converged omega_max %.0f .. %.0f rad/s\n",
+        c.warm_modes, c.iterations, c.tolerance, static_cast<double>(products) / (frames - 1),
+        worst, worst_frame, lo, hi);
   }
   for (Integrator integ : {Integrator::RK4, Integrator::SymplecticEuler})
     for (double safety : {0.9, 0.95, 0.97, 1.0}) {
@@ -92,8 +96,8 @@ int main() {
       } catch (const std::exception& e) {
         outcome = std::string("stopped: ") + e.what();
       }
-      std::printf("%-17s safety %.2f (default re-estimate): %ld substeps, %d rollbacks, %s\n", to_string(integ),
-                  safety, substeps, retries, outcome.substr(0, 160).c_str());
+      std::printf("%-17s safety %.2f (default re-estimate): %ld substeps, %d rollbacks, %s\n",
+                  to_string(integ), safety, substeps, retries, outcome.substr(0, 160).c_str());
     }
   return 0;
 }

@@ -130,7 +130,8 @@ int main(int argc, char** argv) {
       {1, true, base, autom, "checks every step, baseline x86-64 lane loops"},
       {1, false, base, autom, "checks every step, baseline lane loops and exact products"},
       {1, true, best, EnergyCheck::Full,
-       "checks every step, EnergyCheck::Full (elastic energy and smallest det F summed in every check)"}};
+       "checks every step, EnergyCheck::Full (elastic energy and smallest det F summed in every "
+       "check)"}};
   const int nconfigs = sizeof(configs) / sizeof(configs[0]);
   const Integrator integs[2] = {Integrator::RK4, Integrator::SymplecticEuler};
   // Unit costs: one force evaluation with and without the fused health
@@ -196,9 +197,11 @@ int main(int argc, char** argv) {
   const double ntets = static_cast<double>(m.T.rows());
   std::printf(
       "unit CPU costs (medians over the repetitions of 3 x 100 calls): force evaluation %.1f "
-      "ns/tet, with the fused health check %.1f ns/tet, with the orientation check only %.1f ns/tet, "
+      "ns/tet, with the fused health check %.1f ns/tet, with the orientation check only %.1f "
+      "ns/tet, "
       "force differential %.1f ns/tet\n",
-      t_eval / ntets * 1e9, t_health / ntets * 1e9, t_orient / ntets * 1e9, t_product / ntets * 1e9);
+      t_eval / ntets * 1e9, t_health / ntets * 1e9, t_orient / ntets * 1e9,
+      t_product / ntets * 1e9);
   // Per simulated second: the sum over the 60 frames of each frame's median
   // over the repetitions; and the smallest per-second total of a repetition.
   double cpu_med[2][nconfigs], wall_med[2][nconfigs], cpu_min[2][nconfigs];
@@ -271,13 +274,16 @@ int main(int argc, char** argv) {
     const double lanczos = t.first_products * t_product + t.products * t_eval;
     const double total = cpu_med[k][0];
     std::printf(
-        "  %-17s %.3f s: force evaluations %.3f s (%.0f%%: %ld plain, %ld with the fused check, %ld "
+        "  %-17s %.3f s: force evaluations %.3f s (%.0f%%: %ld plain, %ld with the fused check, "
+        "%ld "
         "frame-end checks; the checks' share %.3f s), omega_max estimates %.3f s (%.0f%%: %ld cold "
-        "products, then %ld warm ones in 59 frames), rest %.3f s (%.0f%%: node passes, step control, "
+        "products, then %ld warm ones in 59 frames), rest %.3f s (%.0f%%: node passes, step "
+        "control, "
         "in-situ kernel slowdown)\n",
         to_string(integs[k]), total, evals, 100 * evals / total, plain, fused, end_checks,
-        fused * (t_orient - t_eval) + end_checks * (t_health - t_eval), lanczos, 100 * lanczos / total, t.first_products,
-        t.products, total - evals - lanczos, 100 * (total - evals - lanczos) / total);
+        fused * (t_orient - t_eval) + end_checks * (t_health - t_eval), lanczos,
+        100 * lanczos / total, t.first_products, t.products, total - evals - lanczos,
+        100 * (total - evals - lanczos) / total);
   }
   std::printf("load average after: %s\n", load_average().c_str());
   return 0;

@@ -14,7 +14,7 @@ namespace icd::experiments {
 /// Where run_to_contact() stopped.
 struct ContactMoment {
   int contact_frame = -1;  ///< first frame (0-based) where a sphere pair produced a force; -1: none
-  int last_frame = -1;     ///< the frame the world is at now (contact_frame + after, or the last run)
+  int last_frame = -1;  ///< the frame the world is at now (contact_frame + after, or the last run)
   std::vector<runner::FrameMetrics> frames;  ///< metrics of every frame run
 };
 

@@ -29,7 +29,8 @@ void usage() {
   std::printf(
       "usage: fig9 [--out DIR] [--scene FILE] [--budgets a,b,...] [--max-frames N] [--after N]\n"
       "  Default: experiments/scenes/bunny_dragon.json, critical times 1e-4,1e-3,1e-2,1e-1 s,\n"
-      "  3 frames after first contact (uninterrupted run). Writes DIR/budget_<t>/*.vtu and DIR/manifest.csv.\n");
+      "  3 frames after first contact (uninterrupted run). Writes DIR/budget_<t>/*.vtu and "
+      "DIR/manifest.csv.\n");
 }
 
 }  // namespace
@@ -41,11 +42,16 @@ int main(int argc, char** argv) {
   int max_frames = 200, after = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc) scene_path = argv[++i];
-    else if (a == "--budgets" && i + 1 < argc) budgets_text = argv[++i];
-    else if (a == "--max-frames" && i + 1 < argc) max_frames = std::stoi(argv[++i]);
-    else if (a == "--after" && i + 1 < argc) after = std::stoi(argv[++i]);
+    if (a == "--out" && i + 1 < argc)
+      out = argv[++i];
+    else if (a == "--scene" && i + 1 < argc)
+      scene_path = argv[++i];
+    else if (a == "--budgets" && i + 1 < argc)
+      budgets_text = argv[++i];
+    else if (a == "--max-frames" && i + 1 < argc)
+      max_frames = std::stoi(argv[++i]);
+    else if (a == "--after" && i + 1 < argc)
+      after = std::stoi(argv[++i]);
     else {
       usage();
       return a == "--help" || a == "-h" ? 0 : 2;
@@ -70,7 +76,8 @@ int main(int argc, char** argv) {
     {
       scene.collision.budget_seconds = *std::max_element(budgets.begin(), budgets.end());
       World reference(scene, cache, tools);
-      if (reference.plan().pairs.empty()) throw InputError(scene_path.string() + ": no collision pair");
+      if (reference.plan().pairs.empty())
+        throw InputError(scene_path.string() + ": no collision pair");
       int contact = -1;
       try {
         for (int f = 0; f < max_frames && (contact < 0 || f <= contact + after); ++f) {
@@ -80,11 +87,12 @@ int main(int argc, char** argv) {
       } catch (const std::exception& e) {
         // A simulation that fails after contact: draw its last completed frame.
         if (contact < 0) throw;
-        std::fprintf(stderr, "fig9: reference run failed after frame %d (drawing that frame): %s\n", frame,
-                     e.what());
+        std::fprintf(stderr, "fig9: reference run failed after frame %d (drawing that frame): %s\n",
+                     frame, e.what());
       }
       if (contact < 0)
-        throw InputError(scene_path.string() + ": no contact within " + std::to_string(max_frames) + " frames");
+        throw InputError(scene_path.string() + ": no contact within " + std::to_string(max_frames) +
+                         " frames");
     }
     for (double budget : budgets) {
       scene.collision.budget_seconds = budget;
@@ -111,7 +119,8 @@ int main(int argc, char** argv) {
       std::string objects, spheres;
       for (RuntimeObject& o : world.objects()) {
         const std::string name = o.spec.name + "_dense.vtu";
-        write_vtu_surface_mesh(out / dir / name, SurfaceMesh{experiments::dense_positions(o), o.asset.dense.F});
+        write_vtu_surface_mesh(out / dir / name,
+                               SurfaceMesh{experiments::dense_positions(o), o.asset.dense.F});
         objects += (objects.empty() ? "" : ";") + name;
       }
       // The first pair only (the paper's scenes have one).
@@ -124,10 +133,13 @@ int main(int argc, char** argv) {
       const FrameMetrics& m = cm.frames.back();
       manifest << budget << ',' << dir << ',' << scene.name << ',' << cm.contact_frame << ','
                << cm.last_frame << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests
-               << ',' << m.completed_level << ',' << objects << ',' << spheres << ',' << failure << '\n';
-      std::printf("%-14s budget %-7g contact frame %3d, drawn frame %3d: PAIRLIST %lld COLLISIONLIST %lld\n",
-                  scene.name.c_str(), budget, cm.contact_frame, cm.last_frame,
-                  static_cast<long long>(m.pair_list), static_cast<long long>(m.collision_list));
+               << ',' << m.completed_level << ',' << objects << ',' << spheres << ',' << failure
+               << '\n';
+      std::printf(
+          "%-14s budget %-7g contact frame %3d, drawn frame %3d: PAIRLIST %lld COLLISIONLIST "
+          "%lld\n",
+          scene.name.c_str(), budget, cm.contact_frame, cm.last_frame,
+          static_cast<long long>(m.pair_list), static_cast<long long>(m.collision_list));
       std::fflush(stdout);
     }
     write_file_atomically(out / "manifest.csv", manifest.str());

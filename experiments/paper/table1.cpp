@@ -27,25 +27,38 @@ struct PaperRow {
 };
 const std::map<std::string, std::map<double, PaperRow>> kPaper = {
     {"dragon_dragon",
-     {{1e-4, {3, 0, 60}}, {1e-3, {17, 0, 60}}, {1e-2, {30, 0, 42}}, {1e-1, {41, 6, 35}}, {1, {1345, 30, 25}}}},
+     {{1e-4, {3, 0, 60}},
+      {1e-3, {17, 0, 60}},
+      {1e-2, {30, 0, 42}},
+      {1e-1, {41, 6, 35}},
+      {1, {1345, 30, 25}}}},
     {"bunny_bunny",
-     {{1e-4, {3, 0, 52}}, {1e-3, {25, 0, 48}}, {1e-2, {44, 0, 37}}, {1e-1, {61, 11, 30}}, {1, {1405, 36, 22}}}},
+     {{1e-4, {3, 0, 52}},
+      {1e-3, {25, 0, 48}},
+      {1e-2, {44, 0, 37}},
+      {1e-1, {61, 11, 30}},
+      {1, {1405, 36, 22}}}},
     {"bunny_dragon",
-     {{1e-4, {3, 0, 56}}, {1e-3, {21, 0, 51}}, {1e-2, {33, 0, 42}}, {1e-1, {52, 12, 33}}, {1, {1387, 28, 23}}}},
+     {{1e-4, {3, 0, 56}},
+      {1e-3, {21, 0, 51}},
+      {1e-2, {33, 0, 42}},
+      {1e-1, {52, 12, 33}},
+      {1, {1387, 28, 23}}}},
 };
 
 struct Row {
   std::string scene;
   double budget = 0;
   int contact_frame = -1, measure_frame = -1;
-  FrameMetrics at;       // metrics of the measured frame
-  double fps = 0;        // frames per wall second over the contact window
+  FrameMetrics at;          // metrics of the measured frame
+  double fps = 0;           // frames per wall second over the contact window
   double collision_ms = 0;  // mean collision time per frame in the window
 };
 
 void usage() {
   std::printf(
-      "usage: table1 [--out DIR] [--scene FILE]... [--budgets a,b,...] [--max-frames N] [--after N]\n"
+      "usage: table1 [--out DIR] [--scene FILE]... [--budgets a,b,...] [--max-frames N] [--after "
+      "N]\n"
       "              [--paper-scale F]  (the paper's row at critical time x F sits beside ours)\n"
       "  Runs each scene once per critical time (default 1e-4,1e-3,1e-2,1e-1,1 s) and\n"
       "  records the list sizes N frames (--after, default 3) after first contact.\n"
@@ -83,7 +96,8 @@ int main(int argc, char** argv) {
   }
   if (scenes.empty())
     for (const char* s : {"dragon_dragon", "bunny_bunny", "bunny_dragon"})
-      scenes.push_back(fs::path(ICD_SOURCE_DIR) / "experiments/scenes" / (std::string(s) + ".json"));
+      scenes.push_back(fs::path(ICD_SOURCE_DIR) / "experiments/scenes" /
+                       (std::string(s) + ".json"));
   const fs::path cache = fs::path(ICD_SOURCE_DIR) / "assets";
   const fs::path tools = fs::canonical("/proc/self/exe").parent_path();
   std::vector<Row> rows;
@@ -123,10 +137,10 @@ int main(int argc, char** argv) {
           row.fps = n / wall;
           row.collision_ms = 1e3 * coll / n;
         }
-        std::printf("%-14s budget %-7g contact frame %3d: PAIRLIST %6lld COLLISIONLIST %5lld fps %6.1f\n",
-                    row.scene.c_str(), budget, row.contact_frame,
-                    static_cast<long long>(row.at.pair_list),
-                    static_cast<long long>(row.at.collision_list), row.fps);
+        std::printf(
+            "%-14s budget %-7g contact frame %3d: PAIRLIST %6lld COLLISIONLIST %5lld fps %6.1f\n",
+            row.scene.c_str(), budget, row.contact_frame, static_cast<long long>(row.at.pair_list),
+            static_cast<long long>(row.at.collision_list), row.fps);
         std::fflush(stdout);
         rows.push_back(row);
       }
@@ -153,8 +167,8 @@ int main(int argc, char** argv) {
         << r.at.pair_list << ',' << r.at.collision_list << ',' << r.fps << ',' << r.collision_ms
         << ',' << r.at.tests << ',' << r.at.interrupted << ',' << r.at.completed_level << ','
         << (p ? std::to_string(p->pair_list) : "") << ','
-        << (p ? std::to_string(p->collision_list) : "") << ','
-        << (p ? std::to_string(p->fps) : "") << '\n';
+        << (p ? std::to_string(p->collision_list) : "") << ',' << (p ? std::to_string(p->fps) : "")
+        << '\n';
     char fps[32];
     std::snprintf(fps, sizeof fps, "%.1f", r.fps);
     md << "| " << r.scene << " | " << r.budget << " | " << r.at.pair_list << " | "

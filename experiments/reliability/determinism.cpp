@@ -37,8 +37,8 @@ std::string slurp(const fs::path& p) {
 }
 
 // The columns of frames.csv that hold wall-clock times.
-const std::set<std::string> kWallColumns = {"wall", "fem", "links", "sphere_update", "collision",
-                                            "response"};
+const std::set<std::string> kWallColumns = {"wall",          "fem",       "links",
+                                            "sphere_update", "collision", "response"};
 
 // frames.csv without its wall-time columns.
 std::string strip_wall_columns(const std::string& csv) {
@@ -106,11 +106,16 @@ int main(int argc, char** argv) {
   fs::path out = fs::temp_directory_path() / "icd_determinism";
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i];
-    if (k == "--scene") scene_path = argv[i + 1];
-    else if (k == "--frames") frames = std::atoi(argv[i + 1]);
-    else if (k == "--budget-tests") budget = std::atoll(argv[i + 1]);
-    else if (k == "--vtu-every") vtu_every = std::atoi(argv[i + 1]);
-    else if (k == "--out") out = argv[i + 1];
+    if (k == "--scene")
+      scene_path = argv[i + 1];
+    else if (k == "--frames")
+      frames = std::atoi(argv[i + 1]);
+    else if (k == "--budget-tests")
+      budget = std::atoll(argv[i + 1]);
+    else if (k == "--vtu-every")
+      vtu_every = std::atoi(argv[i + 1]);
+    else if (k == "--out")
+      out = argv[i + 1];
     else {
       std::fprintf(stderr, "determinism: unknown argument %s\n", k.c_str());
       return 2;

@@ -30,12 +30,12 @@ using namespace icd;
 
 struct Case {
   std::string name;
-  std::string what;     // the documented expectation
+  std::string what;  // the documented expectation
   double left_x = -0.13, right_x = 0.13, speed = 0.6;
   std::string collision = R"("budget_tests": 2000)";
   bool fix_all_left = false;
   std::string model = "stvk";  // material of both balls
-  double kick_at_half = 0;  // m/s added to every left-ball node at the middle frame
+  double kick_at_half = 0;     // m/s added to every left-ball node at the middle frame
 };
 
 runner::Scene make_scene(const Case& c) {
@@ -161,7 +161,8 @@ int main(int argc, char** argv) {
   for (const Case& c : cases) {
     const Outcome o = run_case(c, frames);
     std::printf("%-29s %-10s %6d %12.4g %8d  %s\n", c.name.c_str(), o.status.c_str(), o.frames,
-                o.max_energy, o.contact_frames, o.message.empty() ? c.what.c_str() : o.message.c_str());
+                o.max_energy, o.contact_frames,
+                o.message.empty() ? c.what.c_str() : o.message.c_str());
     ok = ok && o.status != "FAILED";
   }
   return ok ? 0 : 1;

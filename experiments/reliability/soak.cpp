@@ -71,15 +71,25 @@ Args parse_args(int argc, char** argv) {
       std::exit(2);
     }
     const char* v = argv[++i];
-    if (k == "--frames") a.frames = std::atoi(v);
-    else if (k == "--every") a.every = std::max(1, std::atoi(v));
-    else if (k == "--budget-tests") { a.budget_tests = std::atoll(v); a.budget_given = true; }
-    else if (k == "--scene") a.scene = v;
-    else if (k == "--speed") a.speed = std::atof(v);
-    else if (k == "--energy-factor") a.energy_factor = std::atof(v);
-    else if (k == "--max-growth-mb") a.max_growth_mb = std::atof(v);
-    else if (k == "--csv") a.csv = v;
-    else if (k == "--relaunch") a.relaunch = std::max(0, std::atoi(v));
+    if (k == "--frames")
+      a.frames = std::atoi(v);
+    else if (k == "--every")
+      a.every = std::max(1, std::atoi(v));
+    else if (k == "--budget-tests") {
+      a.budget_tests = std::atoll(v);
+      a.budget_given = true;
+    } else if (k == "--scene")
+      a.scene = v;
+    else if (k == "--speed")
+      a.speed = std::atof(v);
+    else if (k == "--energy-factor")
+      a.energy_factor = std::atof(v);
+    else if (k == "--max-growth-mb")
+      a.max_growth_mb = std::atof(v);
+    else if (k == "--csv")
+      a.csv = v;
+    else if (k == "--relaunch")
+      a.relaunch = std::max(0, std::atoi(v));
     else {
       std::fprintf(stderr, "soak: unknown argument %s\n", k.c_str());
       std::exit(2);
@@ -189,16 +199,19 @@ int main(int argc, char** argv) {
       }
     }
     if (csv) std::fclose(csv);
-    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-    std::printf("soak: %d frames in %.1f s (%.1f fps), initial energy %.6g J, max energy ratio "
-                "%.4f (objects %.4f, with the penalty springs %.4f), %lld frames with contact, "
-                "%lld interrupted queries, RSS first window %.1f MB, max %.1f MB\n",
-                a.frames, total, a.frames / total, e0, max_object_ratio, max_object_ratio,
-                max_ratio, contact_frames, interrupted, rss_first, rss_max);
+    const double total =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    std::printf(
+        "soak: %d frames in %.1f s (%.1f fps), initial energy %.6g J, max energy ratio "
+        "%.4f (objects %.4f, with the penalty springs %.4f), %lld frames with contact, "
+        "%lld interrupted queries, RSS first window %.1f MB, max %.1f MB\n",
+        a.frames, total, a.frames / total, e0, max_object_ratio, max_object_ratio, max_ratio,
+        contact_frames, interrupted, rss_first, rss_max);
     if (a.relaunch > 0)
-      std::printf("soak: largest object energy within a launch / energy at its start: %.4f "
-                  "(launch at frame %d)\n",
-                  max_gain, worst_launch_frame);
+      std::printf(
+          "soak: largest object energy within a launch / energy at its start: %.4f "
+          "(launch at frame %d)\n",
+          max_gain, worst_launch_frame);
     if (max_gain > a.energy_factor) {
       std::fprintf(stderr, "soak: FAIL energy grew to %.4f x the energy at %s (limit %.4f)\n",
                    max_gain, a.relaunch > 0 ? "the start of its launch" : "the start",

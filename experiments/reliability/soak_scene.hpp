@@ -10,10 +10,10 @@ namespace icd::reliability {
 
 /// Options of the built-in repeated-contact scene.
 struct ContactBoxOptions {
-  int64_t budget_tests = 2000; ///< collision budget per pair query, sphere tests
-  double speed = 1.0;          ///< initial speed of the ball towards a wall, m/s
-  double stiffness = 2000;     ///< penalty stiffness, N/m
-  int cells = 4;               ///< coarse cells across the ball
+  int64_t budget_tests = 2000;  ///< collision budget per pair query, sphere tests
+  double speed = 1.0;           ///< initial speed of the ball towards a wall, m/s
+  double stiffness = 2000;      ///< penalty stiffness, N/m
+  int cells = 4;                ///< coarse cells across the ball
   std::string integrator = "rk4";
 };
 

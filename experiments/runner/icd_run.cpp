@@ -75,11 +75,14 @@ int main(int argc, char** argv) {
     for (const std::string& line : plan.describe(scene)) std::printf("  %s\n", line.c_str());
     const double fps = target_fps >= 0 ? target_fps : scene.target_fps;
     if (fps > 0)
-      std::printf("  real-time mode: %g frames per second; collision detection gets what is left of each frame\n", fps);
+      std::printf(
+          "  real-time mode: %g frames per second; collision detection gets what is left of each "
+          "frame\n",
+          fps);
     if (dry) return 0;
     icd::runner::RunOptions opt;
-    opt.out_dir = out.empty() ? std::filesystem::path("results") / scene.name
-                              : std::filesystem::path(out);
+    opt.out_dir =
+        out.empty() ? std::filesystem::path("results") / scene.name : std::filesystem::path(out);
     opt.cache_dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
     opt.tool_dir = std::filesystem::canonical("/proc/self/exe").parent_path();
     opt.frames = frames;

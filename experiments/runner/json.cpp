@@ -45,9 +45,8 @@ class Parser {
   }
 
   void skip_ws() {
-    while (m_pos < m_text.size() &&
-           (m_text[m_pos] == ' ' || m_text[m_pos] == '\t' || m_text[m_pos] == '\n' ||
-            m_text[m_pos] == '\r'))
+    while (m_pos < m_text.size() && (m_text[m_pos] == ' ' || m_text[m_pos] == '\t' ||
+                                     m_text[m_pos] == '\n' || m_text[m_pos] == '\r'))
       ++m_pos;
   }
 
@@ -147,24 +146,44 @@ class Parser {
       if (m_pos >= m_text.size()) break;
       const char e = m_text[m_pos++];
       switch (e) {
-        case '"': out.push_back('"'); break;
-        case '\\': out.push_back('\\'); break;
-        case '/': out.push_back('/'); break;
-        case 'b': out.push_back('\b'); break;
-        case 'f': out.push_back('\f'); break;
-        case 'n': out.push_back('\n'); break;
-        case 'r': out.push_back('\r'); break;
-        case 't': out.push_back('\t'); break;
+        case '"':
+          out.push_back('"');
+          break;
+        case '\\':
+          out.push_back('\\');
+          break;
+        case '/':
+          out.push_back('/');
+          break;
+        case 'b':
+          out.push_back('\b');
+          break;
+        case 'f':
+          out.push_back('\f');
+          break;
+        case 'n':
+          out.push_back('\n');
+          break;
+        case 'r':
+          out.push_back('\r');
+          break;
+        case 't':
+          out.push_back('\t');
+          break;
         case 'u': {
           if (m_pos + 4 > m_text.size()) fail("truncated \\u escape");
           unsigned code = 0;
           for (int k = 0; k < 4; ++k) {
             const char h = m_text[m_pos++];
             code <<= 4;
-            if (h >= '0' && h <= '9') code |= h - '0';
-            else if (h >= 'a' && h <= 'f') code |= h - 'a' + 10;
-            else if (h >= 'A' && h <= 'F') code |= h - 'A' + 10;
-            else fail("bad hex digit in \\u escape");
+            if (h >= '0' && h <= '9')
+              code |= h - '0';
+            else if (h >= 'a' && h <= 'f')
+              code |= h - 'a' + 10;
+            else if (h >= 'A' && h <= 'F')
+              code |= h - 'A' + 10;
+            else
+              fail("bad hex digit in \\u escape");
           }
           if (code >= 0xD800 && code <= 0xDFFF) fail("surrogate \\u escapes are not supported");
           // UTF-8 encode.
@@ -180,7 +199,9 @@ class Parser {
           }
           break;
         }
-        default: --m_pos; fail(std::string("bad escape '\\") + e + "'");
+        default:
+          --m_pos;
+          fail(std::string("bad escape '\\") + e + "'");
       }
     }
     fail("unterminated string");

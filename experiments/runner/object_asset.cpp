@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <map>
 #include <numbers>
+#include <sstream>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -126,10 +126,11 @@ void place_object(ObjectAsset& a, const ObjectSpec& spec) {
   const double longest = (hi - lo).maxCoeff();
   const double s = spec.size > 0 ? spec.size / longest : 1.0;
   const double d2r = std::numbers::pi / 180.0;
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(spec.rotation_deg.z() * d2r, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(spec.rotation_deg.y() * d2r, Eigen::Vector3d::UnitY()) *
-                             Eigen::AngleAxisd(spec.rotation_deg.x() * d2r, Eigen::Vector3d::UnitX()))
-                                .toRotationMatrix();
+  const Eigen::Matrix3d R =
+      (Eigen::AngleAxisd(spec.rotation_deg.z() * d2r, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(spec.rotation_deg.y() * d2r, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(spec.rotation_deg.x() * d2r, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   const Eigen::RowVector3d pos = spec.position.transpose();
   auto map_points = [&](MatX3d& P) {
     P = (((P.rowwise() - centre) * s) * R.transpose()).rowwise() + pos;
@@ -141,8 +142,7 @@ void place_object(ObjectAsset& a, const ObjectSpec& spec) {
   a.links.coeffs *= s;
   for (auto* spheres : {&a.spheres.spheres, &a.spheres.rest_spheres})
     for (collision::Sphere& sp : *spheres) {
-      const Eigen::Vector3d c =
-          R * ((sp.center() - centre.transpose()) * s) + spec.position;
+      const Eigen::Vector3d c = R * ((sp.center() - centre.transpose()) * s) + spec.position;
       sp = {c.x(), c.y(), c.z(), sp.r * s};
     }
   for (double& d : a.spheres.assoc_rest_dist) d *= s;
@@ -174,8 +174,7 @@ ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::pat
   char hash[17];
   std::snprintf(hash, sizeof hash, "%016llx",
                 static_cast<unsigned long long>(coupling::fnv1a64(key.data(), key.size())));
-  const std::filesystem::path folder =
-      cache_dir / (spec.mesh.stem().string() + "-" + hash);
+  const std::filesystem::path folder = cache_dir / (spec.mesh.stem().string() + "-" + hash);
   if (!std::filesystem::exists(folder / coupling::kBundleDataFile)) {
     const std::filesystem::path tool = tool_dir / "icd-preprocess";
     if (!std::filesystem::exists(tool))
@@ -185,8 +184,8 @@ ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::pat
     const std::filesystem::path tmp = folder.string() + ".part";
     std::filesystem::remove_all(tmp);
     std::filesystem::create_directories(cache_dir);
-    std::fprintf(stderr, "[icd] preprocessing %s (first use, cached in %s)\n",
-                 spec.mesh.c_str(), folder.c_str());
+    std::fprintf(stderr, "[icd] preprocessing %s (first use, cached in %s)\n", spec.mesh.c_str(),
+                 folder.c_str());
     std::ostringstream command;  // (a stream: GCC 12 warns falsely on long string sums)
     command << '"' << tool.string() << "\" \"" << spec.mesh.string() << "\" -o \"" << tmp.string()
             << "\" -q" << args.str();

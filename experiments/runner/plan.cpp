@@ -45,9 +45,8 @@ StagePlan make_plan(const Scene& scene) {
   plan.exact_reference = scene.output.exact_reference && !plan.pairs.empty();
   for (int i = 0; i < n; ++i) {
     const bool moves = scene.objects[i].kind != ObjectKind::Static;
-    plan.objects[i].dense_update =
-        moves && ((plan.vtu_output && scene.output.dense) ||
-                  (plan.exact_reference && plan.objects[i].sphere_tree));
+    plan.objects[i].dense_update = moves && ((plan.vtu_output && scene.output.dense) ||
+                                             (plan.exact_reference && plan.objects[i].sphere_tree));
   }
   return plan;
 }

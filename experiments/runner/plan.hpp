@@ -24,8 +24,8 @@ struct StagePlan {
   std::vector<ObjectPlan> objects;
   /// Object pairs whose collisions are detected (at least one moves).
   std::vector<std::pair<int, int>> pairs;
-  bool broad_phase = false;   ///< more than one candidate pair: cull by root spheres first
-  bool response = false;      ///< penalty forces onto deformable objects
+  bool broad_phase = false;  ///< more than one candidate pair: cull by root spheres first
+  bool response = false;     ///< penalty forces onto deformable objects
   bool exact_reference = false;
   bool vtu_output = false;
   /// Deepest sphere-tree level the queries can use (root = 0); the trees are

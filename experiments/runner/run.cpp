@@ -42,8 +42,8 @@ void write_frame_vtu(World& world, int frame, const std::filesystem::path& dir,
     for (size_t p = 0; p < world.plan().pairs.size(); ++p) {
       const auto [i, j] = world.plan().pairs[p];
       for (int side = 0; side < 2; ++side) {
-        const std::string name = objects[side ? j : i].spec.name + "_contact_spheres_pair" +
-                                 std::to_string(p) + suffix;
+        const std::string name =
+            objects[side ? j : i].spec.name + "_contact_spheres_pair" + std::to_string(p) + suffix;
         write_contact_spheres(world, p, side, dir / name);
         series[s].push_back({t, name});
         ++s;
@@ -91,14 +91,16 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
   csv.precision(9);
   csv << "frame,time,wall,fem,links,sphere_update,collision,response,budget,pair_list,"
          "collision_list,tests,interrupted,completed_level,active_pairs,max_penetration,"
-         "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened,limited\n";
+         "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened,"
+         "limited\n";
   for (const FrameMetrics& m : frames)
     csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
         << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
-        << ',' << m.budget << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests
-        << ',' << m.interrupted << ',' << m.completed_level << ',' << m.active_pairs << ','
-        << m.max_penetration << ',' << m.contact_force << ',' << m.cycles << ',' << m.substeps << ',' << m.min_step
-        << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback << ',' << m.reused << ',' << m.softened << ',' << m.limited << '\n';
+        << ',' << m.budget << ',' << m.pair_list << ',' << m.collision_list << ',' << m.tests << ','
+        << m.interrupted << ',' << m.completed_level << ',' << m.active_pairs << ','
+        << m.max_penetration << ',' << m.contact_force << ',' << m.cycles << ',' << m.substeps
+        << ',' << m.min_step << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback
+        << ',' << m.reused << ',' << m.softened << ',' << m.limited << '\n';
   return csv.str();
 }
 
@@ -161,10 +163,9 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   if (tty) std::fprintf(stderr, "\n");
 
   if (opt.log) {
-    std::fprintf(opt.log,
-                 "%-13s %7s %8s %8s %8s %8s %8s %9s %9s %6s %6s %7s\n", "frames", "fps", "fem%",
-                 "links%", "update%", "collide%", "respond%", "PAIRLIST", "COLLLIST", "intr.",
-                 "reused", "cycles");
+    std::fprintf(opt.log, "%-13s %7s %8s %8s %8s %8s %8s %9s %9s %6s %6s %7s\n", "frames", "fps",
+                 "fem%", "links%", "update%", "collide%", "respond%", "PAIRLIST", "COLLLIST",
+                 "intr.", "reused", "cycles");
     const int ranges = std::max(1, std::min(opt.summary_ranges, scene.frames));
     for (int r = 0; r < ranges; ++r) {
       const int a = r * scene.frames / ranges, b = (r + 1) * scene.frames / ranges;
@@ -197,9 +198,12 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   }
 
   if (opt.log && scene.target_fps > 0) {
-    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(opt.log, "real-time mode: target %.1f fps, held %.1f fps, %d of %d frames over their deadline\n",
-                 scene.target_fps, scene.frames / el, missed, scene.frames);
+    const double el =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(
+        opt.log,
+        "real-time mode: target %.1f fps, held %.1f fps, %d of %d frames over their deadline\n",
+        scene.target_fps, scene.frames / el, missed, scene.frames);
   }
   if (scene.output.csv) write_file_atomically(opt.out_dir / "frames.csv", metrics_csv(frames));
   if (scene.output.vtu_every > 0) {

@@ -11,14 +11,14 @@ namespace icd::runner {
 
 /// Options of run_scene().
 struct RunOptions {
-  std::filesystem::path out_dir;     ///< results folder (created); required
-  std::filesystem::path cache_dir;   ///< preprocessed assets cache
-  std::filesystem::path tool_dir;    ///< where icd-preprocess lives
-  int frames = -1;                   ///< override the scene's frame count (-1 = keep)
-  double target_fps = -1;            ///< override the scene's real-time target (-1 = keep, 0 = off)
-  bool progress = true;              ///< progress bar on stderr
-  int summary_ranges = 4;            ///< summary lines (frame ranges) printed at the end
-  std::FILE* log = stdout;           ///< where summaries go (nullptr = silent)
+  std::filesystem::path out_dir;    ///< results folder (created); required
+  std::filesystem::path cache_dir;  ///< preprocessed assets cache
+  std::filesystem::path tool_dir;   ///< where icd-preprocess lives
+  int frames = -1;                  ///< override the scene's frame count (-1 = keep)
+  double target_fps = -1;           ///< override the scene's real-time target (-1 = keep, 0 = off)
+  bool progress = true;             ///< progress bar on stderr
+  int summary_ranges = 4;           ///< summary lines (frame ranges) printed at the end
+  std::FILE* log = stdout;          ///< where summaries go (nullptr = silent)
 };
 
 /// Runs the scene and writes `<out_dir>/frames.csv` (and the VTU/PVD series

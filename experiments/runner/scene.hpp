@@ -31,18 +31,18 @@ enum class ObjectKind {
 /// A mesh generated in code (no preprocessing needed): dense icosphere or box
 /// surface on a structured coarse tet mesh.
 struct PrimitiveSpec {
-  std::string type = "sphere";  ///< "sphere" or "box"
-  double radius = 0.1;          ///< sphere radius, m
+  std::string type = "sphere";            ///< "sphere" or "box"
+  double radius = 0.1;                    ///< sphere radius, m
   Eigen::Vector3d extent{0.2, 0.2, 0.2};  ///< box sides, m
-  int subdivisions = 3;         ///< icosphere subdivisions of the dense surface
-  int cells = 4;                ///< coarse cells along the longest side
+  int subdivisions = 3;                   ///< icosphere subdivisions of the dense surface
+  int cells = 4;                          ///< coarse cells along the longest side
 };
 
 /// Off-line preprocessing options for a raw mesh (passed to icd-preprocess).
 struct PreprocessSpec {
-  int coarse_tets = 1500;     ///< target coarse tet count
-  int tree_depth = 3;         ///< sphere-tree levels below the root (paper: 3)
-  int tree_branching = 8;     ///< sphere tree branching factor
+  int coarse_tets = 1500;               ///< target coarse tet count
+  int tree_depth = 3;                   ///< sphere-tree levels below the root (paper: 3)
+  int tree_branching = 8;               ///< sphere tree branching factor
   std::string tree_builder = "medial";  ///< "medial" (adaptive medial axis) or "octree"
 };
 
@@ -84,10 +84,10 @@ struct CollisionSpec {
   double budget_seconds = 1e-3;  ///< critical time per pair query (s); inf = none
   int64_t budget_tests = -1;     ///< or a budget in sphere tests (deterministic); -1 = none
   collision::TraversalMode mode = collision::TraversalMode::BreadthFirstFifo;
-  bool literal = false;          ///< the paper's Fig. 7 literally (test on pop, clock every test)
+  bool literal = false;  ///< the paper's Fig. 7 literally (test on pop, clock every test)
   int clock_check_interval = 16;
   std::size_t max_list_size = 1 << 14;  ///< priority mode cap
-  int depth_cap = -1;            ///< -1 = none
+  int depth_cap = -1;                   ///< -1 = none
   bool temporal_coherence = false;
   /// After each update, grow parents to enclose their children (a layered
   /// tree): the penalty force then grows continuously from first contact.
@@ -125,10 +125,10 @@ struct CollisionSpec {
 
 /// What the run writes.
 struct OutputSpec {
-  bool csv = true;         ///< per-frame metrics, frames.csv
-  int vtu_every = 0;       ///< write meshes every N frames as a VTU/PVD series (0 = never)
-  bool dense = true;       ///< VTU output includes the dense meshes (needs the rigid links)
-  bool spheres = true;     ///< VTU output includes the spheres used for the response
+  bool csv = true;               ///< per-frame metrics, frames.csv
+  int vtu_every = 0;             ///< write meshes every N frames as a VTU/PVD series (0 = never)
+  bool dense = true;             ///< VTU output includes the dense meshes (needs the rigid links)
+  bool spheres = true;           ///< VTU output includes the spheres used for the response
   bool exact_reference = false;  ///< per frame, exact dense triangle contacts (needs dense meshes)
 };
 
@@ -138,7 +138,7 @@ struct Scene {
   int frames = 120;
   double frame_rate = 60;  ///< simulated frames per simulated second
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
-  double target_fps = 0;   ///< real-time mode: hold this wall-clock rate (0 = off)
+  double target_fps = 0;  ///< real-time mode: hold this wall-clock rate (0 = off)
   std::vector<ObjectSpec> objects;
   CollisionSpec collision;
   OutputSpec output;

@@ -92,8 +92,8 @@ World::World(const Scene& scene, const std::filesystem::path& cache_dir,
   // Node masses for the mass-weighted response; objects without FEM never
   // move under contact: infinite mass for the stability estimate.
   for (RuntimeObject& o : m_objects)
-    o.node_mass = o.sim ? o.sim->model().mass()
-                        : Eigen::VectorXd::Constant(o.rest.rows(), kImmovableMass);
+    o.node_mass =
+        o.sim ? o.sim->model().mass() : Eigen::VectorXd::Constant(o.rest.rows(), kImmovableMass);
   m_min_node_mass = std::numeric_limits<double>::infinity();
   for (const RuntimeObject& o : m_objects)
     if (o.sim) m_min_node_mass = std::min(m_min_node_mass, o.node_mass.minCoeff());
@@ -113,7 +113,8 @@ int World::contact_cycles(double dt) const {
   // rollback when they end in contact.)
   const double k = std::max(m_node_stiffness, m_scene.collision.contact.stiffness);
   const double omega = std::sqrt(k / m_min_node_mass);
-  return std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1, kMaxContactCycles);
+  return std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1,
+                    kMaxContactCycles);
 }
 
 void World::update_dense(RuntimeObject& o) {
@@ -127,8 +128,8 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
   //    forces), rigid motion for kinematic ones.
   for (RuntimeObject& o : m_objects) {
     if (o.plan.fem) {
-      const bool track_work = m_plan.response && m_scene.collision.passive &&
-                              m_passive_allowance >= 0;
+      const bool track_work =
+          m_plan.response && m_scene.collision.passive && m_passive_allowance >= 0;
       if (m_plan.response) o.sim->set_external_forces(o.contact_forces);
       // The forces are constant over the cycle: their work is f . x1 - f . x0.
       if (track_work) m_contact_work -= o.contact_forces.cwiseProduct(o.positions).sum();
@@ -155,8 +156,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
   // 3. Sphere trees follow the coarse nodes (paper 4.4).
   t0 = Clock::now();
   for (RuntimeObject& o : m_objects)
-    if (o.plan.sphere_update)
-    {
+    if (o.plan.sphere_update) {
       if (m_scene.collision.midpoint && o.sim && m_plan.response) {
         // Midpoint sampling: the forces of this query act during the next
         // cycle, so detect at the positions predicted for its middle.
@@ -178,9 +178,9 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
   }
   for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
     const auto [i, j] = m_plan.pairs[p];
-    collision::CollisionRequest req =
-        cs.literal ? collision::CollisionRequest::paper_reference(budget)
-                   : collision::CollisionRequest{};
+    collision::CollisionRequest req = cs.literal
+                                          ? collision::CollisionRequest::paper_reference(budget)
+                                          : collision::CollisionRequest{};
     req.budget_seconds = budget;
     req.budget_tests = cs.budget_tests;
     if (!cs.literal) {
@@ -243,8 +243,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
                             std::isfinite(m_complete_time[p]);
       // (relative slack: cycle end times are sums of h, the age of a
       // one-frame-old answer can exceed 1 / frame_rate by rounding)
-      const bool reuse =
-          previous && t_end - m_complete_time[p] <= cs.previous_max_age * (1 + 1e-9);
+      const bool reuse = previous && t_end - m_complete_time[p] <= cs.previous_max_age * (1 + 1e-9);
       if (previous && !reuse && m_complete_depth[p] > 0)
         co.max_untested_penetration = m_complete_depth[p];
       if (reuse) ++m.reused;
@@ -270,8 +269,8 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     if (m_node_stiffness > 0) {
       const double omega_h = std::sqrt(m_node_stiffness / m_min_node_mass) * h;
       if (omega_h > kContactOmegaLimit)
-        m_contact_scale = std::min(m_contact_scale, (kContactOmegaLimit / omega_h) *
-                                                        (kContactOmegaLimit / omega_h));
+        m_contact_scale = std::min(m_contact_scale,
+                                   (kContactOmegaLimit / omega_h) * (kContactOmegaLimit / omega_h));
     }
     if (m_contact_scale < 1 && m_node_stiffness > 0) {
       for (RuntimeObject& o : m_objects) o.contact_forces *= m_contact_scale;
@@ -285,7 +284,6 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     m.energy += m_penalty_energy;
     m.penalty_energy = m_penalty_energy;
   }
-
 }
 
 void World::limit_contact_work(double h, FrameMetrics& m) {
@@ -427,10 +425,10 @@ FrameMetrics World::finish_frame(FrameMetrics& m, Clock::time_point frame_start)
       const RuntimeObject& b = m_objects[j];
       const collision::AabbTree ta(a.dense, a.asset.dense.F);
       const collision::AabbTree tb(b.dense, b.asset.dense.F);
-      m.exact_contacts += static_cast<int>(
-          collision::intersecting_triangle_pairs(ta, a.dense, a.asset.dense.F, tb, b.dense,
-                                                 b.asset.dense.F)
-              .size());
+      m.exact_contacts +=
+          static_cast<int>(collision::intersecting_triangle_pairs(ta, a.dense, a.asset.dense.F, tb,
+                                                                  b.dense, b.asset.dense.F)
+                               .size());
     }
   }
 

@@ -25,7 +25,7 @@ struct StageTimes {
 /// Metrics of one frame (summed over object pairs where that makes sense).
 struct FrameMetrics {
   int frame = 0;
-  double time = 0;             ///< simulated time at the end of the frame, s
+  double time = 0;  ///< simulated time at the end of the frame, s
   StageTimes times;
   double wall = 0;             ///< wall time of the whole frame, s
   double budget = 0;           ///< collision budget given to each query, s (inf = none)
@@ -50,8 +50,8 @@ struct FrameMetrics {
   /// Cycles whose penalty forces were scaled down to keep the contact
   /// passive (collision.passive).
   int limited = 0;
-  int substeps = 0;            ///< FEM sub-steps summed over objects
-  double min_step = 0;         ///< smallest FEM step used, s
+  int substeps = 0;     ///< FEM sub-steps summed over objects
+  double min_step = 0;  ///< smallest FEM step used, s
   /// Mechanical energy of the deformable objects, J: kinetic + elastic +
   /// gravity potential, plus the energy in the penalty springs of the last
   /// response (contact forces are not counted as loads with a potential).
@@ -59,7 +59,7 @@ struct FrameMetrics {
   /// The part of `energy` held by the penalty springs of the last response, J
   /// (for an interrupted query, springs between coarse spheres assumed colliding).
   double penalty_energy = 0;
-  int exact_contacts = -1;     ///< exact intersecting dense triangle pairs (-1: not computed)
+  int exact_contacts = -1;  ///< exact intersecting dense triangle pairs (-1: not computed)
 };
 
 /// One object at run time.
@@ -68,13 +68,13 @@ struct RuntimeObject {
   ObjectPlan plan;
   ObjectAsset asset;
   std::unique_ptr<fem::Simulator> sim;  ///< deformable objects only (not movable: held by pointer)
-  MatX3d positions;       ///< current coarse positions (#V x 3)
-  MatX3d rest;            ///< rest coarse positions, placed in the scene
-  MatX3d contact_forces;  ///< forces from the last collision response (#V x 3)
-  MatX3d dense;           ///< current dense positions (when the plan updates them)
+  MatX3d positions;                     ///< current coarse positions (#V x 3)
+  MatX3d rest;                          ///< rest coarse positions, placed in the scene
+  MatX3d contact_forces;                ///< forces from the last collision response (#V x 3)
+  MatX3d dense;                         ///< current dense positions (when the plan updates them)
   coupling::LinkEvaluator links;  ///< the rigid links, grouped by node triple (when dense_update)
-  MatX3d predicted;       ///< coarse positions half a cycle ahead (collision.midpoint)
-  Eigen::VectorXd node_mass;  ///< lumped coarse node masses (kg); huge for objects without FEM
+  MatX3d predicted;               ///< coarse positions half a cycle ahead (collision.midpoint)
+  Eigen::VectorXd node_mass;      ///< lumped coarse node masses (kg); huge for objects without FEM
 };
 
 /// A scene being simulated.
@@ -162,7 +162,7 @@ class World {
   double m_contact_work = 0;
   /// Net energy the current episode may add, J (-1: no episode under way).
   double m_passive_allowance = -1;
-  Snapshot m_snapshot;          ///< reused storage for the single-cycle trial
+  Snapshot m_snapshot;  ///< reused storage for the single-cycle trial
   int m_frame = 0;
   double m_time = 0;
 };

@@ -412,11 +412,12 @@ int run(int argc, char** argv) {
       std::printf(
           "# %s worst split: %d splits in %d tries (%d merges; %d worst leaves with a full parent; "
           "relief band: %d without two better halves, %d without a merge; %d re-divided with a "
-          "sibling), %d spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d dirs) %.2f\n",
-          model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent,
-          w.relief_no_split, w.relief_no_merge, w.redivisions, w.measured,
-          options.worst_split.measure_directions, to_2000 * w.worst_before, to_2000 * w.worst_after,
-          options.worst_split.choice_directions, to_2000 * w.mean_before);
+          "sibling), %d spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d "
+          "dirs) %.2f\n",
+          model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent, w.relief_no_split,
+          w.relief_no_merge, w.redivisions, w.measured, options.worst_split.measure_directions,
+          to_2000 * w.worst_before, to_2000 * w.worst_after, options.worst_split.choice_directions,
+          to_2000 * w.mean_before);
     }
     std::printf("# %s allocation: largest worst child bound chosen per level (medial samples):",
                 model.name.c_str());

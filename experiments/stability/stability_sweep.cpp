@@ -84,7 +84,8 @@ std::vector<Case> make_cases(bool quick) {
     };
   };
   char buf[64];
-  for (double e : quick ? std::vector<double>{1e4, 1e9} : std::vector<double>{1e4, 1e5, 1e6, 1e7, 1e8, 1e9}) {
+  for (double e :
+       quick ? std::vector<double>{1e4, 1e9} : std::vector<double>{1e4, 1e5, 1e6, 1e7, 1e8, 1e9}) {
     std::snprintf(buf, sizeof buf, "E = %g Pa", e);
     cases.push_back({"young", buf, for_all([e](ObjectSpec& o) { o.material.young = e; }), 0});
   }
@@ -92,23 +93,26 @@ std::vector<Case> make_cases(bool quick) {
     std::snprintf(buf, sizeof buf, "nu = %g", nu);
     cases.push_back({"poisson", buf, for_all([nu](ObjectSpec& o) { o.material.poisson = nu; }), 0});
   }
-  for (double k : quick ? std::vector<double>{1e2, 1e6} : std::vector<double>{1e2, 1e3, 1e4, 1e5, 1e6}) {
+  for (double k :
+       quick ? std::vector<double>{1e2, 1e6} : std::vector<double>{1e2, 1e3, 1e4, 1e5, 1e6}) {
     std::snprintf(buf, sizeof buf, "k = %g N/m", k);
     cases.push_back({"penalty", buf, [k](Scene& s) { s.collision.contact.stiffness = k; }, 0});
   }
   for (double v : quick ? std::vector<double>{20} : std::vector<double>{2, 5, 10, 20}) {
     std::snprintf(buf, sizeof buf, "speed %g m/s each, head-on", v);
-    cases.push_back({"velocity", buf, [v](Scene& s) {
+    cases.push_back({"velocity", buf,
+                     [v](Scene& s) {
                        s.objects[0].velocity = Eigen::Vector3d(v, 0, 0);
                        s.objects[1].velocity = Eigen::Vector3d(-v, 0, 0);
                      },
                      0});
   }
   cases.push_back({"compression", "70 % along x, released", [](Scene&) {}, 0.7});
-  cases.push_back({"compression", "70 % along x, stable Neo-Hookean",
-                   for_all([](ObjectSpec& o) { o.material.model = fem::MaterialModel::StableNeoHookean; }), 0.7});
-  cases.push_back({"compression", "70 % along x, E = 1e7 Pa, nu = 0.45",
-                   for_all([](ObjectSpec& o) {
+  cases.push_back({"compression", "70 % along x, stable Neo-Hookean", for_all([](ObjectSpec& o) {
+                     o.material.model = fem::MaterialModel::StableNeoHookean;
+                   }),
+                   0.7});
+  cases.push_back({"compression", "70 % along x, E = 1e7 Pa, nu = 0.45", for_all([](ObjectSpec& o) {
                      o.material.young = 1e7;
                      o.material.poisson = 0.45;
                    }),
@@ -142,10 +146,13 @@ Outcome run_case(const Case& c, int frames, double max_seconds) {
   c.edit(scene);
   Outcome out;
   const auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   int total_substeps = 0, deformables = 0;
   try {
-    World world(scene, fs::path(ICD_SOURCE_DIR) / "assets", fs::canonical("/proc/self/exe").parent_path());
+    World world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
+                fs::canonical("/proc/self/exe").parent_path());
     for (const RuntimeObject& o : world.objects()) deformables += o.sim ? 1 : 0;
     if (c.compression > 0) {
       RuntimeObject& o = world.objects()[0];
@@ -225,40 +232,50 @@ int main(int argc, char** argv) {
   bool quick = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out = argv[++i];
-    else if (a == "--frames" && i + 1 < argc) frames = std::stoi(argv[++i]);
-    else if (a == "--max-seconds" && i + 1 < argc) max_seconds = std::stod(argv[++i]);
-    else if (a == "--quick") quick = true;
+    if (a == "--out" && i + 1 < argc)
+      out = argv[++i];
+    else if (a == "--frames" && i + 1 < argc)
+      frames = std::stoi(argv[++i]);
+    else if (a == "--max-seconds" && i + 1 < argc)
+      max_seconds = std::stod(argv[++i]);
+    else if (a == "--quick")
+      quick = true;
     else {
-      std::printf("usage: stability_sweep [--out DIR] [--frames N] [--max-seconds S] [--quick]\n"
-                  "  Runs every case for N frames (default 30 = 0.5 simulated second), at most S s of\n"
-                  "  wall time each (default 30); --quick runs the extreme cases only.\n");
+      std::printf(
+          "usage: stability_sweep [--out DIR] [--frames N] [--max-seconds S] [--quick]\n"
+          "  Runs every case for N frames (default 30 = 0.5 simulated second), at most S s of\n"
+          "  wall time each (default 30); --quick runs the extreme cases only.\n");
       return a == "--help" || a == "-h" ? 0 : 2;
     }
   }
   std::ostringstream csv, md;
   csv << "group,case,status,frames,min_step,mean_step,energy_initial,energy_end,energy_drift,"
          "max_energy_gain,max_penetration,fps,message\n";
-  md << "| group | case | status | frames | min step (s) | mean step (s) | energy drift | max energy gain | "
-        "max penetration (m) | frames/s | message |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  md << "| group | case | status | frames | min step (s) | mean step (s) | energy drift | max "
+        "energy gain | "
+        "max penetration (m) | frames/s | message "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   int failures = 0;
   for (const Case& c : make_cases(quick)) {
     const Outcome o = run_case(c, frames, max_seconds);
     failures += o.status != "stable";
     char line[512];
-    std::snprintf(line, sizeof line, "%-12s %-38s %-8s %3d frames, step min %.3g mean %.3g s, drift %+.3g, "
+    std::snprintf(line, sizeof line,
+                  "%-12s %-38s %-8s %3d frames, step min %.3g mean %.3g s, drift %+.3g, "
                   "gain %.3g, %.1f fps %s\n",
-                  c.group.c_str(), c.name.c_str(), o.status.c_str(), o.frames, o.min_step, o.mean_step, o.drift,
-                  o.max_gain, o.fps, o.message.c_str());
+                  c.group.c_str(), c.name.c_str(), o.status.c_str(), o.frames, o.min_step,
+                  o.mean_step, o.drift, o.max_gain, o.fps, o.message.c_str());
     std::fputs(line, stdout);
     std::fflush(stdout);
-    csv << c.group << ',' << csv_escape(c.name) << ',' << o.status << ',' << o.frames << ',' << o.min_step << ','
-        << o.mean_step << ',' << o.energy0 << ',' << o.energy_end << ',' << o.drift << ',' << o.max_gain << ','
-        << o.max_penetration << ',' << o.fps << ',' << csv_escape(o.message) << '\n';
+    csv << c.group << ',' << csv_escape(c.name) << ',' << o.status << ',' << o.frames << ','
+        << o.min_step << ',' << o.mean_step << ',' << o.energy0 << ',' << o.energy_end << ','
+        << o.drift << ',' << o.max_gain << ',' << o.max_penetration << ',' << o.fps << ','
+        << csv_escape(o.message) << '\n';
     char row[512];
-    std::snprintf(row, sizeof row, "| %s | %s | %s | %d | %.3g | %.3g | %+.3g | %.3g | %.3g | %.1f | %s |\n",
-                  c.group.c_str(), c.name.c_str(), o.status.c_str(), o.frames, o.min_step, o.mean_step, o.drift,
-                  o.max_gain, o.max_penetration, o.fps, md_escape(o.message).c_str());
+    std::snprintf(
+        row, sizeof row, "| %s | %s | %s | %d | %.3g | %.3g | %+.3g | %.3g | %.3g | %.1f | %s |\n",
+        c.group.c_str(), c.name.c_str(), o.status.c_str(), o.frames, o.min_step, o.mean_step,
+        o.drift, o.max_gain, o.max_penetration, o.fps, md_escape(o.message).c_str());
     md << row;
   }
   try {
@@ -269,6 +286,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "stability_sweep: %s\n", e.what());
     return 1;
   }
-  std::printf("%d of the cases not stable (see the table); results: %s\n", failures, fs::absolute(out).c_str());
+  std::printf("%d of the cases not stable (see the table); results: %s\n", failures,
+              fs::absolute(out).c_str());
   return 0;
 }

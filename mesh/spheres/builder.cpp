@@ -253,7 +253,9 @@ void exchange_across_leaves(const ReductionProblem& dense,
   for (size_t l = 0; l < levels.size(); ++l) {
     for (const Node& n : levels[l]) level_worst[l] = std::max(level_worst[l], n.sphere.error);
   }
-  auto accepts = [&](int leaf, int s) { return ancestors_cover(dense, levels, parent_of, leaf, s); };
+  auto accepts = [&](int leaf, int s) {
+    return ancestors_cover(dense, levels, parent_of, leaf, s);
+  };
   auto accepts_growing = [&](int leaf, int s) {
     int node = leaf;
     for (size_t l = last; l >= 1; --l) {

@@ -125,9 +125,7 @@ MeshOracle::MeshOracle(const SurfaceMesh& closed) : m_impl(std::make_unique<Impl
 
 MeshOracle::~MeshOracle() = default;
 
-double MeshOracle::distance(const Eigen::Vector3d& p) const {
-  return m_impl->bvh->distance(p);
-}
+double MeshOracle::distance(const Eigen::Vector3d& p) const { return m_impl->bvh->distance(p); }
 
 Eigen::Vector3d MeshOracle::closest_point(const Eigen::Vector3d& p) const {
   return m_impl->bvh->closest(p).point;

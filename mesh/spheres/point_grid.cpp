@@ -45,7 +45,8 @@ PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_ce
   for (size_t c = 0; c < num_cells; ++c) m_start[c + 1] += m_start[c];
   m_index.resize(n);
   std::vector<int> fill(m_start.begin(), m_start.end() - 1);
-  for (size_t i = 0; i < n; ++i) m_index[static_cast<size_t>(fill[cell[i]]++)] = static_cast<int>(i);
+  for (size_t i = 0; i < n; ++i)
+    m_index[static_cast<size_t>(fill[cell[i]]++)] = static_cast<int>(i);
 }
 
 size_t PointGrid::linear(int i, int j, int k) const {
@@ -68,9 +69,9 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
   if (m_points.empty() || !(radius >= 0)) return out;
   const Eigen::Vector3i lo =
       cell_of(center - Eigen::Vector3d::Constant(radius)).cwiseMax(Eigen::Vector3i::Zero());
-  const Eigen::Vector3i hi = cell_of(center + Eigen::Vector3d::Constant(radius))
-                                 .cwiseMin(Eigen::Vector3i(m_dims[0] - 1, m_dims[1] - 1,
-                                                           m_dims[2] - 1));
+  const Eigen::Vector3i hi =
+      cell_of(center + Eigen::Vector3d::Constant(radius))
+          .cwiseMin(Eigen::Vector3i(m_dims[0] - 1, m_dims[1] - 1, m_dims[2] - 1));
   const double r2 = radius * radius;
   for (int i = lo.x(); i <= hi.x(); ++i) {
     for (int j = lo.y(); j <= hi.y(); ++j) {

@@ -372,9 +372,9 @@ void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, Fi
   // Large member sets: the search runs on their extreme points along 162
   // directions (a slight underestimate of the farthest distance); the result
   // is refitted exactly and kept only when it beats the exact starting point.
-  const std::vector<Eigen::Vector3d> hull = sphere.members.size() > 20000
-                                                ? support_points(problem.points, sphere.members)
-                                                : extreme_points(problem.points, sphere.members, false);
+  const std::vector<Eigen::Vector3d> hull =
+      sphere.members.size() > 20000 ? support_points(problem.points, sphere.members)
+                                    : extreme_points(problem.points, sphere.members, false);
   FittedSphere start = sphere;
   refit_radius(problem, start);
   double gmax = 0;

@@ -54,7 +54,8 @@ int TriangleBvh::build(int begin, int end, int depth) {
   Eigen::Vector3d hi = -lo;
   for (int i = begin; i < end; ++i) {
     for (size_t k = 0; k < 3; ++k) {
-      const Eigen::Vector3d& q = m_corner[3 * static_cast<size_t>(m_order[static_cast<size_t>(i)]) + k];
+      const Eigen::Vector3d& q =
+          m_corner[3 * static_cast<size_t>(m_order[static_cast<size_t>(i)]) + k];
       lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
     }
   }

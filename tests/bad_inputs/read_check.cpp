@@ -24,8 +24,7 @@ int main(int argc, char** argv) {
                   b.spheres.num_nodes());
     } else {
       const icd::collision::SphereTree t = icd::collision::read_sph(path.string());
-      std::printf("%s: sphere tree, %d nodes, %d levels\n", argv[1], t.num_nodes(),
-                  t.num_levels());
+      std::printf("%s: sphere tree, %d nodes, %d levels\n", argv[1], t.num_nodes(), t.num_levels());
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "icd-read-check: %s\n", e.what());

@@ -21,12 +21,14 @@ using namespace icd::collision::testing;
 
 // Points of the true intersection of two dense surfaces: the hull vertices of
 // every intersecting triangle pair and the midpoints between them.
-std::vector<Eigen::Vector3d> contact_points(const MatX3d& Va, const MatX3i& Fa, const MatX3d& Vb, const MatX3i& Fb) {
+std::vector<Eigen::Vector3d> contact_points(const MatX3d& Va, const MatX3i& Fa, const MatX3d& Vb,
+                                            const MatX3i& Fb) {
   const AabbTree ta(Va, Fa), tb(Vb, Fb);
   std::vector<Eigen::Vector3d> pts;
   for (const auto& [f, g] : intersecting_triangle_pairs(ta, Va, Fa, tb, Vb, Fb)) {
-    const auto p = triangle_intersection_points(Va.row(Fa(f, 0)), Va.row(Fa(f, 1)), Va.row(Fa(f, 2)), Vb.row(Fb(g, 0)),
-                                                Vb.row(Fb(g, 1)), Vb.row(Fb(g, 2)));
+    const auto p =
+        triangle_intersection_points(Va.row(Fa(f, 0)), Va.row(Fa(f, 1)), Va.row(Fa(f, 2)),
+                                     Vb.row(Fb(g, 0)), Vb.row(Fb(g, 1)), Vb.row(Fb(g, 2)));
     for (std::size_t i = 0; i < p.size(); ++i) {
       pts.push_back(p[i]);
       for (std::size_t j = i + 1; j < p.size(); ++j) pts.push_back(0.5 * (p[i] + p[j]));
@@ -45,7 +47,8 @@ std::vector<int> nodes_containing(const SphereTree& t, const Eigen::Vector3d& p)
 }
 
 // Checks the guarantee for many test budgets and every traversal mode.
-void check_all_budgets(const SphereTree& a, const SphereTree& b, const std::vector<Eigen::Vector3d>& pts) {
+void check_all_budgets(const SphereTree& a, const SphereTree& b,
+                       const std::vector<Eigen::Vector3d>& pts) {
   ASSERT_GT(pts.size(), 20u);
   std::vector<std::vector<int>> in_a, in_b;
   for (const auto& p : pts) {
@@ -55,26 +58,31 @@ void check_all_budgets(const SphereTree& a, const SphereTree& b, const std::vect
     ASSERT_FALSE(in_b.back().empty());
   }
   std::vector<CollisionRequest> requests;
-  for (auto mode : {TraversalMode::BreadthFirstFifo, TraversalMode::DepthFirst, TraversalMode::Priority}) {
+  for (auto mode :
+       {TraversalMode::BreadthFirstFifo, TraversalMode::DepthFirst, TraversalMode::Priority}) {
     CollisionRequest r;
     r.mode = mode;
     r.max_list_size = 64;
     requests.push_back(r);
   }
-  requests.back().priority = PriorityKey::DeepestOverlap;  // the capped priority mode with both keys
+  requests.back().priority =
+      PriorityKey::DeepestOverlap;  // the capped priority mode with both keys
   requests.push_back(requests.back());
   requests.back().priority = PriorityKey::LargestSphere;
   requests.push_back(CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()));
   const int64_t full_tests = collide(a, b, CollisionRequest::paper_reference(INFINITY)).tests;
   int checked = 0, lossy_without_untested = 0;
   for (CollisionRequest r : requests) {
-    for (int64_t budget = 0; budget <= full_tests + 1; budget = budget < 40 ? budget + 1 : budget * 5 / 4) {
+    for (int64_t budget = 0; budget <= full_tests + 1;
+         budget = budget < 40 ? budget + 1 : budget * 5 / 4) {
       r.budget_tests = budget;
       const CollisionResult res = collide(a, b, r);
       std::unordered_set<uint64_t> leaf_pairs, reported;
-      for (const NodePair& p : res.colliding) leaf_pairs.insert((uint64_t(uint32_t(p.a)) << 32) | uint32_t(p.b));
+      for (const NodePair& p : res.colliding)
+        leaf_pairs.insert((uint64_t(uint32_t(p.a)) << 32) | uint32_t(p.b));
       reported = leaf_pairs;
-      for (const NodePair& p : res.untested) reported.insert((uint64_t(uint32_t(p.a)) << 32) | uint32_t(p.b));
+      for (const NodePair& p : res.untested)
+        reported.insert((uint64_t(uint32_t(p.a)) << 32) | uint32_t(p.b));
       auto covers = [&](const std::unordered_set<uint64_t>& set, std::size_t k) {
         for (int i : in_a[k])
           for (int j : in_b[k])
@@ -83,8 +91,9 @@ void check_all_budgets(const SphereTree& a, const SphereTree& b, const std::vect
       };
       bool leaves_alone_suffice = true;
       for (std::size_t k = 0; k < pts.size(); ++k) {
-        ASSERT_TRUE(covers(reported, k)) << "mode " << int(r.mode) << " budget " << budget << ": contact point "
-                                         << pts[k].transpose() << " under no reported pair";
+        ASSERT_TRUE(covers(reported, k))
+            << "mode " << int(r.mode) << " budget " << budget << ": contact point "
+            << pts[k].transpose() << " under no reported pair";
         leaves_alone_suffice = leaves_alone_suffice && covers(leaf_pairs, k);
       }
       // The check has teeth: when interrupted early, dropping the untested
@@ -102,7 +111,8 @@ TEST(Conservative, OverlappingIcospheresAtRest) {
   const SurfaceMesh b = translated(make_icosphere(3, 0.8), {1.2, 0.3, -0.2});
   OctreeTreeOptions o;
   o.levels = 4;
-  check_all_budgets(build_octree_tree(a.V, a.F, o), build_octree_tree(b.V, b.F, o), contact_points(a.V, a.F, b.V, b.F));
+  check_all_budgets(build_octree_tree(a.V, a.F, o), build_octree_tree(b.V, b.F, o),
+                    contact_points(a.V, a.F, b.V, b.F));
 }
 
 TEST(Conservative, OracleDetectsTreesThatStopCoveringTheSurface) {
@@ -132,12 +142,14 @@ TEST(Conservative, InterlockedToriAtRest) {
   const SurfaceMesh a = make_torus(1.0, 0.3, 32, 12);
   SurfaceMesh b = make_torus(1.0, 0.3, 32, 12);
   // Rotate b by 90 degrees about x and shift it so the tori interpenetrate.
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
   b.V = (b.V * R.transpose()).eval();
   b.V.rowwise() += Eigen::RowVector3d(1.9, 0.1, 0.05);  // b passes through a's tube
   OctreeTreeOptions o;
   o.levels = 4;
-  check_all_budgets(build_octree_tree(a.V, a.F, o), build_octree_tree(b.V, b.F, o), contact_points(a.V, a.F, b.V, b.F));
+  check_all_budgets(build_octree_tree(a.V, a.F, o), build_octree_tree(b.V, b.F, o),
+                    contact_points(a.V, a.F, b.V, b.F));
 }
 
 // A dense mesh steered by coarse nodes through convex weights (as linear
@@ -154,7 +166,8 @@ Deformable make_deformable(const SurfaceMesh& dense, const MatX3d& coarse) {
   Deformable d{dense, coarse, {0}, {}, {}, {}};
   for (int v = 0; v < dense.V.rows(); ++v) {
     std::vector<std::pair<double, int>> dist;
-    for (int j = 0; j < coarse.rows(); ++j) dist.push_back({(coarse.row(j) - dense.V.row(v)).norm(), j});
+    for (int j = 0; j < coarse.rows(); ++j)
+      dist.push_back({(coarse.row(j) - dense.V.row(v)).norm(), j});
     std::sort(dist.begin(), dist.end());
     double sum = 0;
     for (int k = 0; k < 4; ++k) sum += 1 / (dist[k].first + 1e-2);
@@ -175,7 +188,11 @@ MatX3d deform_coarse(const MatX3d& X, double amp, double phase, const Eigen::Vec
   MatX3d x = X;
   for (int i = 0; i < X.rows(); ++i) {
     const Eigen::Vector3d p = X.row(i).transpose();
-    x.row(i) = (p + amp * Eigen::Vector3d(std::sin(2 * p.y() + phase), 0.5 * std::cos(3 * p.z() - phase), std::sin(p.x() + p.y())) + shift).transpose();
+    x.row(i) = (p +
+                amp * Eigen::Vector3d(std::sin(2 * p.y() + phase),
+                                      0.5 * std::cos(3 * p.z() - phase), std::sin(p.x() + p.y())) +
+                shift)
+                   .transpose();
   }
   return x;
 }
@@ -183,7 +200,8 @@ MatX3d deform_coarse(const MatX3d& X, double amp, double phase, const Eigen::Vec
 MatX3d dense_positions(const Deformable& d, const MatX3d& x) {
   MatX3d V = d.dense.V;
   for (int v = 0; v < V.rows(); ++v)
-    for (int k = d.off[v]; k < d.off[v + 1]; ++k) V.row(v) += d.w[k] * (x.row(d.nodes[k]) - d.coarse.row(d.nodes[k]));
+    for (int k = d.off[v]; k < d.off[v + 1]; ++k)
+      V.row(v) += d.w[k] * (x.row(d.nodes[k]) - d.coarse.row(d.nodes[k]));
   return V;
 }
 

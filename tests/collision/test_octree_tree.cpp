@@ -32,18 +32,28 @@ std::vector<Eigen::Vector3d> surface_samples(const SurfaceMesh& m, int per_face,
   for (int f = 0; f < m.F.rows(); ++f)
     for (int k = 0; k < per_face; ++k) {
       double a = u(rng), b = u(rng);
-      if (a + b > 1) { a = 1 - a; b = 1 - b; }
+      if (a + b > 1) {
+        a = 1 - a;
+        b = 1 - b;
+      }
       // Include edges and corners explicitly every few samples.
-      if (k == 0) { a = 0; b = 0; }
-      if (k == 1) { a = 0.5; b = 0; }
-      pts.push_back((1 - a - b) * m.V.row(m.F(f, 0)).transpose() + a * m.V.row(m.F(f, 1)).transpose() +
-                    b * m.V.row(m.F(f, 2)).transpose());
+      if (k == 0) {
+        a = 0;
+        b = 0;
+      }
+      if (k == 1) {
+        a = 0.5;
+        b = 0;
+      }
+      pts.push_back((1 - a - b) * m.V.row(m.F(f, 0)).transpose() +
+                    a * m.V.row(m.F(f, 1)).transpose() + b * m.V.row(m.F(f, 2)).transpose());
     }
   return pts;
 }
 
 TEST(OctreeTree, EveryLevelAndEveryChainCoversTheSurface) {
-  std::vector<SurfaceMesh> meshes = {make_icosphere(3), make_box_surface({-1, -0.5, 0}, {2, 0.5, 0.25}),
+  std::vector<SurfaceMesh> meshes = {make_icosphere(3),
+                                     make_box_surface({-1, -0.5, 0}, {2, 0.5, 0.25}),
                                      make_torus(1.0, 0.3, 24, 12)};
   for (const SurfaceMesh& m : meshes) {
     OctreeTreeOptions o;
@@ -56,14 +66,16 @@ TEST(OctreeTree, EveryLevelAndEveryChainCoversTheSurface) {
       ASSERT_TRUE(chain_covers(t, 0, p)) << p.transpose();
       for (int l = 0; l < t.num_levels(); ++l) {
         bool covered = false;
-        for (int i = t.level_offset[l]; i < t.level_offset[l + 1] && !covered; ++i) covered = inside(t.spheres[i], p);
+        for (int i = t.level_offset[l]; i < t.level_offset[l + 1] && !covered; ++i)
+          covered = inside(t.spheres[i], p);
         ASSERT_TRUE(covered) << "level " << l;
       }
     }
     // Leaf spheres are no larger than the circumsphere of a leaf cell.
     const Eigen::Vector3d ext = m.V.colwise().maxCoeff() - m.V.colwise().minCoeff();
     const double leaf_side = ext.maxCoeff() * (1 + 1e-6) / 8.0;
-    for (int i = t.level_offset[3]; i < t.num_nodes(); ++i) EXPECT_LE(t.spheres[i].r, 0.5 * std::sqrt(3.0) * leaf_side * (1 + 1e-6));
+    for (int i = t.level_offset[3]; i < t.num_nodes(); ++i)
+      EXPECT_LE(t.spheres[i].r, 0.5 * std::sqrt(3.0) * leaf_side * (1 + 1e-6));
   }
 }
 
@@ -135,7 +147,8 @@ TEST(NodeAssociation, SteeringNodesOfEveryTriangleMeetingTheSphere) {
   std::vector<int32_t> off{0}, nodes;
   for (int v = 0; v < m.V.rows(); ++v) {
     std::vector<std::pair<double, int>> d;
-    for (int j = 0; j < coarse.V.rows(); ++j) d.push_back({(coarse.V.row(j) - m.V.row(v)).norm(), j});
+    for (int j = 0; j < coarse.V.rows(); ++j)
+      d.push_back({(coarse.V.row(j) - m.V.row(v)).norm(), j});
     std::sort(d.begin(), d.end());
     nodes.push_back(d[0].second);
     nodes.push_back(d[1].second);
@@ -147,19 +160,22 @@ TEST(NodeAssociation, SteeringNodesOfEveryTriangleMeetingTheSphere) {
   // steering nodes of the triangle's vertices must all be associated.
   const auto pts_per_face = 15;
   for (int i = 0; i < t.num_nodes(); ++i) {
-    std::set<int> got(t.assoc_nodes.begin() + t.assoc_offset[i], t.assoc_nodes.begin() + t.assoc_offset[i + 1]);
+    std::set<int> got(t.assoc_nodes.begin() + t.assoc_offset[i],
+                      t.assoc_nodes.begin() + t.assoc_offset[i + 1]);
     for (int f = 0; f < m.F.rows(); ++f) {
       bool meets = false;
       for (int a = 0; a <= pts_per_face && !meets; ++a)
         for (int b = 0; a + b <= pts_per_face && !meets; ++b) {
           const double wa = double(a) / pts_per_face, wb = double(b) / pts_per_face;
           const Eigen::Vector3d p = (1 - wa - wb) * m.V.row(m.F(f, 0)).transpose() +
-                                    wa * m.V.row(m.F(f, 1)).transpose() + wb * m.V.row(m.F(f, 2)).transpose();
+                                    wa * m.V.row(m.F(f, 1)).transpose() +
+                                    wb * m.V.row(m.F(f, 2)).transpose();
           meets = (p - t.rest_spheres[i].center()).norm() <= t.rest_spheres[i].r;
         }
       if (!meets) continue;
       for (int k = 0; k < 3; ++k)
-        for (int j = off[m.F(f, k)]; j < off[m.F(f, k) + 1]; ++j) ASSERT_TRUE(got.count(nodes[j])) << "sphere " << i;
+        for (int j = off[m.F(f, k)]; j < off[m.F(f, k) + 1]; ++j)
+          ASSERT_TRUE(got.count(nodes[j])) << "sphere " << i;
     }
   }
 }

@@ -12,7 +12,7 @@ namespace {
 // A small wrapped tree built by hand: root, 3 children, grandchildren 2+0+1.
 SphereTree small_tree() {
   SphereTree t;
-  t.spheres = {{0, 0, 0, 5}, {1, 0, 0, 2}, {-1, 0, 0, 2}, {0, 1, 0, 2},
+  t.spheres = {{0, 0, 0, 5},   {1, 0, 0, 2},   {-1, 0, 0, 2}, {0, 1, 0, 2},
                {1.5, 0, 0, 1}, {0.5, 0, 0, 1}, {0, 1.5, 0, 1}};
   build_topology(t, {-1, 0, 0, 0, 1, 1, 3});
   return t;
@@ -113,7 +113,8 @@ TEST(SphIo, RandomTreesRoundTrip) {
       for (std::size_t p = begin; p < end; ++p) {
         const int kids = static_cast<int>(rng() % (branch + 1));
         for (int c = 0; c < kids; ++c) {
-          t.spheres.push_back({std::ldexp(double(rng()), -20), 0.1 * c, -1.0 / (c + 3), 1.0 / level});
+          t.spheres.push_back(
+              {std::ldexp(double(rng()), -20), 0.1 * c, -1.0 / (c + 3), 1.0 / level});
           parent.push_back(static_cast<int32_t>(p));
         }
       }
@@ -133,22 +134,26 @@ TEST(SphIo, RandomTreesRoundTrip) {
 }
 
 TEST(SphIo, MalformedFilesThrowInputError) {
-  const char* bad[] = {
-      "",                                     // empty
-      "two 3\n",                              // non-numeric header
-      "2 3\n0 0 0 1 1\n1 1 1 1 1\n",          // too few lines
-      "1 3\n0 0 0 1 1\n0 0 0 1 1\n",          // too many lines
-      "1 3\n0 0 nan 1 1\n",                   // NaN
-      "1 3\n0 0 0 inf 1\n",                   // infinite radius
-      "1 3\n0 0 x 1 1\n",                     // not a number
-      "1 2\n0 0 0 -1 0\n",                    // unused root
-      "2 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n",  // fine: checks next line is valid
-      "3 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n",  // child of unused
-      "30 64\n0 0 0 1 1\n",                   // huge declared size
-      "12 64\n0 0 0 1 1\n",                   // (64^12-1)/63 lines: over the cap
-      "-1 2\n",
-      "2 0\n",
-  };
+  const char*
+      bad
+          [] =
+              {
+                  "",                                         // empty
+                  "two 3\n",                                  // non-numeric header
+                  "2 3\n0 0 0 1 1\n1 1 1 1 1\n",              // too few lines
+                  "1 3\n0 0 0 1 1\n0 0 0 1 1\n",              // too many lines
+                  "1 3\n0 0 nan 1 1\n",                       // NaN
+                  "1 3\n0 0 0 inf 1\n",                       // infinite radius
+                  "1 3\n0 0 x 1 1\n",                         // not a number
+                  "1 2\n0 0 0 -1 0\n",                        // unused root
+                  "2 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n",  // fine: checks next line is valid
+                  "3 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 "
+                  "0\n",                 // child of unused
+                  "30 64\n0 0 0 1 1\n",  // huge declared size
+                  "12 64\n0 0 0 1 1\n",  // (64^12-1)/63 lines: over the cap
+                  "-1 2\n",
+                  "2 0\n",
+              };
   for (const char* text : bad) {
     std::stringstream ss(text);
     if (std::string(text) == "2 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n") {

@@ -37,7 +37,8 @@ Steered make_steered(const SurfaceMesh& dense, const SurfaceMesh& coarse_surface
   s.coarse = coarse_surface.V;
   for (int v = 0; v < dense.V.rows(); ++v) {
     std::vector<std::pair<double, int>> d;
-    for (int j = 0; j < s.coarse.rows(); ++j) d.push_back({(s.coarse.row(j) - dense.V.row(v)).norm(), j});
+    for (int j = 0; j < s.coarse.rows(); ++j)
+      d.push_back({(s.coarse.row(j) - dense.V.row(v)).norm(), j});
     std::sort(d.begin(), d.end());
     double sum = 0;
     for (int k = 0; k < 3; ++k) sum += 1.0 / (d[k].first + 1e-3);
@@ -57,7 +58,10 @@ MatX3d smooth_deformation(const MatX3d& X, double amplitude, unsigned seed) {
   MatX3d x = X;
   for (int i = 0; i < X.rows(); ++i) {
     const Eigen::Vector3d p = X.row(i).transpose();
-    x.row(i) += amplitude * Eigen::Vector3d(std::sin(2 * p.y() + a), std::cos(3 * p.z() + b) * p.x(), std::sin(p.x() * p.y() + c)).transpose();
+    x.row(i) +=
+        amplitude * Eigen::Vector3d(std::sin(2 * p.y() + a), std::cos(3 * p.z() + b) * p.x(),
+                                    std::sin(p.x() * p.y() + c))
+                        .transpose();
     x(i, 0) *= 1.0 + 0.3 * amplitude;
   }
   return x;
@@ -124,12 +128,17 @@ TEST(SphereUpdate, DisplacementBoundKeepsCoveringUnderConvexSteering) {
     SphereUpdateOptions o;
     o.mode = SphereUpdateMode::DisplacementBound;
     update_spheres(t, s.coarse, x, o);
-    for (int l = 0; l < t.num_levels(); ++l) EXPECT_EQ(measure_coverage(t, V, l).num_uncovered, 0) << "level " << l;
+    for (int l = 0; l < t.num_levels(); ++l)
+      EXPECT_EQ(measure_coverage(t, V, l).num_uncovered, 0) << "level " << l;
     // Interior points of deformed triangles: a chain covers each.
     for (int f = 0; f < s.dense.F.rows(); f += 3) {
       double a = u(rng), b = u(rng);
-      if (a + b > 1) { a = 1 - a; b = 1 - b; }
-      const Eigen::Vector3d p = (1 - a - b) * V.row(s.dense.F(f, 0)).transpose() + a * V.row(s.dense.F(f, 1)).transpose() +
+      if (a + b > 1) {
+        a = 1 - a;
+        b = 1 - b;
+      }
+      const Eigen::Vector3d p = (1 - a - b) * V.row(s.dense.F(f, 0)).transpose() +
+                                a * V.row(s.dense.F(f, 1)).transpose() +
                                 b * V.row(s.dense.F(f, 2)).transpose();
       ASSERT_TRUE(chain_covers(t, 0, p)) << "face " << f;
     }
@@ -158,7 +167,10 @@ TEST(Coverage, MatchesBruteForce) {
   SphereTree t;
   std::vector<int32_t> parent{-1};
   t.spheres.push_back({0, 0, 0, 0.5});
-  for (int i = 0; i < 8; ++i) { t.spheres.push_back({u(rng), u(rng), u(rng), 0.4}); parent.push_back(0); }
+  for (int i = 0; i < 8; ++i) {
+    t.spheres.push_back({u(rng), u(rng), u(rng), 0.4});
+    parent.push_back(0);
+  }
   for (int i = 0; i < 200; ++i) {
     t.spheres.push_back({u(rng), u(rng), u(rng), i == 0 ? 3.0 : ur(rng)});
     parent.push_back(1 + i / 25);
@@ -173,10 +185,17 @@ TEST(Coverage, MatchesBruteForce) {
     for (int v = 0; v < P.rows(); ++v) {
       double best = INFINITY;
       for (int i = 0; i < t.num_nodes(); ++i) {
-        const bool in_cut = level < 0 ? t.is_leaf(i) : (t.level[i] == level || (t.level[i] < level && t.is_leaf(i)));
-        if (in_cut) best = std::min(best, (P.row(v).transpose() - t.spheres[i].center()).norm() - t.spheres[i].r);
+        const bool in_cut = level < 0
+                                ? t.is_leaf(i)
+                                : (t.level[i] == level || (t.level[i] < level && t.is_leaf(i)));
+        if (in_cut)
+          best = std::min(best,
+                          (P.row(v).transpose() - t.spheres[i].center()).norm() - t.spheres[i].r);
       }
-      if (best > 0) { ++expected; gap = std::max(gap, best); }
+      if (best > 0) {
+        ++expected;
+        gap = std::max(gap, best);
+      }
     }
     EXPECT_EQ(rep.num_uncovered, expected) << "level " << level;
     EXPECT_NEAR(rep.max_gap, gap, 1e-12);

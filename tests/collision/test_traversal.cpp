@@ -28,7 +28,8 @@ Scene torus_and_sphere(int levels, bool make_layered) {
 
 std::vector<CollisionRequest> all_modes() {
   std::vector<CollisionRequest> v;
-  for (auto mode : {TraversalMode::BreadthFirstFifo, TraversalMode::DepthFirst, TraversalMode::Priority})
+  for (auto mode :
+       {TraversalMode::BreadthFirstFifo, TraversalMode::DepthFirst, TraversalMode::Priority})
     for (bool fast : {true, false}) {
       CollisionRequest r;
       r.mode = mode;
@@ -55,7 +56,8 @@ TEST(Traversal, FullTraversalOfLayeredTreesEqualsBruteForceLeafPairs) {
     EXPECT_FALSE(res.interrupted);
     EXPECT_EQ(res.stop_reason, StopReason::Completed);
     EXPECT_TRUE(res.untested.empty());
-    EXPECT_EQ(as_set(res.colliding), expected) << "mode " << int(r.mode) << " fast " << r.test_on_push;
+    EXPECT_EQ(as_set(res.colliding), expected)
+        << "mode " << int(r.mode) << " fast " << r.test_on_push;
     EXPECT_EQ(res.colliding.size(), expected.size());  // no duplicates
     EXPECT_EQ(res.completed_level, 3);
   }
@@ -65,9 +67,11 @@ TEST(Traversal, WrappedTreesAllModesAgreeAndSitBetweenOracles) {
   const Scene s = torus_and_sphere(4, false);
   const auto upper = brute_force_leaf_overlaps(s.a, s.b);
   const auto pa = parents(s.a), pb = parents(s.b);
-  const CollisionResult ref = collide(s.a, s.b, CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()));
+  const CollisionResult ref =
+      collide(s.a, s.b, CollisionRequest::paper_reference(std::numeric_limits<double>::infinity()));
   const auto ref_set = as_set(ref.colliding);
-  for (const CollisionRequest& r : all_modes()) EXPECT_EQ(as_set(collide(s.a, s.b, r).colliding), ref_set);
+  for (const CollisionRequest& r : all_modes())
+    EXPECT_EQ(as_set(collide(s.a, s.b, r).colliding), ref_set);
   // Reported leaf pairs overlap; leaf pairs whose every ancestor combination overlaps are reported.
   for (const auto& p : ref_set) EXPECT_TRUE(upper.count(p));
   for (const auto& [i, j] : upper) {
@@ -81,15 +85,18 @@ TEST(Traversal, WrappedTreesAllModesAgreeAndSitBetweenOracles) {
 }
 
 // Every leaf pair found by the full traversal lies under some reported pair.
-void expect_cut_covers(const SphereTree& a, const SphereTree& b, const std::set<std::pair<int, int>>& full,
-                       const CollisionResult& res) {
+void expect_cut_covers(const SphereTree& a, const SphereTree& b,
+                       const std::set<std::pair<int, int>>& full, const CollisionResult& res) {
   const auto pa = parents(a), pb = parents(b);
   std::vector<NodePair> reported = res.colliding;
   reported.insert(reported.end(), res.untested.begin(), res.untested.end());
   for (const auto& [i, j] : full) {
     bool under = false;
     for (const NodePair& p : reported)
-      if (is_ancestor_or_self(pa, p.a, i) && is_ancestor_or_self(pb, p.b, j)) { under = true; break; }
+      if (is_ancestor_or_self(pa, p.a, i) && is_ancestor_or_self(pb, p.b, j)) {
+        under = true;
+        break;
+      }
     ASSERT_TRUE(under) << "leaf pair (" << i << ", " << j << ") lost";
   }
 }

@@ -28,7 +28,8 @@ bool zero(const IVec& a) { return a[0] == 0 && a[1] == 0 && a[2] == 0; }
 // the 6 in-plane edge normals, which settle the coplanar case).
 bool sat_intersect(const std::array<IVec, 3>& A, const std::array<IVec, 3>& B) {
   std::vector<IVec> axes;
-  const IVec na = cross(sub(A[1], A[0]), sub(A[2], A[0])), nb = cross(sub(B[1], B[0]), sub(B[2], B[0]));
+  const IVec na = cross(sub(A[1], A[0]), sub(A[2], A[0])),
+             nb = cross(sub(B[1], B[0]), sub(B[2], B[0]));
   axes.push_back(na);
   axes.push_back(nb);
   for (int i = 0; i < 3; ++i) {
@@ -59,7 +60,9 @@ TEST(ExactPredicates, Orient3dAgreesWithIntegerDeterminantAndIsExactNearZero) {
   for (int t = 0; t < 20000; ++t) {
     std::array<IVec, 4> p;
     for (auto& q : p) q = {c(rng), c(rng), c(rng)};
-    if (t % 3 == 0) p[3] = {p[0][0] + p[1][0] - p[2][0], p[0][1] + p[1][1] - p[2][1], p[0][2] + p[1][2] - p[2][2]};  // coplanar
+    if (t % 3 == 0)
+      p[3] = {p[0][0] + p[1][0] - p[2][0], p[0][1] + p[1][1] - p[2][1],
+              p[0][2] + p[1][2] - p[2][2]};  // coplanar
     // Differences < 4e5: the exact determinant fits in 64-bit integers, while
     // the double products round (so near-coplanar cases take the exact path).
     const long long exact = dot(sub(p[1], p[0]), cross(sub(p[2], p[0]), sub(p[3], p[0])));
@@ -82,7 +85,8 @@ TEST(ExactPredicates, Orient3dAgreesWithIntegerDeterminantAndIsExactNearZero) {
     EXPECT_EQ(orient3d(a, c2, b, d), -o);
   }
   EXPECT_EQ(orient2d(0, 0, 1, 1, 3, 3), 0);
-  EXPECT_EQ(orient2d(0.1, 0.1, 0.2, 0.2, 0.3, 0.3 + 1e-17), orient2d(0.3, 0.3 + 1e-17, 0.1, 0.1, 0.2, 0.2));
+  EXPECT_EQ(orient2d(0.1, 0.1, 0.2, 0.2, 0.3, 0.3 + 1e-17),
+            orient2d(0.3, 0.3 + 1e-17, 0.1, 0.1, 0.2, 0.2));
 }
 
 TEST(TriangleIntersection, SmallIntegerGridAgainstSeparatingAxisOracle) {
@@ -97,16 +101,23 @@ TEST(TriangleIntersection, SmallIntegerGridAgainstSeparatingAxisOracle) {
     if (tested % 4 == 0)  // force a coplanar configuration
       for (auto* T : {&A, &B})
         for (auto& q : *T) q[2] = 1;
-    if (zero(cross(sub(A[1], A[0]), sub(A[2], A[0]))) || zero(cross(sub(B[1], B[0]), sub(B[2], B[0])))) continue;
+    if (zero(cross(sub(A[1], A[0]), sub(A[2], A[0]))) ||
+        zero(cross(sub(B[1], B[0]), sub(B[2], B[0]))))
+      continue;
     ++tested;
     const bool expected = sat_intersect(A, B);
     hits += expected;
     const IVec na = cross(sub(A[1], A[0]), sub(A[2], A[0]));
-    if (dot(na, sub(B[0], A[0])) == 0 && dot(na, sub(B[1], A[0])) == 0 && dot(na, sub(B[2], A[0])) == 0) ++coplanar;
-    const bool got = triangles_intersect(to_vec(A[0]), to_vec(A[1]), to_vec(A[2]), to_vec(B[0]), to_vec(B[1]), to_vec(B[2]));
+    if (dot(na, sub(B[0], A[0])) == 0 && dot(na, sub(B[1], A[0])) == 0 &&
+        dot(na, sub(B[2], A[0])) == 0)
+      ++coplanar;
+    const bool got = triangles_intersect(to_vec(A[0]), to_vec(A[1]), to_vec(A[2]), to_vec(B[0]),
+                                         to_vec(B[1]), to_vec(B[2]));
     ASSERT_EQ(got, expected) << "case " << tested;
     // Symmetric in the triangles and in vertex order.
-    ASSERT_EQ(triangles_intersect(to_vec(B[2]), to_vec(B[0]), to_vec(B[1]), to_vec(A[1]), to_vec(A[0]), to_vec(A[2])), expected);
+    ASSERT_EQ(triangles_intersect(to_vec(B[2]), to_vec(B[0]), to_vec(B[1]), to_vec(A[1]),
+                                  to_vec(A[0]), to_vec(A[2])),
+              expected);
   }
   EXPECT_GT(hits, 3000);
   EXPECT_LT(hits, 27000);
@@ -126,7 +137,8 @@ TEST(TriangleIntersection, RandomFloatTrianglesAndIntersectionPoints) {
     const Vec na = (A[1] - A[0]).cross(A[2] - A[0]), nb = (B[1] - B[0]).cross(B[2] - B[0]);
     axes = {na, nb};
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) axes.push_back((A[(i + 1) % 3] - A[i]).cross(B[(j + 1) % 3] - B[j]));
+      for (int j = 0; j < 3; ++j)
+        axes.push_back((A[(i + 1) % 3] - A[i]).cross(B[(j + 1) % 3] - B[j]));
     bool separated = false;
     for (const Vec& ax : axes) {
       double amin = INFINITY, amax = -INFINITY, bmin = INFINITY, bmax = -INFINITY;
@@ -162,7 +174,8 @@ TEST(TriangleIntersection, DegenerateAndNearDegenerateCases) {
   const Vec o(0, 0, 0), x(1, 0, 0), y(0, 1, 0);
   // Touching a vertex on the face, then lifted by +-1e-12.
   for (double h : {0.0, -1e-12, 1e-12, -1e-300, 1e-300}) {
-    const bool got = triangles_intersect(o, x, y, Vec(0.2, 0.2, h), Vec(0.3, 0.2, 1), Vec(0.2, 0.3, 1));
+    const bool got =
+        triangles_intersect(o, x, y, Vec(0.2, 0.2, h), Vec(0.3, 0.2, 1), Vec(0.2, 0.3, 1));
     EXPECT_EQ(got, h <= 0.0) << h;
   }
   // Shared vertex only, shared edge, coplanar containment, coplanar disjoint.
@@ -170,15 +183,19 @@ TEST(TriangleIntersection, DegenerateAndNearDegenerateCases) {
   EXPECT_TRUE(triangles_intersect(o, x, y, o, x, Vec(0, -1, 0)));
   EXPECT_TRUE(triangles_intersect(o, x, y, Vec(0.1, 0.1, 0), Vec(0.2, 0.1, 0), Vec(0.1, 0.2, 0)));
   EXPECT_FALSE(triangles_intersect(o, x, y, Vec(0.6, 0.6, 0), Vec(2, 0.6, 0), Vec(0.6, 2, 0)));
-  EXPECT_TRUE(triangles_intersect(o, x, y, Vec(0.5, 0.5, 0), Vec(2, 0.5, 0), Vec(0.5, 2, 0)));  // touch at (0.5,0.5)
+  EXPECT_TRUE(triangles_intersect(o, x, y, Vec(0.5, 0.5, 0), Vec(2, 0.5, 0),
+                                  Vec(0.5, 2, 0)));  // touch at (0.5,0.5)
   // Edge crossing an edge in 3D (non-coplanar) and just missing it.
   EXPECT_TRUE(triangles_intersect(o, x, y, Vec(0.5, -1, 0), Vec(0.5, 1, 0), Vec(0.5, 0, 1)));
-  EXPECT_FALSE(triangles_intersect(o, x, y, Vec(0.5, -1, 1e-12), Vec(0.5, 1, 1e-12), Vec(0.5, 0, 1)));
+  EXPECT_FALSE(
+      triangles_intersect(o, x, y, Vec(0.5, -1, 1e-12), Vec(0.5, 1, 1e-12), Vec(0.5, 0, 1)));
   // Zero-area triangles: a segment through the face, a segment beside it, a point on it.
-  EXPECT_TRUE(triangles_intersect(o, x, y, Vec(0.2, 0.2, -1), Vec(0.2, 0.2, 1), Vec(0.2, 0.2, 0.5)));
+  EXPECT_TRUE(
+      triangles_intersect(o, x, y, Vec(0.2, 0.2, -1), Vec(0.2, 0.2, 1), Vec(0.2, 0.2, 0.5)));
   EXPECT_FALSE(triangles_intersect(o, x, y, Vec(2, 2, -1), Vec(2, 2, 1), Vec(2, 2, 0.5)));
   EXPECT_TRUE(triangles_intersect(o, x, y, Vec(0.3, 0.3, 0), Vec(0.3, 0.3, 0), Vec(0.3, 0.3, 0)));
-  EXPECT_FALSE(triangles_intersect(o, x, y, Vec(0.3, 0.3, 1e-12), Vec(0.3, 0.3, 1e-12), Vec(0.3, 0.3, 1e-12)));
+  EXPECT_FALSE(triangles_intersect(o, x, y, Vec(0.3, 0.3, 1e-12), Vec(0.3, 0.3, 1e-12),
+                                   Vec(0.3, 0.3, 1e-12)));
   // Two collinear segments (both triangles degenerate), overlapping or not.
   EXPECT_TRUE(triangles_intersect(o, x, 0.5 * x, 0.7 * x, 2 * x, 1.5 * x));
   EXPECT_FALSE(triangles_intersect(o, x, 0.5 * x, 1.1 * x, 2 * x, 1.5 * x));
@@ -195,7 +212,8 @@ TEST(AabbTree, IntersectingPairsEqualBruteForceAtRestAndAfterRefit) {
   EXPECT_GT(expected.size(), 20u);
   EXPECT_EQ(got, expected);
   MatX3d Vb = b.V;
-  for (int i = 0; i < Vb.rows(); ++i) Vb.row(i) += 0.2 * Eigen::RowVector3d(std::sin(3 * Vb(i, 1)), 0.5 * Vb(i, 0), 0.1);
+  for (int i = 0; i < Vb.rows(); ++i)
+    Vb.row(i) += 0.2 * Eigen::RowVector3d(std::sin(3 * Vb(i, 1)), 0.5 * Vb(i, 0), 0.1);
   tb.refit(Vb, b.F);
   const auto got2 = intersecting_triangle_pairs(ta, a.V, a.F, tb, Vb, b.F);
   const auto expected2 = intersecting_triangle_pairs_brute_force(a.V, a.F, Vb, b.F);

@@ -30,7 +30,8 @@ inline SphereTree layered(SphereTree t) {
   for (int i = t.num_nodes() - 1; i >= 0; --i)
     for (int c = 0; c < t.child_count[i]; ++c) {
       const Sphere& ch = t.spheres[t.first_child[i] + c];
-      t.spheres[i].r = std::max(t.spheres[i].r, (ch.center() - t.spheres[i].center()).norm() + ch.r);
+      t.spheres[i].r =
+          std::max(t.spheres[i].r, (ch.center() - t.spheres[i].center()).norm() + ch.r);
     }
   t.rest_spheres = t.spheres;
   return t;
@@ -42,7 +43,8 @@ inline std::set<std::pair<int, int>> as_set(const std::vector<NodePair>& v) {
   return s;
 }
 
-inline std::set<std::pair<int, int>> brute_force_leaf_overlaps(const SphereTree& a, const SphereTree& b) {
+inline std::set<std::pair<int, int>> brute_force_leaf_overlaps(const SphereTree& a,
+                                                               const SphereTree& b) {
   std::set<std::pair<int, int>> s;
   for (int i = 0; i < a.num_nodes(); ++i)
     if (a.is_leaf(i))

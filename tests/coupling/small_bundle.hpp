@@ -27,8 +27,11 @@ inline AssetBundle make_small_bundle(int subdivisions, double radius) {
   for (int v : s) b.surface_nodes[i++] = v;
   b.links = build_rigid_links(b.dense.V, b.coarse.V, b.surface_nodes);
   collision::SphereTree& t = b.spheres;
-  t.spheres = {{0.5, 0.5, 0.5, 0.9}, {0.25, 0.5, 0.5, 0.5}, {0.75, 0.5, 0.5, 0.5},
-               {0.5, 0.25, 0.5, 0.5}, {0.5, 0.75, 0.5, 0.5}};
+  t.spheres = {{0.5, 0.5, 0.5, 0.9},
+               {0.25, 0.5, 0.5, 0.5},
+               {0.75, 0.5, 0.5, 0.5},
+               {0.5, 0.25, 0.5, 0.5},
+               {0.5, 0.75, 0.5, 0.5}};
   collision::build_topology(t, {-1, 0, 0, 0, 0});
   std::vector<int> cand(b.surface_nodes.data(), b.surface_nodes.data() + b.surface_nodes.size());
   collision::associate_nearest_nodes(t, b.coarse.V, {}, cand);

@@ -25,8 +25,7 @@ TEST(BarycentricEmbedding, ExactAtRestAndUnderAffineMaps) {
   std::mt19937 rng(0);
   std::uniform_real_distribution<double> u(-0.05, 1.05);
   MatX3d P(500, 3);
-  for (int i = 0; i < P.rows(); ++i)
-    P.row(i) << u(rng) * 1.0, u(rng) * 0.5, u(rng) * 0.25;
+  for (int i = 0; i < P.rows(); ++i) P.row(i) << u(rng) * 1.0, u(rng) * 0.5, u(rng) * 0.25;
   const BarycentricEmbedding emb = build_barycentric_embedding(P, box.V, box.T);
   EXPECT_GT(emb.num_outside, 0);
   EXPECT_LT(emb.num_outside, P.rows());

@@ -62,7 +62,8 @@ TEST(ContactResponse, UntestedPenetrationCapAppliesToUntestedPairsOnly) {
   const Eigen::Vector3d dir = Eigen::Vector3d(1, 2, 2) / 3.0;
   const Eigen::Vector3d cb = 1.5 * dir;
   const SphereTree a = make_tree({{0, 0, 0, 1}}, {{0}, {0}});
-  const SphereTree b = make_tree({{cb.x(), cb.y(), cb.z(), 1}}, {{0}, {0}}, {cb.x(), cb.y(), cb.z(), 10});
+  const SphereTree b =
+      make_tree({{cb.x(), cb.y(), cb.z(), 1}}, {{0}, {0}}, {cb.x(), cb.y(), cb.z(), 10});
   ContactOptions o;
   o.stiffness = 200.0;
   o.max_untested_penetration = 0.25;

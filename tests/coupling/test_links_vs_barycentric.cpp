@@ -53,7 +53,8 @@ TEST(LinksVsBarycentric, ExactWhenRigidAndConvergentUnderBending) {
     EXPECT_LT((by_links - P).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((by_bary - P).cwiseAbs().maxCoeff(), 1e-12);
 
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
     const MatX3d Vr = (box.V * R.transpose()).rowwise() + Eigen::RowVector3d(0.3, -1, 2);
     const MatX3d Pr = (P * R.transpose()).rowwise() + Eigen::RowVector3d(0.3, -1, 2);
     apply(links, Vr, by_links);
@@ -77,14 +78,15 @@ TEST(LinksVsBarycentric, ExactWhenRigidAndConvergentUnderBending) {
     const double diff = (by_links - by_bary).rowwise().norm().maxCoeff();
     const double err_links = (by_links - Pb).rowwise().norm().maxCoeff();
     const double err_bary = (by_bary - Pb).rowwise().norm().maxCoeff();
-    std::printf("h = %.4f: |links - barycentric| max %.3e, links error %.3e, barycentric error %.3e "
-                "(kappa h^2 = %.3e)\n",
-                h, diff, err_links, err_bary, kappa * h * h);
+    std::printf(
+        "h = %.4f: |links - barycentric| max %.3e, links error %.3e, barycentric error %.3e "
+        "(kappa h^2 = %.3e)\n",
+        h, diff, err_links, err_bary, kappa * h * h);
     EXPECT_LT(err_bary, kappa * h * h);
     EXPECT_LT(err_links, kappa * h * t);
     EXPECT_LT(diff, err_links + err_bary);
     if (refine == 2) {
-      EXPECT_LT(err_bary, 0.35 * prev_bary);  // second order
+      EXPECT_LT(err_bary, 0.35 * prev_bary);   // second order
       EXPECT_LT(err_links, 0.7 * prev_links);  // first order
       EXPECT_GT(err_links, 0.35 * prev_links);
     }

@@ -11,7 +11,8 @@ namespace icd::runner {
 /// into the scene's collision block (JSON members without braces); the penalty
 /// stiffness is 2000 N/m unless `collision` sets it.
 inline Scene head_on_scene(const std::string& collision) {
-  const std::string text = R"({
+  const std::string text =
+      R"({
     "frames": 30, "frame_rate": 60,
     "objects": [
       {"name": "left", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 2, "cells": 5},
@@ -22,9 +23,9 @@ inline Scene head_on_scene(const std::string& collision) {
        "material": {"young": 5e5, "poisson": 0.3, "density": 1000}, "preprocess": {"tree_depth": 3}}
     ],
     "collision": {)" +
-                           (collision.find("stiffness") == std::string::npos ? std::string(R"("stiffness": 2000, )")
-                                                                             : std::string()) +
-                           collision + R"(},
+      (collision.find("stiffness") == std::string::npos ? std::string(R"("stiffness": 2000, )")
+                                                        : std::string()) +
+      collision + R"(},
     "output": {"csv": false}
   })";
   return parse_scene(parse_json(text, "head_on"), "head_on", ".");

@@ -24,7 +24,8 @@ const PointDataArray& array_named(const VtuData& d, const std::string& name) {
 int find_node(const collision::SphereTree& tree, const Eigen::Vector3d& c, double r) {
   for (int i = 0; i < tree.num_nodes(); ++i) {
     const collision::Sphere& s = tree.spheres[i];
-    if ((Eigen::Vector3d(s.x, s.y, s.z) - c).norm() <= 1e-12 && std::abs(s.r - r) <= 1e-12) return i;
+    if ((Eigen::Vector3d(s.x, s.y, s.z) - c).norm() <= 1e-12 && std::abs(s.r - r) <= 1e-12)
+      return i;
   }
   return -1;
 }
@@ -72,7 +73,8 @@ void expect_written_pairs_overlap(const std::string& collision, bool expect_unte
         const Eigen::Vector3d c = sets[s]->centers.row(k).transpose();
         node[s] = find_node(*trees[s], c, sets[s]->radii[k]);
         EXPECT_GE(node[s], 0) << "row " << k << " of side " << s << " is no sphere of its tree";
-        EXPECT_EQ(find_node(*trees[1 - s], c, sets[s]->radii[k]), -1) << "row " << k << " of side " << s;
+        EXPECT_EQ(find_node(*trees[1 - s], c, sets[s]->radii[k]), -1)
+            << "row " << k << " of side " << s;
       }
       EXPECT_EQ(flag0.values(k, 0), flag1.values(k, 0)) << "row " << k;
       if (node[0] >= 0) {
@@ -80,7 +82,8 @@ void expect_written_pairs_overlap(const std::string& collision, bool expect_unte
       }
       if (flag0.values(k, 0) == 1.0) {
         ++leaves;
-        const double gap = (set0.centers.row(k) - set1.centers.row(k)).norm() - set0.radii[k] - set1.radii[k];
+        const double gap =
+            (set0.centers.row(k) - set1.centers.row(k)).norm() - set0.radii[k] - set1.radii[k];
         EXPECT_LE(gap, 1e-12) << "row " << k << ": a colliding leaf pair that does not overlap";
         for (int s = 0; s < 2; ++s)
           if (node[s] >= 0) {
@@ -91,7 +94,8 @@ void expect_written_pairs_overlap(const std::string& collision, bool expect_unte
     EXPECT_EQ(leaves, r.colliding.size());
     return;
   }
-  FAIL() << "no query with " << (expect_untested ? "untested" : "colliding") << " pairs in 30 frames";
+  FAIL() << "no query with " << (expect_untested ? "untested" : "colliding")
+         << " pairs in 30 frames";
 }
 
 TEST(ContactSpheres, CompleteQueryWritesOverlappingLeafPairs) {

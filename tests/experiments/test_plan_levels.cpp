@@ -18,7 +18,8 @@ Scene two_spheres(const std::string& collision) {
       {"name": "a", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 3}, "position": [-0.05, 0, 0]},
       {"name": "b", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 3}, "position": [0.05, 0.01, 0]}
     ],
-    "collision": {)" + collision + R"(}, "output": {"csv": false}})";
+    "collision": {)" + collision +
+                           R"(}, "output": {"csv": false}})";
   return parse_scene(parse_json(text, "levels"), "levels", ".");
 }
 

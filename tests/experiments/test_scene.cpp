@@ -9,7 +9,9 @@
 namespace icd::runner {
 namespace {
 
-Scene parse(const std::string& text) { return parse_scene(parse_json(text, "s.json"), "s.json", "."); }
+Scene parse(const std::string& text) {
+  return parse_scene(parse_json(text, "s.json"), "s.json", ".");
+}
 
 const char* kSphere = R"({"name": "a", "primitive": {"type": "sphere"}})";
 
@@ -49,8 +51,8 @@ TEST(Scene, EachBadFieldGetsAClearError) {
       {with_objects(R"({"mesh": "x.off", "primitive": {}})"), "objects[0]", "exactly one of"},
       {with_objects(R"({"primitive": {}, "material": {"poisson": 0.5}})"),
        "objects[0].material.poisson", "(-1, 0.5)"},
-      {with_objects(R"({"primitive": {}, "material": {"young": -1}})"),
-       "objects[0].material.young", "must be in"},
+      {with_objects(R"({"primitive": {}, "material": {"young": -1}})"), "objects[0].material.young",
+       "must be in"},
       {with_objects(R"({"primitive": {}, "material": {"density": 0}})"),
        "objects[0].material.density", "must be in"},
       {with_objects(R"({"primitive": {}, "material": {"rayleigh": [1]}})"),
@@ -65,16 +67,15 @@ TEST(Scene, EachBadFieldGetsAClearError) {
        "non-negative integer"},
       {with_objects(R"({"primitive": {"type": "cone"}})"), "objects[0].primitive.type",
        "must be one of"},
-      {with_objects(R"({"primitive": {}, "colour": "red"})"), "objects[0].colour",
-       "unknown field"},
+      {with_objects(R"({"primitive": {}, "colour": "red"})"), "objects[0].colour", "unknown field"},
       {with_objects(std::string(kSphere) + "," + kSphere), "objects[1].name", "duplicate"},
       {with_objects(kSphere, R"("frames": 0)"), "frames", "must be in"},
       {with_objects(kSphere, R"("frames": 2.5)"), "frames", "integer"},
       {with_objects(kSphere, R"("frame_rate": 0)"), "frame_rate", "must be in"},
-      {with_objects(kSphere, R"("collision": {"budget_seconds": -1})"),
-       "collision.budget_seconds", "must be in"},
-      {with_objects(kSphere, R"("collision": {"budget_seconds": 0})"),
-       "collision.budget_seconds", "must be in"},
+      {with_objects(kSphere, R"("collision": {"budget_seconds": -1})"), "collision.budget_seconds",
+       "must be in"},
+      {with_objects(kSphere, R"("collision": {"budget_seconds": 0})"), "collision.budget_seconds",
+       "must be in"},
       {with_objects(kSphere, R"("collision": {"budget_tests": -5})"), "collision.budget_tests",
        "must be in"},
       {with_objects(kSphere, R"("collision": {"stiffness": 0})"), "collision.stiffness",
@@ -123,7 +124,7 @@ TEST(Plan, RigidObstacleGetsNoFemButCollides) {
   EXPECT_TRUE(p.objects[1].sphere_tree);
   EXPECT_FALSE(p.objects[1].sphere_update);  // never moves
   EXPECT_FALSE(p.objects[1].dense_update);
-  EXPECT_TRUE(p.objects[0].dense_update);    // written to VTU
+  EXPECT_TRUE(p.objects[0].dense_update);  // written to VTU
   ASSERT_EQ(p.pairs.size(), 1u);
   EXPECT_TRUE(p.response);
   EXPECT_FALSE(p.broad_phase);
@@ -142,7 +143,9 @@ TEST(Plan, TwoDeformableObjectsRunEverything) {
   EXPECT_TRUE(p.objects[2].kinematic);
   EXPECT_TRUE(p.objects[2].sphere_update);
   for (const ObjectPlan& o : p.objects) EXPECT_TRUE(o.dense_update);  // exact reference needs them
-  EXPECT_EQ(p.describe(s)[1], "b: load, fem (stvk, backward_euler), sphere tree, sphere update, rigid links (dense mesh)");
+  EXPECT_EQ(
+      p.describe(s)[1],
+      "b: load, fem (stvk, backward_euler), sphere tree, sphere update, rigid links (dense mesh)");
 }
 
 }  // namespace

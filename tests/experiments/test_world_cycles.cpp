@@ -37,7 +37,8 @@ TEST(WorldCycles, SingleCycleFramesWhileApartMatchFullyCycledFrames) {
     rollbacks += a.rollback;
     if (a.active_pairs > 0 && first_contact_fast < 0) first_contact_fast = f;
     if (b.active_pairs > 0 && first_contact_full < 0) first_contact_full = f;
-    const double dx = (fast.objects()[0].positions - full.objects()[0].positions).rowwise().norm().maxCoeff();
+    const double dx =
+        (fast.objects()[0].positions - full.objects()[0].positions).rowwise().norm().maxCoeff();
     max_rel_dx = std::max(max_rel_dx, dx / 0.1);
   }
   EXPECT_GT(single, 5);
@@ -93,7 +94,8 @@ namespace {
 // Two overlapping soft spheres (in contact from the first frame).
 Scene overlapping_scene(double target_fps) {
   const std::string text = R"({
-    "frames": 10, "frame_rate": 60, "target_fps": )" + std::to_string(target_fps) + R"(,
+    "frames": 10, "frame_rate": 60, "target_fps": )" +
+                           std::to_string(target_fps) + R"(,
     "objects": [
       {"name": "a", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 3, "cells": 4}, "position": [-0.09, 0, 0]},
       {"name": "b", "primitive": {"type": "sphere", "radius": 0.1, "subdivisions": 3, "cells": 4}, "position": [0.09, 0, 0]}
@@ -155,9 +157,10 @@ namespace {
 TEST(WorldCycles, MidpointSamplingKeepsTheBounceEnergy) {
   double gain[2];
   for (int mid = 0; mid < 2; ++mid) {
-    World w(head_on_scene(std::string(R"("budget_tests": 1000000, "passive": false, "midpoint": )") +
-                          (mid ? "true" : "false")),
-            "", "");
+    World w(
+        head_on_scene(std::string(R"("budget_tests": 1000000, "passive": false, "midpoint": )") +
+                      (mid ? "true" : "false")),
+        "", "");
     const double e0 = w.step().energy;
     FrameMetrics m;
     for (int f = 1; f < 30; ++f) m = w.step();
@@ -211,8 +214,9 @@ namespace {
 TEST(WorldCycles, PassiveResponseBoundsTheEnergyOfInterruptedQueries) {
   double gain[2];
   for (int passive = 0; passive < 2; ++passive) {
-    World w(head_on_scene(std::string(R"("on_interrupt": "untested", "budget_tests": 64, "passive": )") +
-                          (passive ? "true" : "false")),
+    World w(head_on_scene(
+                std::string(R"("on_interrupt": "untested", "budget_tests": 64, "passive": )") +
+                (passive ? "true" : "false")),
             "", "");
     double e_init = 0;
     for (const RuntimeObject& o : w.objects())
@@ -232,9 +236,10 @@ TEST(WorldCycles, PassiveResponseBoundsTheEnergyOfInterruptedQueries) {
     EXPECT_GT(interrupted, 0);
     EXPECT_LT(mean_velocity_x(w.objects()[0]), -0.1);  // rebounded
     gain[passive] = m.energy / e_init;
-    std::printf("%s response: energy after the bounce / initial kinetic energy %.4f (%d cycles "
-                "limited)\n",
-                passive ? "passive" : "raw", gain[passive], limited);
+    std::printf(
+        "%s response: energy after the bounce / initial kinetic energy %.4f (%d cycles "
+        "limited)\n",
+        passive ? "passive" : "raw", gain[passive], limited);
     if (passive) {
       EXPECT_GT(limited, 0);
     }

@@ -28,9 +28,12 @@ std::vector<std::string> split_csv(const std::string& line) {
   std::vector<std::string> out(1);
   bool quoted = false;
   for (char c : line) {
-    if (c == '"') quoted = !quoted;
-    else if (c == ',' && !quoted) out.emplace_back();
-    else out.back() += c;
+    if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted)
+      out.emplace_back();
+    else
+      out.back() += c;
   }
   return out;
 }
@@ -61,15 +64,16 @@ double num(const Row& r, const std::string& key) {
 
 // A fresh output folder per test.
 fs::path out_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("icd_exp_reduced_" + std::to_string(::getpid())) / name;
+  const fs::path d =
+      fs::temp_directory_path() / ("icd_exp_reduced_" + std::to_string(::getpid())) / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
 }
 
 int run(const std::string& program, const std::string& args, const fs::path& out) {
-  const std::string cmd = std::string(ICD_EXP_BIN_DIR) + "/" + program + " --out " + out.string() + " " + args +
-                          " > " + (out / "log.txt").string() + " 2>&1";
+  const std::string cmd = std::string(ICD_EXP_BIN_DIR) + "/" + program + " --out " + out.string() +
+                          " " + args + " > " + (out / "log.txt").string() + " 2>&1";
   return std::system(cmd.c_str());
 }
 
@@ -83,12 +87,15 @@ std::string log_of(const fs::path& out) {
 const std::string kScene = std::string(ICD_EXP_SOURCE_DIR) + "/experiments/scenes/two_spheres.json";
 
 bool python_has_plotting() {
-  return std::system("/usr/bin/python3 -c 'import meshio, matplotlib, numpy' > /dev/null 2>&1") == 0;
+  return std::system("/usr/bin/python3 -c 'import meshio, matplotlib, numpy' > /dev/null 2>&1") ==
+         0;
 }
 
 TEST(ExperimentsReduced, Table1) {
   const fs::path out = out_dir("table1");
-  ASSERT_EQ(run("table1", "--scene " + kScene + " --budgets 1e-3 --max-frames 20 --after 1", out), 0) << log_of(out);
+  ASSERT_EQ(run("table1", "--scene " + kScene + " --budgets 1e-3 --max-frames 20 --after 1", out),
+            0)
+      << log_of(out);
   const auto rows = read_csv(out / "table1.csv");
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_GE(num(rows[0], "contact_frame"), 0);
@@ -98,19 +105,24 @@ TEST(ExperimentsReduced, Table1) {
 
 TEST(ExperimentsReduced, Fig9) {
   const fs::path out = out_dir("fig9");
-  ASSERT_EQ(run("fig9", "--scene " + kScene + " --budgets 1e-5,1e-2 --max-frames 20 --after 1", out), 0) << log_of(out);
+  ASSERT_EQ(
+      run("fig9", "--scene " + kScene + " --budgets 1e-5,1e-2 --max-frames 20 --after 1", out), 0)
+      << log_of(out);
   const auto rows = read_csv(out / "manifest.csv");
   ASSERT_EQ(rows.size(), 2u);
   for (const Row& r : rows) {
     EXPECT_GE(num(r, "contact_frame"), 0);
     for (const char* key : {"objects", "spheres"}) {
       std::stringstream ss(r.at(key));
-      for (std::string f; std::getline(ss, f, ';');) EXPECT_TRUE(fs::exists(out / r.at("dir") / f)) << f;
+      for (std::string f; std::getline(ss, f, ';');)
+        EXPECT_TRUE(fs::exists(out / r.at("dir") / f)) << f;
     }
   }
-  if (!python_has_plotting()) GTEST_SKIP() << "/usr/bin/python3 lacks meshio/matplotlib: plot not checked";
-  const std::string cmd = "/usr/bin/python3 " + std::string(ICD_EXP_SOURCE_DIR) + "/scripts/plot_fig9.py " +
-                          out.string() + " --max-faces 2000 > " + (out / "plot.txt").string() + " 2>&1";
+  if (!python_has_plotting())
+    GTEST_SKIP() << "/usr/bin/python3 lacks meshio/matplotlib: plot not checked";
+  const std::string cmd = "/usr/bin/python3 " + std::string(ICD_EXP_SOURCE_DIR) +
+                          "/scripts/plot_fig9.py " + out.string() + " --max-faces 2000 > " +
+                          (out / "plot.txt").string() + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_GT(fs::file_size(out / "fig9.png"), 1000u);
 }
@@ -127,11 +139,12 @@ TEST(ExperimentsReduced, ContactError) {
   ASSERT_NE(at, std::string::npos) << "two_spheres.json changed: update this test";
   json.replace(at, std::string("\"stiffness\": 2000").size(), "\"stiffness\": 20");
   std::ofstream(out / "soft.json") << json;
-  ASSERT_EQ(run("contact_error",
-                "--scene " + (out / "soft.json").string() +
-                    " --budgets 1e-5,1e-3 --test-budgets 20,100000000 --reps 1 --max-frames 20 --after 3",
-                out),
-            0)
+  ASSERT_EQ(
+      run("contact_error",
+          "--scene " + (out / "soft.json").string() +
+              " --budgets 1e-5,1e-3 --test-budgets 20,100000000 --reps 1 --max-frames 20 --after 3",
+          out),
+      0)
       << log_of(out);
   const auto rows = read_csv(out / "contact_error.csv");
   ASSERT_EQ(rows.size(), 5u * 4u);  // 5 modes x (2 time + 2 test budgets)
@@ -150,8 +163,10 @@ TEST(ExperimentsReduced, ContactError) {
           return num(q, "recall_exact");
       return std::numeric_limits<double>::quiet_NaN();
     }();
-    EXPECT_GE(num(r, "recall_exact"), full_recall_of_exact - 1e-12) << r.at("mode") << " " << r.at("budget");
-    EXPECT_DOUBLE_EQ(num(r, "recall_full"), 1.0) << "interrupted answers must cover every colliding leaf pair";
+    EXPECT_GE(num(r, "recall_exact"), full_recall_of_exact - 1e-12)
+        << r.at("mode") << " " << r.at("budget");
+    EXPECT_DOUBLE_EQ(num(r, "recall_full"), 1.0)
+        << "interrupted answers must cover every colliding leaf pair";
     // An unlimited budget reaches the same leaves in every mode (different orders).
     if (r.at("budget_kind") == "tests" && num(r, "budget") > 1e7) {
       EXPECT_EQ(num(r, "interrupted"), 0) << r.at("mode");
@@ -164,7 +179,8 @@ TEST(ExperimentsReduced, ContactError) {
 TEST(ExperimentsReduced, DeformationError) {
   const fs::path out = out_dir("deformation");
   ASSERT_EQ(run("deformation_error",
-                "--scene " + kScene + " --resolution-scene " + kScene + " --frames 4 --reps 1 --cells 2,4 --fine 4",
+                "--scene " + kScene + " --resolution-scene " + kScene +
+                    " --frames 4 --reps 1 --cells 2,4 --fine 4",
                 out),
             0)
       << log_of(out);
@@ -173,7 +189,8 @@ TEST(ExperimentsReduced, DeformationError) {
   for (const Row& r : links) {
     EXPECT_GE(num(r, "rms_error"), 0);
     EXPECT_GE(num(r, "max_error"), num(r, "rms_error"));
-    EXPECT_LT(num(r, "max_error_pct_bbox"), 100) << "links and barycentric surfaces should be close";
+    EXPECT_LT(num(r, "max_error_pct_bbox"), 100)
+        << "links and barycentric surfaces should be close";
     // Before contact the motion is a translation, which both mappings reproduce exactly.
     if (num(r, "frame") == 0 && num(r, "active_pairs") == 0) {
       EXPECT_LT(num(r, "max_error_pct_bbox"), 1e-9);
@@ -182,12 +199,14 @@ TEST(ExperimentsReduced, DeformationError) {
   const auto res = read_csv(out / "resolution.csv");
   ASSERT_EQ(res.size(), 2u);
   EXPECT_GT(num(res[0], "rms_error"), 0) << "a coarser grid must change the surface";
-  EXPECT_EQ(num(res[1], "max_error"), 0) << "the same resolution must reproduce the reference exactly";
+  EXPECT_EQ(num(res[1], "max_error"), 0)
+      << "the same resolution must reproduce the reference exactly";
 }
 
 TEST(ExperimentsReduced, SphereUpdate) {
   const fs::path out = out_dir("sphere_update");
-  ASSERT_EQ(run("sphere_update_error", "--scene " + kScene + " --frames 4 --reps 1", out), 0) << log_of(out);
+  ASSERT_EQ(run("sphere_update_error", "--scene " + kScene + " --frames 4 --reps 1", out), 0)
+      << log_of(out);
   const auto rows = read_csv(out / "sphere_update.csv");
   ASSERT_EQ(rows.size(), 4u * 2u * 3u);  // frames x objects x methods
   for (const Row& r : rows) {
@@ -205,8 +224,10 @@ TEST(ExperimentsReduced, SphereUpdate) {
   for (const Row& r : rows)
     if (num(r, "frame") == 0 && r.at("method") != "rebuild_octree")
       for (const Row& q : rows)
-        if (num(q, "frame") == 0 && q.at("method") == "rebuild_octree" && q.at("object") == r.at("object")) {
-          EXPECT_NEAR(num(r, "tightness"), num(q, "tightness"), 1e-6 * num(q, "tightness")) << r.at("method");
+        if (num(q, "frame") == 0 && q.at("method") == "rebuild_octree" &&
+            q.at("object") == r.at("object")) {
+          EXPECT_NEAR(num(r, "tightness"), num(q, "tightness"), 1e-6 * num(q, "tightness"))
+              << r.at("method");
         }
 }
 

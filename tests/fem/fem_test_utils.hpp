@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
 
 #include "fem/material.hpp"
 #include "fem/model.hpp"
@@ -17,7 +17,8 @@ namespace icd::fem::test {
 
 inline const std::vector<MaterialModel>& all_models() {
   static const std::vector<MaterialModel> models{MaterialModel::Linear, MaterialModel::Corotational,
-                                                 MaterialModel::StVK, MaterialModel::StableNeoHookean};
+                                                 MaterialModel::StVK,
+                                                 MaterialModel::StableNeoHookean};
   return models;
 }
 
@@ -62,8 +63,8 @@ inline std::string model_name(const ::testing::TestParamInfo<MaterialModel>& par
 
 /// Cantilever 1.0 x 0.1 x 0.1 m on a (10 r) x r x r-cell structured mesh,
 /// clamped (all nodes fixed) at x = 0, optionally under gravity along -z.
-inline Model cantilever(int r, const Material& mat, double gravity = 9.81, RayleighDamping damping = {},
-                        int num_threads = 1) {
+inline Model cantilever(int r, const Material& mat, double gravity = 9.81,
+                        RayleighDamping damping = {}, int num_threads = 1) {
   const TetMesh m = box(10 * r, r, r);
   ModelOptions o;
   o.gravity = {0.0, 0.0, -gravity};

@@ -2,8 +2,8 @@
 
 #include <random>
 
-#include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
+#include <Eigen/SparseCholesky>
 
 #include "mesh/io/error.hpp"
 
@@ -27,7 +27,8 @@ Eigen::SparseMatrix<double> laplacian(int n, double shift) {
 }
 
 TEST(CholmodSolver, AnalyseOnceFactorAndSolveManyForEveryOrdering) {
-  for (CholmodOrdering ordering : {CholmodOrdering::Default, CholmodOrdering::Amd, CholmodOrdering::Metis}) {
+  for (CholmodOrdering ordering :
+       {CholmodOrdering::Default, CholmodOrdering::Amd, CholmodOrdering::Metis}) {
     CholmodSolver solver(ordering);
     std::mt19937 gen(0);
     std::uniform_real_distribution<double> u(-1, 1);

@@ -2,8 +2,8 @@
 // energy, rigid motions, and the affine patch test.
 #include "fem/forces.hpp"
 
-#include <Eigen/SVD>
 #include <gtest/gtest.h>
+#include <Eigen/SVD>
 
 #include "fem/constitutive.hpp"
 #include "fem/element_kernels.hpp"
@@ -58,7 +58,8 @@ TEST_P(ForcesPerModel, StiffnessIsTheFiniteDifferenceJacobianAndDifferentialMatc
     forces.compute(xp, fp);
     forces.compute(xm, fm);
     const Eigen::VectorXd col = -(Eigen::Map<const Eigen::VectorXd>(fp.data(), n) -
-                                  Eigen::Map<const Eigen::VectorXd>(fm.data(), n)) / (2 * h);
+                                  Eigen::Map<const Eigen::VectorXd>(fm.data(), n)) /
+                                (2 * h);
     EXPECT_LT((K.col(j) - col).norm(), 1e-6 * K.norm()) << "dof " << j;
   }
   const MatX3d dx = test::random_field(d.num_nodes, 3);
@@ -133,7 +134,8 @@ TEST_P(ForcesPerModel, PatchTestAffineFieldGivesAnalyticStressAndBalancedInterio
     }
   }
   EXPECT_NEAR(W, psi * size.prod(), 1e-12 * std::abs(psi * size.prod()));
-  for (int e = 0; e < d.num_tets(); ++e) EXPECT_LT((d.deformation_gradient(x, e) - A).norm(), 1e-13);
+  for (int e = 0; e < d.num_tets(); ++e)
+    EXPECT_LT((d.deformation_gradient(x, e) - A).norm(), 1e-13);
   // Nodal forces: interior nodes are balanced; the internal force of a boundary
   // node balances the traction P N of its rest boundary faces (one third of
   // each face area for linear triangles), i.e. equals minus that traction.
@@ -178,12 +180,15 @@ TEST_P(ForcesPerModel, FusedHealthMatchesTheSeparatePassForAnyThreadCount) {
     MatX3d x = deformed(d, 21, 0.01);
     MatX3d f(d.num_nodes, 3), g(d.num_nodes, 3);
     for (int variant = 0; variant < 3; ++variant) {
-      if (variant == 1) x.row(d.tets(700, 0)) = x.row(d.tets(700, 1)) + (x.row(d.tets(700, 1)) - x.row(d.tets(700, 0)));
+      if (variant == 1)
+        x.row(d.tets(700, 0)) =
+            x.row(d.tets(700, 1)) + (x.row(d.tets(700, 1)) - x.row(d.tets(700, 0)));
       if (variant == 2) x(d.tets(300, 2), 1) = std::numeric_limits<double>::quiet_NaN();
       const ElementHealth h = forces.compute_with_health(x, f);
       forces.compute(x, g);
       const ElementHealth ref = forces.health(x);
-      EXPECT_TRUE(f.cwiseEqual(g).all() || variant == 2) << "threads " << threads << " variant " << variant;
+      EXPECT_TRUE(f.cwiseEqual(g).all() || variant == 2)
+          << "threads " << threads << " variant " << variant;
       if (variant < 2) {
         EXPECT_NEAR(h.energy, ref.energy, 1e-12 * std::abs(ref.energy));
         EXPECT_EQ(h.min_det_f, ref.min_det_f);
@@ -216,14 +221,18 @@ TEST_P(ForcesPerModel, OrientationCheckMatchesABruteForceDeterminantScan) {
     fo.num_threads = threads;
     for (int variant = 0; variant < 4; ++variant) {
       // Fresh objects: corotational's warm-start rotations are state.
-      ElasticForces forces(d, test::material(GetParam()), fo), plain(d, test::material(GetParam()), fo);
+      ElasticForces forces(d, test::material(GetParam()), fo),
+          plain(d, test::material(GetParam()), fo);
       MatX3d x = deformed(d, 23, 0.01);
-      auto invert = [&](int e) { x.row(d.tets(e, 0)) = x.row(d.tets(e, 1)) + (x.row(d.tets(e, 1)) - x.row(d.tets(e, 0))); };
+      auto invert = [&](int e) {
+        x.row(d.tets(e, 0)) = x.row(d.tets(e, 1)) + (x.row(d.tets(e, 1)) - x.row(d.tets(e, 0)));
+      };
       if (variant == 1) invert(d.num_tets() - 1);
       if (variant == 2) invert(200);
       if (variant == 3) x(d.tets(300, 2), 1) = std::numeric_limits<double>::quiet_NaN();
       bool expected = true;
-      for (int e = 0; e < d.num_tets(); ++e) expected = expected && d.deformation_gradient(x, e).determinant() > 0;
+      for (int e = 0; e < d.num_tets(); ++e)
+        expected = expected && d.deformation_gradient(x, e).determinant() > 0;
       MatX3d f(d.num_nodes, 3), g(d.num_nodes, 3);
       const bool oriented = forces.compute_with_orientation_check(x, f);
       plain.compute(x, g);
@@ -253,15 +262,18 @@ TEST(Forces, LaneKernelsMatchTheScalarKernelsPerElement) {
   auto check = [&](auto tag, auto stress, auto energy, auto dstress) {
     constexpr MaterialModel kModel = decltype(tag)::value;
     double out[8][12], psi[8], det[8], dout[8][12];
-    lanes::block_forces<kModel, lanes::LaneCheck::Full>(x.data(), d.tets.data(), count, block, mu, lambda, out, psi, det);
-    lanes::block_differential<kModel>(x.data(), dx.data(), d.tets.data(), count, block, mu, lambda, dout);
+    lanes::block_forces<kModel, lanes::LaneCheck::Full>(x.data(), d.tets.data(), count, block, mu,
+                                                        lambda, out, psi, det);
+    lanes::block_differential<kModel>(x.data(), dx.data(), d.tets.data(), count, block, mu, lambda,
+                                      dout);
     // The orientation check: the same forces and det F, no energy density.
     double out_o[8][12], det_o[8];
-    lanes::block_forces<kModel, lanes::LaneCheck::Orientation>(x.data(), d.tets.data(), count, block, mu, lambda,
-                                                               out_o, nullptr, det_o);
+    lanes::block_forces<kModel, lanes::LaneCheck::Orientation>(
+        x.data(), d.tets.data(), count, block, mu, lambda, out_o, nullptr, det_o);
     for (int e = 0; e < count; ++e) {
       EXPECT_EQ(det_o[e], det[e]) << to_string(kModel) << " element " << e;
-      for (int k = 0; k < 12; ++k) EXPECT_EQ(out_o[e][k], out[e][k]) << to_string(kModel) << " element " << e;
+      for (int k = 0; k < 12; ++k)
+        EXPECT_EQ(out_o[e][k], out[e][k]) << to_string(kModel) << " element " << e;
     }
     for (int e = 0; e < count; ++e) {
       const int* t = d.tets.data() + 4 * e;
@@ -281,25 +293,35 @@ TEST(Forces, LaneKernelsMatchTheScalarKernelsPerElement) {
       for (int r = 0; r < 3; ++r)
         for (int a = 1; a < 4; ++a) {
           EXPECT_EQ(out[e][3 * a + r], H[3 * r + a - 1]) << to_string(kModel) << " element " << e;
-          EXPECT_NEAR(dout[e][3 * a + r], dH[3 * r + a - 1], 1e-13 * scale) << to_string(kModel) << " element " << e;
+          EXPECT_NEAR(dout[e][3 * a + r], dH[3 * r + a - 1], 1e-13 * scale)
+              << to_string(kModel) << " element " << e;
         }
     }
   };
   using kernels::determinant;
-  check(std::integral_constant<MaterialModel, MaterialModel::Linear>{},
-        [&](const double* F, double* P) { kernels::linear_stress(F, mu, lambda, P); },
-        [&](const double* F, double) { return kernels::linear_energy(F, mu, lambda); },
-        [&](const double*, const double* dF, double* dP) { kernels::linear_stress_differential(dF, mu, lambda, dP); });
-  check(std::integral_constant<MaterialModel, MaterialModel::StVK>{},
-        [&](const double* F, double* P) { kernels::stvk_stress(F, mu, lambda, P); },
-        [&](const double* F, double) { return kernels::stvk_energy(F, mu, lambda); },
-        [&](const double* F, const double* dF, double* dP) { kernels::stvk_stress_differential(F, dF, mu, lambda, dP); });
-  check(std::integral_constant<MaterialModel, MaterialModel::StableNeoHookean>{},
-        [&](const double* F, double* P) { kernels::stable_neo_hookean_stress(F, mu, lambda, P); },
-        [&](const double* F, double J) { return kernels::stable_neo_hookean_energy(F, J, mu, lambda); },
-        [&](const double* F, const double* dF, double* dP) {
-          kernels::stable_neo_hookean_stress_differential(F, dF, mu, lambda, dP);
-        });
+  check(
+      std::integral_constant<MaterialModel, MaterialModel::Linear>{},
+      [&](const double* F, double* P) { kernels::linear_stress(F, mu, lambda, P); },
+      [&](const double* F, double) { return kernels::linear_energy(F, mu, lambda); },
+      [&](const double*, const double* dF, double* dP) {
+        kernels::linear_stress_differential(dF, mu, lambda, dP);
+      });
+  check(
+      std::integral_constant<MaterialModel, MaterialModel::StVK>{},
+      [&](const double* F, double* P) { kernels::stvk_stress(F, mu, lambda, P); },
+      [&](const double* F, double) { return kernels::stvk_energy(F, mu, lambda); },
+      [&](const double* F, const double* dF, double* dP) {
+        kernels::stvk_stress_differential(F, dF, mu, lambda, dP);
+      });
+  check(
+      std::integral_constant<MaterialModel, MaterialModel::StableNeoHookean>{},
+      [&](const double* F, double* P) { kernels::stable_neo_hookean_stress(F, mu, lambda, P); },
+      [&](const double* F, double J) {
+        return kernels::stable_neo_hookean_energy(F, J, mu, lambda);
+      },
+      [&](const double* F, const double* dF, double* dP) {
+        kernels::stable_neo_hookean_stress_differential(F, dF, mu, lambda, dP);
+      });
 }
 
 TEST(Forces, RejectsShapeMismatch) {

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "fem/simulator.hpp"
 #include "fem/static_solver.hpp"
@@ -31,7 +31,8 @@ TEST(Integrators, DampedDynamicsSettleToTheStaticSolution) {
   ASSERT_TRUE(solver.solve(ref, x_static).converged);
   // First mode ~2 Hz (omega_1 ~ 13 rad/s): alpha = 26/s damps it critically,
   // the residual after 1.5 s is ~exp(-13 * 1.5) ~ 1e-8 of the initial error.
-  for (Integrator integ : {Integrator::RK4, Integrator::SymplecticEuler, Integrator::BackwardEuler}) {
+  for (Integrator integ :
+       {Integrator::RK4, Integrator::SymplecticEuler, Integrator::BackwardEuler}) {
     SimulatorOptions o;
     o.integrator = integ;
     o.max_step = 2e-3;  // backward Euler: small enough not to matter for the end state
@@ -68,8 +69,8 @@ TEST(Integrators, SymplecticEulerKeepsEnergyWithinOnePercentOver10000Steps) {
 }
 
 // Frequency of q(t) = phi^T M (x(t) - X), by upward zero crossings (linear interpolation).
-double measured_frequency(Integrator integ, Model& model, const MatX3d& x0, const MatX3d& phi, double h,
-                          double duration) {
+double measured_frequency(Integrator integ, Model& model, const MatX3d& x0, const MatX3d& phi,
+                          double h, double duration) {
   State s{x0, MatX3d::Zero(model.num_nodes(), 3)};
   const MatX3d& X = model.mesh().rest_positions;
   auto q = [&](const MatX3d& x) {
@@ -80,9 +81,12 @@ double measured_frequency(Integrator integ, Model& model, const MatX3d& x0, cons
   std::vector<double> crossings;
   double prev = q(s.x);
   for (int k = 1; k * h <= duration; ++k) {
-    if (integ == Integrator::RK4) stepper.rk4(model, s, h);
-    else if (integ == Integrator::SymplecticEuler) stepper.symplectic_euler(model, s, h);
-    else implicit.step(model, s, h);
+    if (integ == Integrator::RK4)
+      stepper.rk4(model, s, h);
+    else if (integ == Integrator::SymplecticEuler)
+      stepper.symplectic_euler(model, s, h);
+    else
+      implicit.step(model, s, h);
     const double z = q(s.x);
     if (prev < 0 && z >= 0) crossings.push_back((k - 1) * h + h * (-prev) / (z - prev));
     prev = z;
@@ -144,7 +148,8 @@ FusedCase fused_case(bool element_damping) {
   if (element_damping) model.set_strain_rate_damping({1.0, 2.0});
   const int n = model.num_nodes();
   model.set_external_forces(test::random_field(n, 3));
-  State in{model.mesh().rest_positions + 0.01 * test::random_field(n, 1), 0.1 * test::random_field(n, 2)};
+  State in{model.mesh().rest_positions + 0.01 * test::random_field(n, 1),
+           0.1 * test::random_field(n, 2)};
   for (int i = 0; i < n; ++i)
     if (model.fixed_nodes()[i]) in.v.row(i).setZero();
   return {std::move(model), std::move(in)};
@@ -207,8 +212,10 @@ TEST(Integrators, GivenElasticForcesReplaceTheFirstEvaluationBitwise) {
         StateEnergies energies;
         extras.energies = &energies;
         if (k == 1) extras.elastic = &f;
-        if (integ == Integrator::RK4) stepper.rk4(c.model, c.in, out[k], 1e-4, extras);
-        else stepper.symplectic_euler(c.model, c.in, out[k], 1e-4, extras);
+        if (integ == Integrator::RK4)
+          stepper.rk4(c.model, c.in, out[k], 1e-4, extras);
+        else
+          stepper.symplectic_euler(c.model, c.in, out[k], 1e-4, extras);
         EXPECT_NEAR(energies.kinetic, c.model.kinetic_energy(c.in.v), 1e-14 * energies.kinetic);
       }
       EXPECT_TRUE(out[0].x.cwiseEqual(out[1].x).all()) << to_string(integ) << element_damping;
@@ -232,7 +239,7 @@ TEST(Integrators, StateEnergiesAreNotFiniteForANonFiniteEntry) {
   for (int k = 0; k < 3; ++k) {
     State s = c.in;
     if (k == 0) s.v(7, 1) = std::numeric_limits<double>::quiet_NaN();
-    if (k == 1) s.x(7, 0) = inf;  // no load along x
+    if (k == 1) s.x(7, 0) = inf;            // no load along x
     if (k == 2) s.x(fixed_node, 1) = -inf;  // no load at a fixed node
     const StateEnergies e = state_energies(c.model, s);
     EXPECT_FALSE(std::isfinite(e.kinetic) && std::isfinite(e.load)) << k;

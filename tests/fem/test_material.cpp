@@ -47,7 +47,8 @@ TEST(Material, LameParametersMatchTheirDefinition) {
   m.young = 2e6;
   m.poisson = 0.25;
   const Lame l = lame_parameters(m);
-  // Independent relations: E = mu (3 lambda + 2 mu) / (lambda + mu), nu = lambda / (2 (lambda + mu)).
+  // Independent relations: E = mu (3 lambda + 2 mu) / (lambda + mu), nu = lambda / (2 (lambda +
+  // mu)).
   EXPECT_NEAR(l.mu * (3 * l.lambda + 2 * l.mu) / (l.lambda + l.mu), 2e6, 1e-6);
   EXPECT_NEAR(l.lambda / (2 * (l.lambda + l.mu)), 0.25, 1e-14);
 }

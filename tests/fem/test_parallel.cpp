@@ -46,7 +46,8 @@ TEST_P(ParallelPerModel, ForcesEnergyAndDifferentialAreBitwiseIdenticalFor1And2T
 TEST_P(ParallelPerModel, LaneLoopsAreBitwiseIdenticalForTheBaselineAndAvx2InstructionSets) {
   // Only where the CPU has AVX2 (else there is one build to run).
   if (!lanes::set_lane_isa(lanes::LaneIsa::AVX2)) GTEST_SKIP() << "no AVX2 on this CPU";
-  const TetMeshData d = test::box_data(9, 2, 1);  // 108 tets: 13 whole 8-lane blocks and a partial one
+  const TetMeshData d =
+      test::box_data(9, 2, 1);  // 108 tets: 13 whole 8-lane blocks and a partial one
   const MatX3d x = d.rest_positions + 0.01 * test::random_field(d.num_nodes, 21);
   const MatX3d dx = test::random_field(d.num_nodes, 22);
   MatX3d f[2], df[2];
@@ -68,7 +69,8 @@ TEST_P(ParallelPerModel, LaneLoopsAreBitwiseIdenticalForTheBaselineAndAvx2Instru
   EXPECT_GT(h[0].energy, 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllModels, ParallelPerModel, ::testing::ValuesIn(test::all_models()), test::model_name);
+INSTANTIATE_TEST_SUITE_P(AllModels, ParallelPerModel, ::testing::ValuesIn(test::all_models()),
+                         test::model_name);
 
 TEST(Parallel, SymplecticEulerNodePassIsBitwiseIdenticalForTheBaselineAndAvx2InstructionSets) {
   // The fused node pass (a, v1, x1 and the start state's energies) is
@@ -119,10 +121,12 @@ TEST(Parallel, SimulationIsBitwiseIdenticalFor1And2Threads) {
       result[threads - 1] = sim.positions();
     }
     EXPECT_TRUE(bitwise_equal(result[0], result[1])) << to_string(integ);
-    EXPECT_GT((result[0] - test::cantilever(3, test::material(MaterialModel::Corotational)).mesh().rest_positions)
-                  .cwiseAbs()
-                  .maxCoeff(),
-              0.0);
+    EXPECT_GT(
+        (result[0] -
+         test::cantilever(3, test::material(MaterialModel::Corotational)).mesh().rest_positions)
+            .cwiseAbs()
+            .maxCoeff(),
+        0.0);
   }
 }
 

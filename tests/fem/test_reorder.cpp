@@ -48,7 +48,8 @@ TEST(Reorder, IsAPermutationThatKeepsGeometryOrientationAndForces) {
   ElasticForces f_old(make_tet_mesh_data(s.V, s.T), test::material(MaterialModel::StVK));
   ElasticForces f_new(make_tet_mesh_data(r.V, r.T), test::material(MaterialModel::StVK));
   MatX3d x_new(s.V.rows(), 3), fo(s.V.rows(), 3), fn(s.V.rows(), 3);
-  for (int i = 0; i < s.V.rows(); ++i) x_new.row(i) = s.V.row(r.new_to_old_node[i]) + d.row(r.new_to_old_node[i]);
+  for (int i = 0; i < s.V.rows(); ++i)
+    x_new.row(i) = s.V.row(r.new_to_old_node[i]) + d.row(r.new_to_old_node[i]);
   f_old.compute(s.V + d, fo);
   f_new.compute(x_new, fn);
   for (int i = 0; i < s.V.rows(); ++i)
@@ -66,7 +67,8 @@ TEST(Reorder, ReducesTheBandwidthOfAShuffledMeshToNearTheStructuredOne) {
   // a few cross-sections: well below the structured x-fastest numbering.
   EXPECT_LT(node_bandwidth(r.T), 60);
   // Consecutive elements share nodes: the smallest index is non-decreasing.
-  for (int e = 0; e + 1 < r.T.rows(); ++e) EXPECT_LE(r.T.row(e).minCoeff(), r.T.row(e + 1).minCoeff());
+  for (int e = 0; e + 1 < r.T.rows(); ++e)
+    EXPECT_LE(r.T.row(e).minCoeff(), r.T.row(e + 1).minCoeff());
 }
 
 }  // namespace

@@ -29,7 +29,8 @@ TEST(Simulator, FixedStepAboveTheLimitIsRefusedNamingTheLimit) {
     } catch (const ParameterError& e) {
       const std::string msg = e.what();
       EXPECT_NE(msg.find("stable step limit"), std::string::npos) << msg;
-      EXPECT_NE(msg.find(std::to_string(limit).substr(0, 5)), std::string::npos) << msg << " vs " << limit;
+      EXPECT_NE(msg.find(std::to_string(limit).substr(0, 5)), std::string::npos)
+          << msg << " vs " << limit;
     }
     EXPECT_THROW(over.step(1.05 * limit), ParameterError);
     // Later frames re-estimate with a few warm Lanczos products and take the
@@ -59,7 +60,8 @@ TEST(Simulator, StiffAndNearlyIncompressibleMaterialsRunWithAutomaticSteps) {
       const auto reps = run(sim, 3);
       EXPECT_TRUE(sim.positions().allFinite()) << to_string(mm);
       // The step chosen is safety x limit, and the limit ~ 2 / omega_max.
-      EXPECT_NEAR(reps[0].step, 0.9 * reps[0].step_limit, 0.01 * reps[0].step_limit) << to_string(mm);
+      EXPECT_NEAR(reps[0].step, 0.9 * reps[0].step_limit, 0.01 * reps[0].step_limit)
+          << to_string(mm);
       EXPECT_NEAR(reps[0].step_limit * reps[0].omega_max, 2.0, 1e-6);
       EXPECT_GT(reps[0].substeps, 10);
     }
@@ -72,7 +74,8 @@ TEST(Simulator, ReleaseFrom70PercentCompressionStaysFinite) {
   // allowed by policy Auto); corotational too when inversion is allowed.
   // StVK is not inversion-safe: it may stop, but only with a NumericalError
   // naming the element, never with NaN positions.
-  for (MaterialModel mm : {MaterialModel::StableNeoHookean, MaterialModel::Corotational, MaterialModel::StVK}) {
+  for (MaterialModel mm :
+       {MaterialModel::StableNeoHookean, MaterialModel::Corotational, MaterialModel::StVK}) {
     const TetMesh m = test::box(4, 4, 4, {0.2, 0.2, 0.2});
     Model model(m.V, m.T, test::material(mm, 1e6, 0.45));
     MatX3d x = m.V;
@@ -206,8 +209,10 @@ TEST(Simulator, FrameEndForcesReusedGiveTheTrajectoryOfPlainSteps) {
       while (t < frame) {
         const int remaining = static_cast<int>(std::ceil((frame - t) / o.fixed_step * (1 - 1e-12)));
         const double hh = (frame - t) / std::max(remaining, 1);
-        if (integ == Integrator::RK4) stepper.rk4(model, s, hh);
-        else stepper.symplectic_euler(model, s, hh);
+        if (integ == Integrator::RK4)
+          stepper.rk4(model, s, hh);
+        else
+          stepper.symplectic_euler(model, s, hh);
         t = remaining <= 1 ? frame : t + hh;
         ++count;
       }
@@ -264,15 +269,16 @@ UnstableRun unstable_run(EnergyCheck check, double overshoot, int max_retries) {
   o.energy_check = check;
   o.max_retries = max_retries;
   o.frequency_reuse_time = 1e9;
-  UnstableRun u{
-      std::make_unique<Simulator>(test::cantilever(1, test::material(MaterialModel::StVK, 1e7, 0.3), 0.0), o)};
+  UnstableRun u{std::make_unique<Simulator>(
+      test::cantilever(1, test::material(MaterialModel::StVK, 1e7, 0.3), 0.0), o)};
   const int n = u.sim->model().num_nodes();
   u.sim->set_velocities(1e-3 * test::random_field(n, 7));  // all modes excited
   const double limit = u.sim->stable_step_limit();
   const double omega = u.sim->last_frequency().omega_bound;
   const double r = 0.9 / overshoot;
   const RayleighDamping damping{0.0, (1 - r * r) / r / omega};
-  EXPECT_NEAR(stable_step_limit(Integrator::SymplecticEuler, omega, damping), r * limit, 1e-6 * limit);
+  EXPECT_NEAR(stable_step_limit(Integrator::SymplecticEuler, omega, damping), r * limit,
+              1e-6 * limit);
   u.sim->model().set_damping(damping);
   u.h = 0.9 * limit;
   return u;

@@ -3,8 +3,8 @@
 // and the integrators themselves on both sides of the limit.
 #include "fem/stable_step.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "fem/integrators.hpp"
 #include "fem/simulator.hpp"
@@ -44,7 +44,8 @@ TEST(StableStep, LanczosMatchesDenseEigenvaluesAtRestCompressedAndWithContact) {
         o.contact_stiffness = kc;
         const FrequencyEstimate est = estimate_max_frequency(model, *x, o);
         EXPECT_TRUE(est.converged) << to_string(mm);
-        EXPECT_NEAR(est.omega_max, dense_omega_max(model, *x, kc), 1e-4 * est.omega_max) << to_string(mm);
+        EXPECT_NEAR(est.omega_max, dense_omega_max(model, *x, kc), 1e-4 * est.omega_max)
+            << to_string(mm);
       }
     // A warm start from the last top Ritz vector converges in a few products.
     FrequencyOptions one;
@@ -85,7 +86,8 @@ TEST(StableStep, GivenForcesAtXReplaceTheBaseEvaluationOfTheForwardDifferences) 
   // The Simulator hands the forces of its last health check at x to the
   // per-frame re-estimate: the estimate must be bitwise the one that
   // evaluates them (the lane-kernel materials are deterministic at a given x).
-  for (MaterialModel mm : {MaterialModel::Linear, MaterialModel::StVK, MaterialModel::StableNeoHookean}) {
+  for (MaterialModel mm :
+       {MaterialModel::Linear, MaterialModel::StVK, MaterialModel::StableNeoHookean}) {
     Model model = test::cantilever(1, test::material(mm, 1e7, 0.45));
     const MatX3d x = model.mesh().rest_positions + 0.01 * test::random_field(model.num_nodes(), 5);
     FrequencyOptions o;
@@ -143,7 +145,8 @@ TEST(StableStep, LanczosMatchesDenseEigenvaluesAt70PercentCompressionForEveryMat
       const FrequencyEstimate est = estimate_max_frequency(model, x, {});
       const double dense = dense_omega_max(model, x);
       EXPECT_NEAR(est.omega_max, dense, 5e-4 * dense) << to_string(mm) << " a = " << a;
-      EXPECT_LE(est.omega_max, dense * (1 + 1e-9)) << to_string(mm) << " a = " << a;  // a Ritz value: a lower bound
+      EXPECT_LE(est.omega_max, dense * (1 + 1e-9))
+          << to_string(mm) << " a = " << a;  // a Ritz value: a lower bound
     }
   }
 }
@@ -161,7 +164,8 @@ double spectral_radius(Integrator integ, double omega, double c, double h) {
     const double k2x = v + 0.5 * h * k1v, k2v = acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
     const double k3x = v + 0.5 * h * k2v, k3v = acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v);
     const double k4x = v + h * k3v, k4v = acc(x + h * k3x, v + h * k3v);
-    return {x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x), v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)};
+    return {x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x),
+            v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)};
   };
   Eigen::Matrix2d A;
   A.col(0) = step(1, 0);
@@ -172,10 +176,12 @@ double spectral_radius(Integrator integ, double omega, double c, double h) {
 TEST(StableStep, LimitsMatchTheAmplificationMatrixOfEachIntegrator) {
   const double omega = 1000;
   EXPECT_NEAR(stable_step_limit(Integrator::SymplecticEuler, omega, {}), 2.0 / omega, 1e-12);
-  EXPECT_NEAR(stable_step_limit(Integrator::RK4, omega, {}), 2.0 * std::sqrt(2.0) / omega, 1e-9 / omega);
+  EXPECT_NEAR(stable_step_limit(Integrator::RK4, omega, {}), 2.0 * std::sqrt(2.0) / omega,
+              1e-9 / omega);
   EXPECT_TRUE(std::isinf(stable_step_limit(Integrator::BackwardEuler, omega, {})));
   for (Integrator integ : {Integrator::SymplecticEuler, Integrator::RK4})
-    for (RayleighDamping d : {RayleighDamping{0, 2e-4}, RayleighDamping{0, 2e-3}, RayleighDamping{5, 1e-4}}) {
+    for (RayleighDamping d :
+         {RayleighDamping{0, 2e-4}, RayleighDamping{0, 2e-3}, RayleighDamping{5, 1e-4}}) {
       const double h = stable_step_limit(integ, omega, d);
       // Stable for every mode up to omega at 0.999 h; the limiting mode is unstable at 1.001 h.
       double worst_below = 0, worst_above = 0;
@@ -198,7 +204,8 @@ double energy_growth(Integrator integ, double factor, int steps) {
   s.v = 1e-3 * test::random_field(model.num_nodes(), 7);  // all modes excited
   for (int i = 0; i < model.num_nodes(); ++i)
     if (model.fixed_nodes()[i]) s.v.row(i).setZero();
-  const double h = factor * stable_step_limit(integ, estimate_max_frequency(model, s.x, {}).omega_max, {});
+  const double h =
+      factor * stable_step_limit(integ, estimate_max_frequency(model, s.x, {}).omega_max, {});
   const double e0 = model.kinetic_energy(s.v);
   double emax = e0;
   ExplicitStepper stepper;
@@ -219,7 +226,6 @@ TEST(StableStep, IntegratorsAreStableAt099AndBlowUpAt105OfTheEstimate) {
     EXPECT_GT(energy_growth(integ, 1.05, 3000), 1e6) << to_string(integ);
   }
 }
-
 
 // A free cube squeezed by an isochoric initial velocity field (z compressed,
 // x and y stretched) that stiffens as it compresses and rebounds (stable
@@ -243,7 +249,8 @@ std::vector<SqueezeFrame> squeeze(Integrator integ, double reuse_time, int frame
   MatX3d v(m.V.rows(), 3);
   const double k = 150;  // 1/s
   for (int i = 0; i < m.V.rows(); ++i)
-    v.row(i) = k * Eigen::Vector3d(0.5 * (m.V(i, 0) - 0.15), 0.5 * (m.V(i, 1) - 0.15), -(m.V(i, 2) - 0.15));
+    v.row(i) = k * Eigen::Vector3d(0.5 * (m.V(i, 0) - 0.15), 0.5 * (m.V(i, 1) - 0.15),
+                                   -(m.V(i, 2) - 0.15));
   sim.set_velocities(v);
   std::vector<SqueezeFrame> out;
   double omega = dense_omega_max(reference, sim.positions());
@@ -285,12 +292,14 @@ TEST(StableStep, AutomaticStepStaysBelowTheTrueLimitWhileTheObjectStiffens) {
       if (f > 0) {
         EXPECT_EQ(pf.rep.frequency_products, 0);  // reused
       }
-      worst = std::max(worst, 0.9 * stable_step_limit(integ, frozen[0].rep.omega_max, {}) /
-                                  stable_step_limit(integ, std::max(pf.omega_start, pf.omega_end), {}));
+      worst =
+          std::max(worst, 0.9 * stable_step_limit(integ, frozen[0].rep.omega_max, {}) /
+                              stable_step_limit(integ, std::max(pf.omega_start, pf.omega_end), {}));
       omega_min = std::min(omega_min, pf.omega_start);
       omega_max = std::max(omega_max, pf.omega_start);
     }
-    EXPECT_GT(worst, 1.05) << to_string(integ) << ": omega_max " << omega_min << " .. " << omega_max;
+    EXPECT_GT(worst, 1.05) << to_string(integ) << ": omega_max " << omega_min << " .. "
+                           << omega_max;
   }
 }
 

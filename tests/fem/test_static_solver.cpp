@@ -66,7 +66,8 @@ TEST(StaticSolver, StretchedBarEndDisplacementIsFLOverEA) {
 
 // Timoshenko tip deflection of a clamped beam under its weight q = rho g A.
 double timoshenko(const Material& mat) {
-  const double E = mat.young, nu = mat.poisson, G = E / (2 * (1 + nu)), A = 0.01, I = 1e-4 / 12, L = 1.0;
+  const double E = mat.young, nu = mat.poisson, G = E / (2 * (1 + nu)), A = 0.01, I = 1e-4 / 12,
+               L = 1.0;
   const double q = mat.density * 9.81 * A, kappa = 10 * (1 + nu) / (12 + 11 * nu);
   return q * std::pow(L, 4) / (8 * E * I) + q * L * L / (2 * kappa * G * A);
 }
@@ -96,7 +97,8 @@ double first_frequency(Model& model) {
 TEST(StaticSolver, CantileverConvergesToTimoshenkoWithTheLockingTrendOfLinearTets) {
   const Material mat = test::material(MaterialModel::Linear, 1e8, 0.3);
   const double delta = timoshenko(mat);
-  const double f_beam = 1.8751 * 1.8751 / (2 * M_PI) * std::sqrt(mat.young * (1e-4 / 12) / (mat.density * 0.01));
+  const double f_beam =
+      1.8751 * 1.8751 / (2 * M_PI) * std::sqrt(mat.young * (1e-4 / 12) / (mat.density * 0.01));
   std::vector<double> ratio, freq;
   for (int r : {1, 2, 4, 8}) {  // 60, 480, 3840, 30720 tets
     Model model = test::cantilever(r, mat);
@@ -120,7 +122,8 @@ TEST(StaticSolver, CantileverConvergesToTimoshenkoWithTheLockingTrendOfLinearTet
   std::vector<double> err;
   for (double q : ratio) err.push_back(1 - q);
   for (size_t k = 0; k + 1 < err.size(); ++k) EXPECT_GT(err[k] / err[k + 1], 1.4) << k;
-  for (size_t k = 0; k + 2 < err.size(); ++k) EXPECT_GT(err[k + 1] / err[k + 2], err[k] / err[k + 1]);
+  for (size_t k = 0; k + 2 < err.size(); ++k)
+    EXPECT_GT(err[k + 1] / err[k + 2], err[k] / err[k + 1]);
   // Finest mesh (h/t = 1/8): C fitted on the coarser meshes is 3.5..4.4, growing
   // slowly; C <= 6 gives u_h/u >= 0.914. Tolerance: 9% below the beam value.
   EXPECT_GT(ratio.back(), 0.91);
@@ -146,7 +149,8 @@ TEST(StaticSolver, NonlinearMaterialsAgreeWithLinearForSmallLoadsAndConvergeForL
   StaticSolver ref_solver;
   ASSERT_TRUE(ref_solver.solve(ref_model, x_ref).converged);
   const double u_lin = test::tip_deflection(ref_model, x_ref);
-  for (MaterialModel mm : {MaterialModel::Corotational, MaterialModel::StVK, MaterialModel::StableNeoHookean}) {
+  for (MaterialModel mm :
+       {MaterialModel::Corotational, MaterialModel::StVK, MaterialModel::StableNeoHookean}) {
     Model model = test::cantilever(2, test::material(mm, 1e9, 0.3));
     MatX3d x = model.mesh().rest_positions;
     StaticSolver solver;

@@ -5,8 +5,8 @@
 // with the damping included in the step limit.
 #include "fem/strain_rate_damping.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "fem/simulator.hpp"
 #include "fem_test_utils.hpp"
@@ -16,18 +16,21 @@ namespace icd::fem {
 namespace {
 
 // Test-side dissipation function R(v) = 1/2 sum V (2 psi |Edot|^2 + phi tr(Edot)^2), Eigen only.
-double dissipation_oracle(const TetMeshData& d, const StrainRateDamping& sd, const MatX3d& x, const MatX3d& v) {
+double dissipation_oracle(const TetMeshData& d, const StrainRateDamping& sd, const MatX3d& x,
+                          const MatX3d& v) {
   double R = 0;
   for (int e = 0; e < d.num_tets(); ++e) {
     const Eigen::Matrix3d F = d.deformation_gradient(x, e);
     const Eigen::Matrix3d Fdot = d.deformation_gradient(v, e);  // linear in its argument
     const Eigen::Matrix3d Edot = 0.5 * (F.transpose() * Fdot + Fdot.transpose() * F);
-    R += 0.5 * d.rest_volume[e] * (2 * sd.psi * Edot.squaredNorm() + sd.phi * Edot.trace() * Edot.trace());
+    R += 0.5 * d.rest_volume[e] *
+         (2 * sd.psi * Edot.squaredNorm() + sd.phi * Edot.trace() * Edot.trace());
   }
   return R;
 }
 
-MatX3d damping_force(const TetMeshData& d, const StrainRateDamping& sd, const MatX3d& x, const MatX3d& v) {
+MatX3d damping_force(const TetMeshData& d, const StrainRateDamping& sd, const MatX3d& x,
+                     const MatX3d& v) {
   MatX3d f = MatX3d::Zero(d.num_nodes, 3);
   add_strain_rate_damping_forces(d, sd, x, v, f);
   return f;
@@ -39,7 +42,8 @@ TEST(StrainRateDamping, RigidVelocitiesAreNotDamped) {
   const MatX3d x = d.rest_positions + 0.02 * test::random_field(d.num_nodes, 11);
   const Eigen::Vector3d w(0.3, -1.2, 0.7), t(0.5, 0.1, -0.4);
   MatX3d v(d.num_nodes, 3);
-  for (int i = 0; i < d.num_nodes; ++i) v.row(i) = (w.cross(Eigen::Vector3d(x.row(i))) + t).transpose();
+  for (int i = 0; i < d.num_nodes; ++i)
+    v.row(i) = (w.cross(Eigen::Vector3d(x.row(i))) + t).transpose();
   MatX3d u = test::random_field(d.num_nodes, 12);
   u *= v.norm() / u.norm();  // a generic velocity of the same size
   const MatX3d generic = damping_force(d, sd, x, u);
@@ -61,7 +65,8 @@ TEST(StrainRateDamping, ForceIsMinusTheGradientOfTheDissipationFunctionAndDissip
       MatX3d vp = v, vm = v;
       vp(i, c) += h;
       vm(i, c) -= h;
-      const double fd = -(dissipation_oracle(d, sd, x, vp) - dissipation_oracle(d, sd, x, vm)) / (2 * h);
+      const double fd =
+          -(dissipation_oracle(d, sd, x, vp) - dissipation_oracle(d, sd, x, vm)) / (2 * h);
       EXPECT_NEAR(f(i, c), fd, 1e-9 * f.cwiseAbs().maxCoeff()) << "node " << i << " axis " << c;
     }
   const double R = dissipation_oracle(d, sd, x, v);
@@ -84,7 +89,8 @@ TEST(StrainRateDamping, AffineVelocityGivesTheAnalyticViscousStress) {
   const MatX3d x = (d.rest_positions * A.transpose()).rowwise() + Eigen::RowVector3d(0.1, 0.2, 0.3);
   const MatX3d v = d.rest_positions * B.transpose();
   const Eigen::Matrix3d Edot = 0.5 * (A.transpose() * B + B.transpose() * A);
-  const Eigen::Matrix3d P = A * (sd.phi * Edot.trace() * Eigen::Matrix3d::Identity() + 2 * sd.psi * Edot);
+  const Eigen::Matrix3d P =
+      A * (sd.phi * Edot.trace() * Eigen::Matrix3d::Identity() + 2 * sd.psi * Edot);
   MatX3d expected = MatX3d::Zero(d.num_nodes, 3);
   for (int k = 0; k < mesh.F.rows(); ++k) {
     const Eigen::Vector3d X0 = mesh.V.row(mesh.F(k, 0)), X1 = mesh.V.row(mesh.F(k, 1)),
@@ -94,9 +100,10 @@ TEST(StrainRateDamping, AffineVelocityGivesTheAnalyticViscousStress) {
   }
   const MatX3d f = damping_force(d, sd, x, v);
   EXPECT_LT((f - expected).cwiseAbs().maxCoeff(), 1e-12 * P.norm() * 0.01);
-  EXPECT_NEAR(strain_rate_dissipation(d, sd, x, v),
-              0.5 * size.prod() * (2 * sd.psi * Edot.squaredNorm() + sd.phi * Edot.trace() * Edot.trace()),
-              1e-12 * size.prod() * P.norm());
+  EXPECT_NEAR(
+      strain_rate_dissipation(d, sd, x, v),
+      0.5 * size.prod() * (2 * sd.psi * Edot.squaredNorm() + sd.phi * Edot.trace() * Edot.trace()),
+      1e-12 * size.prod() * P.norm());
 }
 
 TEST(StrainRateDamping, LargestDampingRateMatchesDenseEigenvalues) {
@@ -124,15 +131,18 @@ TEST(StrainRateDamping, LargestDampingRateMatchesDenseEigenvalues) {
   EXPECT_LT((D - D.transpose()).norm(), 1e-10 * D.norm());
   // The assembled matrix (backward Euler's) equals the columns of the force map.
   Eigen::SparseMatrix<double> A = model.elastic().pattern().zero_matrix();
-  add_strain_rate_damping_matrix(model.mesh(), model.elastic().pattern(), mo.strain_rate_damping, x, 1.0, A);
+  add_strain_rate_damping_matrix(model.mesh(), model.elastic().pattern(), mo.strain_rate_damping, x,
+                                 1.0, A);
   const Eigen::MatrixXd Ad = Eigen::MatrixXd(A);
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) EXPECT_NEAR(Ad(free[a], free[b]), D(a, b), 1e-12 * D.norm());
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(D, M, Eigen::EigenvaluesOnly);
-  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-9 * es.eigenvalues().maxCoeff());  // positive semi-definite
+  EXPECT_GT(es.eigenvalues().minCoeff(),
+            -1e-9 * es.eigenvalues().maxCoeff());  // positive semi-definite
   const double c = estimate_max_damping_rate(model, x, {});
   EXPECT_NEAR(c, es.eigenvalues().maxCoeff(), 1e-4 * c);
-  EXPECT_GE(c, es.eigenvalues().maxCoeff() * (1 - 1e-12));  // the residual bound is an upper bound here
+  EXPECT_GE(
+      c, es.eigenvalues().maxCoeff() * (1 - 1e-12));  // the residual bound is an upper bound here
 }
 
 TEST(StrainRateDamping, ExplicitStepsAreStableWithTheDampingInTheLimit) {
@@ -156,14 +166,17 @@ TEST(StrainRateDamping, ExplicitStepsAreStableWithTheDampingInTheLimit) {
       EXPECT_LE(limit, 2.0 / c * (1 + 1e-12));
     }
     auto run = [&](double h) {
-      State s{m.V + 0.01 * test::random_field(model.num_nodes(), 5), MatX3d::Zero(model.num_nodes(), 3)};
+      State s{m.V + 0.01 * test::random_field(model.num_nodes(), 5),
+              MatX3d::Zero(model.num_nodes(), 3)};
       for (int i : fixed) s.x.row(i) = m.V.row(i);
       ExplicitStepper stepper;
       const double e0 = model.elastic().energy(s.x);
       double e = e0;
       for (int k = 0; k < 400 && std::isfinite(e) && e < 1e6 * e0; ++k) {
-        if (integ == Integrator::RK4) stepper.rk4(model, s, h);
-        else stepper.symplectic_euler(model, s, h);
+        if (integ == Integrator::RK4)
+          stepper.rk4(model, s, h);
+        else
+          stepper.symplectic_euler(model, s, h);
         e = model.kinetic_energy(s.v) + model.elastic().energy(s.x);
       }
       return e / e0;
@@ -177,7 +190,8 @@ TEST(StrainRateDamping, SimulatorStepsStayStableAndDissipateForEveryIntegrator) 
   // Through the Simulator: automatic steps include the damping rate in the
   // limit (explicit), Newton includes h D (backward Euler, few iterations);
   // without gravity and loads, KE + W only decreases from a perturbed state.
-  for (Integrator integ : {Integrator::RK4, Integrator::SymplecticEuler, Integrator::BackwardEuler}) {
+  for (Integrator integ :
+       {Integrator::RK4, Integrator::SymplecticEuler, Integrator::BackwardEuler}) {
     ModelOptions mo;
     mo.strain_rate_damping = {500.0, 1000.0};
     const TetMesh m = test::box(10, 1, 1);

@@ -25,8 +25,16 @@ inline void write_fixture_bundle(const std::filesystem::path& folder) {
 /// Recomputes the total-size field and every checksum of bundle.icdb bytes
 /// wherever the layout (coupling/asset_bundle.hpp) can still be followed.
 inline void fix_bundle_checksums(std::string& s) {
-  auto get64 = [&](size_t at) { uint64_t v; std::memcpy(&v, s.data() + at, 8); return v; };
-  auto get32 = [&](size_t at) { uint32_t v; std::memcpy(&v, s.data() + at, 4); return v; };
+  auto get64 = [&](size_t at) {
+    uint64_t v;
+    std::memcpy(&v, s.data() + at, 8);
+    return v;
+  };
+  auto get32 = [&](size_t at) {
+    uint32_t v;
+    std::memcpy(&v, s.data() + at, 4);
+    return v;
+  };
   auto put64 = [&](size_t at, uint64_t v) { std::memcpy(s.data() + at, &v, 8); };
   if (s.size() < 32) return;
   put64(16, s.size());
@@ -47,8 +55,8 @@ inline void fix_bundle_checksums(std::string& s) {
 /// checksums fixed first) and loads it; returns the loaded bundle or throws.
 inline coupling::AssetBundle load_mutated_bundle(const std::filesystem::path& folder,
                                                  const uint8_t* data, size_t size) {
-  std::string bytes = size > 0 ? std::string(reinterpret_cast<const char*>(data) + 1, size - 1)
-                               : std::string();
+  std::string bytes =
+      size > 0 ? std::string(reinterpret_cast<const char*>(data) + 1, size - 1) : std::string();
   if (size > 0 && (data[0] & 1)) fix_bundle_checksums(bytes);
   {
     std::FILE* f = std::fopen((folder / coupling::kBundleDataFile).c_str(), "wb");

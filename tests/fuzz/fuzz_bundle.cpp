@@ -65,6 +65,7 @@ void check_bundle(const icd::coupling::AssetBundle& b) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const fs::path folder = make_folder();
-  icd::fuzz::expect_clean([&] { check_bundle(icd::fuzz::load_mutated_bundle(folder, data, size)); });
+  icd::fuzz::expect_clean(
+      [&] { check_bundle(icd::fuzz::load_mutated_bundle(folder, data, size)); });
   return 0;
 }

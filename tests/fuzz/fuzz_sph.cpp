@@ -29,8 +29,7 @@ void check_tree(const icd::collision::SphereTree& t) {
   }
   for (int i = 0; i < n; ++i) {
     if (t.child_count[i] < 0) finding("sph: negative child count");
-    if (t.child_count[i] > 0 &&
-        (t.first_child[i] <= i || t.first_child[i] + t.child_count[i] > n))
+    if (t.child_count[i] > 0 && (t.first_child[i] <= i || t.first_child[i] + t.child_count[i] > n))
       finding("sph: child range out of bounds");
   }
 }

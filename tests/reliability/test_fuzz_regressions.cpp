@@ -117,8 +117,8 @@ Counts replay_folder(const fs::path& root) {
 TEST(FuzzRegressions, EveryKeptInputGivesAResultOrADocumentedError) {
   const Counts c = replay_folder(fs::path(ICD_FUZZ_DIR) / "regressions");
   RecordProperty("files", c.files);
-  std::cout << "regressions: " << c.files << " files, " << c.accepted << " accepted, "
-            << c.refused << " refused\n";
+  std::cout << "regressions: " << c.files << " files, " << c.accepted << " accepted, " << c.refused
+            << " refused\n";
 }
 
 TEST(FuzzRegressions, EverySeedIsAcceptedOrRefusedCleanly) {

@@ -44,8 +44,7 @@ TEST(HeaderCounts, PlyClaimingTeraVerticesFailsFast) {
       "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n"
       "property float x\nproperty float y\nproperty float z\nelement face 1\n"
       "property list uchar int vertex_indices\nend_header\n";
-  expect_input_error_naming([&] { parse_ply(h + std::string(20, '\0'), "huge.ply"); },
-                            "huge.ply");
+  expect_input_error_naming([&] { parse_ply(h + std::string(20, '\0'), "huge.ply"); }, "huge.ply");
 }
 
 TEST(HeaderCounts, BinaryStlClaimingFourBillionTrianglesFailsFast) {
@@ -66,7 +65,8 @@ TEST(HeaderCounts, VtuClaimingTeraPointsFailsFast) {
 }
 
 TEST(HeaderCounts, SphClaimingAHugeTreeFailsFast) {
-  for (const char* header : {"16 64\n0 0 0 1 0\n", "1000000 2\n0 0 0 1 0\n", "12 12\n0 0 0 1 0\n"}) {
+  for (const char* header :
+       {"16 64\n0 0 0 1 0\n", "1000000 2\n0 0 0 1 0\n", "12 12\n0 0 0 1 0\n"}) {
     std::istringstream in(header);
     expect_input_error_naming([&] { collision::read_sph(in, "huge.sph"); }, "huge.sph");
   }

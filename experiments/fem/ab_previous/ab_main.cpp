@@ -51,16 +51,16 @@ int main(int argc, char** argv) {
   const int mesh = argc > 1 ? std::atoi(argv[1]) : 0;
   const int reps = argc > 2 ? std::atoi(argv[2]) : 11;
   const int check = argc > 3 ? std::atoi(argv[3]) : 1;
-  std::printf("%s, check interval %d, %d repetitions, load average before: %s\n", mesh ? "block" : "bar", check,
-              reps, load_average().c_str());
+  std::printf("%s, check interval %d, %d repetitions, load average before: %s\n",
+              mesh ? "block" : "bar", check, reps, load_average().c_str());
   const char* names[4] = {"old rk4", "old symplectic_euler", "new rk4", "new symplectic_euler"};
   std::vector<std::vector<double>> frames[4];
   for (auto& f : frames) f.assign(60, {});
   long steps[4] = {0, 0, 0, 0};
   double low[4] = {0, 0, 0, 0};
   for (int r = 0; r < reps; ++r) {
-    void* sims[4] = {make_sim_old(0, mesh, check), make_sim_old(1, mesh, check), make_sim_new(0, mesh, check),
-                     make_sim_new(1, mesh, check)};
+    void* sims[4] = {make_sim_old(0, mesh, check), make_sim_old(1, mesh, check),
+                     make_sim_new(0, mesh, check), make_sim_new(1, mesh, check)};
     for (int f = 0; f < 60; ++f)
       for (int k = 0; k < 4; ++k) {
         const double c0 = cpu_seconds();
@@ -70,8 +70,10 @@ int main(int argc, char** argv) {
       }
     for (int k = 0; k < 4; ++k) {
       low[k] = k < 2 ? lowest_z_old(sims[k]) : lowest_z_new(sims[k]);
-      if (k < 2) free_sim_old(sims[k]);
-      else free_sim_new(sims[k]);
+      if (k < 2)
+        free_sim_old(sims[k]);
+      else
+        free_sim_new(sims[k]);
     }
   }
   double total[4], steady[4];
@@ -83,14 +85,17 @@ int main(int argc, char** argv) {
       if (f > 0) steady[k] += m;
     }
     steady[k] *= 60.0 / 59.0;
-    std::printf("%-21s %.4f s CPU per simulated s (without the first frame %.4f s), %ld sub-steps, lowest z %.9f m\n",
-                names[k], total[k], steady[k], steps[k], low[k]);
+    std::printf(
+        "%-21s %.4f s CPU per simulated s (without the first frame %.4f s), %ld sub-steps, lowest "
+        "z %.9f m\n",
+        names[k], total[k], steady[k], steps[k], low[k]);
   }
   std::printf(
-      "symplectic Euler / RK4: old %.3fx (without the first frame %.3fx), new %.3fx (%.3fx); new vs old: RK4 "
+      "symplectic Euler / RK4: old %.3fx (without the first frame %.3fx), new %.3fx (%.3fx); new "
+      "vs old: RK4 "
       "%.3fx, symplectic Euler %.3fx faster\n",
-      total[0] / total[1], steady[0] / steady[1], total[2] / total[3], steady[2] / steady[3], total[0] / total[2],
-      total[1] / total[3]);
+      total[0] / total[1], steady[0] / steady[1], total[2] / total[3], steady[2] / steady[3],
+      total[0] / total[2], total[1] / total[3]);
   std::printf("load average after: %s\n", load_average().c_str());
   return 0;
 }

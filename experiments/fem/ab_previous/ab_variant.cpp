@@ -7,9 +7,9 @@
 // integrator (0 RK4, 1 symplectic Euler) and the check interval.
 #include <vector>
 
+#include "../clamped_bar.hpp"
 #include "fem/simulator.hpp"
 #include "mesh/io/primitives.hpp"
-#include "../clamped_bar.hpp"
 
 #define ICD_AB_CAT2(a, b) a##b
 #define ICD_AB_CAT(a, b) ICD_AB_CAT2(a, b)
@@ -32,7 +32,9 @@ void* ICD_AB_NAME(make_sim)(int integrator, int mesh, int check_interval) {
   return new Simulator(std::move(model), so);
 }
 
-int ICD_AB_NAME(advance)(void* sim) { return static_cast<icd::fem::Simulator*>(sim)->advance(1.0 / 60).substeps; }
+int ICD_AB_NAME(advance)(void* sim) {
+  return static_cast<icd::fem::Simulator*>(sim)->advance(1.0 / 60).substeps;
+}
 
 double ICD_AB_NAME(lowest_z)(void* sim) {
   return static_cast<icd::fem::Simulator*>(sim)->positions().col(2).minCoeff();

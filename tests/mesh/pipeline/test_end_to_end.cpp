@@ -79,8 +79,9 @@ TEST(EndToEnd, DragonDefaultsWithOctreeSpheres) {
         Eigen::Vector3d(stretch(rng), stretch(rng), stretch(rng)).asDiagonal();
     MatX3d X(b.coarse.V.rows(), 3);
     for (int i = 0; i < X.rows(); ++i) {
-      const Eigen::Vector3d noisy = b.coarse.V.row(i).transpose() +
-                                    0.01 * r.bbox_diagonal * Eigen::Vector3d(g(rng), g(rng), g(rng));
+      const Eigen::Vector3d noisy =
+          b.coarse.V.row(i).transpose() +
+          0.01 * r.bbox_diagonal * Eigen::Vector3d(g(rng), g(rng), g(rng));
       X.row(i) = (Rt * S * noisy).transpose();
     }
     EXPECT_EQ(ev.apply(X, fast).degenerate_triples, 0) << "trial " << trial;

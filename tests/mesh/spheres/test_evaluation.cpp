@@ -111,8 +111,8 @@ TEST(Evaluation, CountsSpheresThatCoverNothingAlone) {
   // Two halves, each alone over the corners of its side (|(1, 1, 1) - (-0.5, 0, 0)| = 2.06 >
   // 1.51); one sphere inside touching only the face centres, which the halves cover too; one
   // tucked inside the object, touching nothing.
-  const icd::collision::Sphere left{-0.5, 0, 0, 1.51}, right{0.5, 0, 0, 1.51},
-      middle{0, 0, 0, 1.0}, inner{0.2, 0.1, 0, 0.4};
+  const icd::collision::Sphere left{-0.5, 0, 0, 1.51}, right{0.5, 0, 0, 1.51}, middle{0, 0, 0, 1.0},
+      inner{0.2, 0.1, 0, 0.4};
   const auto metrics = evaluate_sphere_tree(cube, root_over({left, middle, right, inner}), options);
   ASSERT_EQ(metrics.size(), 2u);
   EXPECT_EQ(metrics[1].num_uncovered_samples, 0);

@@ -83,9 +83,9 @@ TEST(TriangleBvh, MatchesBruteForceOnSphereAndTorus) {
       EXPECT_NEAR(hit.squared_distance, brute, 1e-14 * (1 + brute)) << t;
       EXPECT_NEAR((hit.point - p).squaredNorm(), hit.squared_distance, 1e-12);
       ASSERT_GE(hit.face, 0);
-      const Eigen::Vector3d on_face = closest_point_on_triangle(
-          p, mesh.V.row(mesh.F(hit.face, 0)), mesh.V.row(mesh.F(hit.face, 1)),
-          mesh.V.row(mesh.F(hit.face, 2)));
+      const Eigen::Vector3d on_face = closest_point_on_triangle(p, mesh.V.row(mesh.F(hit.face, 0)),
+                                                                mesh.V.row(mesh.F(hit.face, 1)),
+                                                                mesh.V.row(mesh.F(hit.face, 2)));
       EXPECT_NEAR((on_face - hit.point).norm(), 0.0, 1e-12);
       EXPECT_NEAR(bvh.distance(p), std::sqrt(brute), 1e-12);
     }
