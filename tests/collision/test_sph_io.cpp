@@ -2,6 +2,7 @@
 
 #include <random>
 #include <sstream>
+#include <string>
 
 #include "collision/sph_io.hpp"
 #include "mesh/io/error.hpp"
@@ -134,26 +135,25 @@ TEST(SphIo, RandomTreesRoundTrip) {
 }
 
 TEST(SphIo, MalformedFilesThrowInputError) {
-  const char*
-      bad
-          [] =
-              {
-                  "",                                         // empty
-                  "two 3\n",                                  // non-numeric header
-                  "2 3\n0 0 0 1 1\n1 1 1 1 1\n",              // too few lines
-                  "1 3\n0 0 0 1 1\n0 0 0 1 1\n",              // too many lines
-                  "1 3\n0 0 nan 1 1\n",                       // NaN
-                  "1 3\n0 0 0 inf 1\n",                       // infinite radius
-                  "1 3\n0 0 x 1 1\n",                         // not a number
-                  "1 2\n0 0 0 -1 0\n",                        // unused root
-                  "2 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n",  // fine: checks next line is valid
-                  "3 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 "
-                  "0\n",                 // child of unused
-                  "30 64\n0 0 0 1 1\n",  // huge declared size
-                  "12 64\n0 0 0 1 1\n",  // (64^12-1)/63 lines: over the cap
-                  "-1 2\n",
-                  "2 0\n",
-              };
+  // The child of an unused node: 7 lines of a depth-3 binary tree.
+  const std::string child_of_unused =
+      "3 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n0 0 0 1 0\n";
+  const char* bad[] = {
+      "",                                         // empty
+      "two 3\n",                                  // non-numeric header
+      "2 3\n0 0 0 1 1\n1 1 1 1 1\n",              // too few lines
+      "1 3\n0 0 0 1 1\n0 0 0 1 1\n",              // too many lines
+      "1 3\n0 0 nan 1 1\n",                       // NaN
+      "1 3\n0 0 0 inf 1\n",                       // infinite radius
+      "1 3\n0 0 x 1 1\n",                         // not a number
+      "1 2\n0 0 0 -1 0\n",                        // unused root
+      "2 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n",  // fine: checks next line is valid
+      child_of_unused.c_str(),
+      "30 64\n0 0 0 1 1\n",  // huge declared size
+      "12 64\n0 0 0 1 1\n",  // (64^12-1)/63 lines: over the cap
+      "-1 2\n",
+      "2 0\n",
+  };
   for (const char* text : bad) {
     std::stringstream ss(text);
     if (std::string(text) == "2 2\n0 0 0 1 0\n0 0 0 -1 0\n0 0 0 1 0\n") {
