@@ -33,6 +33,7 @@
 
 #include "collision/aabb_tree.hpp"
 #include "coupling/contact_response.hpp"
+#include "experiments/common/command_line.hpp"
 #include "experiments/paper/contact_moment.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/atomic_write.hpp"
@@ -191,14 +192,6 @@ class Evaluator {
   double m_volume_full = 0;
 };
 
-void usage() {
-  std::printf(
-      "usage: contact_error [--out DIR] [--scene FILE] [--budgets s1,s2,...] [--test-budgets "
-      "n1,...]\n"
-      "                     [--reps N] [--after N] [--max-frames N]\n"
-      "  Default scene experiments/scenes/bunny_dragon.json; writes DIR/contact_error.csv.\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -207,27 +200,17 @@ int main(int argc, char** argv) {
   std::string budgets_text = "1e-6,3e-6,1e-5,3e-5,1e-4,3e-4,1e-3,3e-3,1e-2";
   std::string tests_text = "30,100,300,1000,3000,10000,30000,100000";
   int reps = 5, after = 3, max_frames = 200;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
-      out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc)
-      scene_path = argv[++i];
-    else if (a == "--budgets" && i + 1 < argc)
-      budgets_text = argv[++i];
-    else if (a == "--test-budgets" && i + 1 < argc)
-      tests_text = argv[++i];
-    else if (a == "--reps" && i + 1 < argc)
-      reps = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--after" && i + 1 < argc)
-      after = std::stoi(argv[++i]);
-    else if (a == "--max-frames" && i + 1 < argc)
-      max_frames = std::stoi(argv[++i]);
-    else {
-      usage();
-      return a == "--help" || a == "-h" ? 0 : 2;
-    }
-  }
+  icd::experiments::CommandLine cli(
+      "contact_error",
+      "  Default scene experiments/scenes/bunny_dragon.json; writes DIR/contact_error.csv.");
+  cli.path("--out", out, "DIR", "output folder (default results/contact_error)")
+      .path("--scene", scene_path, "FILE", "scene file")
+      .text("--budgets", budgets_text, "s1,s2,...", "critical times (s)")
+      .text("--test-budgets", tests_text, "n1,n2,...", "sphere-test budgets")
+      .integer("--reps", reps, "N", "repetitions per budget (default 5)", 1)
+      .integer("--after", after, "N", "frames after first contact (default 3)", 0)
+      .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     const std::vector<double> budgets = experiments::parse_list(budgets_text, "--budgets");
     const std::vector<double> test_budgets = experiments::parse_list(tests_text, "--test-budgets");

@@ -22,6 +22,7 @@
 
 #include "coupling/barycentric_embedding.hpp"
 #include "coupling/rigid_links.hpp"
+#include "experiments/common/command_line.hpp"
 #include "experiments/paper/contact_moment.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/atomic_write.hpp"
@@ -116,14 +117,6 @@ Run run_resolution(Scene scene, int cells, int frames) {
   return run;
 }
 
-void usage() {
-  std::printf(
-      "usage: deformation_error [--out DIR] [--scene FILE] [--frames N] [--reps N]\n"
-      "                         [--resolution-scene FILE] [--cells a,b,...] [--fine N]\n"
-      "  Defaults: bunny_dragon.json for the links, two_spheres.json with cells 2,3,4,6,8\n"
-      "  against 12 for the resolution; 60 frames.\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -132,27 +125,18 @@ int main(int argc, char** argv) {
   fs::path res_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
   std::string cells_text = "2,3,4,6,8";
   int frames = 60, reps = 5, fine = 12;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
-      out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc)
-      scene_path = argv[++i];
-    else if (a == "--resolution-scene" && i + 1 < argc)
-      res_path = argv[++i];
-    else if (a == "--cells" && i + 1 < argc)
-      cells_text = argv[++i];
-    else if (a == "--fine" && i + 1 < argc)
-      fine = std::stoi(argv[++i]);
-    else if (a == "--frames" && i + 1 < argc)
-      frames = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--reps" && i + 1 < argc)
-      reps = std::max(1, std::stoi(argv[++i]));
-    else {
-      usage();
-      return a == "--help" || a == "-h" ? 0 : 2;
-    }
-  }
+  icd::experiments::CommandLine cli(
+      "deformation_error",
+      "  Defaults: bunny_dragon.json for the links, two_spheres.json with cells 2,3,4,6,8\n"
+      "  against 12 for the resolution; 60 frames.");
+  cli.path("--out", out, "DIR", "output folder (default results/deformation_error)")
+      .path("--scene", scene_path, "FILE", "scene of the link experiment")
+      .integer("--frames", frames, "N", "frames per run", 1)
+      .integer("--reps", reps, "N", "repetitions (default 5)", 1)
+      .path("--resolution-scene", res_path, "FILE", "scene of the resolution experiment")
+      .text("--cells", cells_text, "a,b,...", "coarse resolutions (cells per side)")
+      .integer("--fine", fine, "N", "reference resolution (cells per side)", 1);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     const std::vector<double> cells = experiments::parse_list(cells_text, "--cells");
     auto prepare = [](const fs::path& p) {

@@ -24,6 +24,7 @@
 #include "collision/coverage.hpp"
 #include "collision/octree_tree.hpp"
 #include "collision/sphere_update.hpp"
+#include "experiments/common/command_line.hpp"
 #include "experiments/paper/contact_moment.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/atomic_write.hpp"
@@ -52,36 +53,22 @@ double leaf_volume(const collision::SphereTree& t) {
   return v;
 }
 
-void usage() {
-  std::printf(
-      "usage: sphere_update_error [--out DIR] [--scene FILE] [--frames N] [--every N] [--reps N]\n"
-      "  Default scene experiments/scenes/two_spheres.json (octree trees, so the rebuilt tree\n"
-      "  uses the same builder), 60 frames, every frame.\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   fs::path out = "results/sphere_update";
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
   int frames = 60, every = 1, reps = 5;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
-      out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc)
-      scene_path = argv[++i];
-    else if (a == "--frames" && i + 1 < argc)
-      frames = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--every" && i + 1 < argc)
-      every = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--reps" && i + 1 < argc)
-      reps = std::max(1, std::stoi(argv[++i]));
-    else {
-      usage();
-      return a == "--help" || a == "-h" ? 0 : 2;
-    }
-  }
+  icd::experiments::CommandLine cli(
+      "sphere_update_error",
+      "  Default scene experiments/scenes/two_spheres.json (octree trees, so the rebuilt tree\n"
+      "  uses the same builder), 60 frames, every frame.");
+  cli.path("--out", out, "DIR", "output folder (default results/sphere_update)")
+      .path("--scene", scene_path, "FILE", "scene file")
+      .integer("--frames", frames, "N", "frames", 1)
+      .integer("--every", every, "N", "compare every N-th frame", 1)
+      .integer("--reps", reps, "N", "timing repetitions (default 5)", 1);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   std::ostringstream csv;
   csv << "scene,frame,object,method,seconds,uncovered_fraction,max_gap,tightness,leaf_spheres,"
          "max_displacement\n";

@@ -14,13 +14,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <unordered_map>
 
 #include "collision/coverage.hpp"
 #include "collision/sphere_update.hpp"
 #include "collision/traversal.hpp"
 #include "experiments/collision/workloads.hpp"
+#include "experiments/common/command_line.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -190,14 +190,9 @@ void coherence_experiment(int levels) {
 
 int main(int argc, char** argv) {
   int levels = 6;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--levels") && i + 1 < argc)
-      levels = std::atoi(argv[++i]);
-    else {
-      std::fprintf(stderr, "usage: %s [--levels L]\n", argv[0]);
-      return 2;
-    }
-  }
+  icd::experiments::CommandLine cli("icd_collision_accuracy");
+  cli.integer("--levels", levels, "L", "sphere-tree levels (default 6)", 1);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     coverage_experiment("ChineseDragon-10kv.off", 4);
     coverage_experiment("ChineseDragon-10kv.off", 6);

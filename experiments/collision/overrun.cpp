@@ -13,7 +13,6 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <random>
 #include <string>
@@ -22,6 +21,7 @@
 
 #include "collision/traversal.hpp"
 #include "experiments/collision/workloads.hpp"
+#include "experiments/common/command_line.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -87,18 +87,11 @@ int main(int argc, char** argv) {
   long long max_queries = 10000;
   double max_seconds = 4.0;
   std::string csv_path;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--queries") && i + 1 < argc)
-      max_queries = std::atoll(argv[++i]);
-    else if (!std::strcmp(argv[i], "--max-seconds") && i + 1 < argc)
-      max_seconds = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc)
-      csv_path = argv[++i];
-    else {
-      std::fprintf(stderr, "usage: %s [--queries N] [--max-seconds S] [--csv FILE]\n", argv[0]);
-      return 2;
-    }
-  }
+  icd::experiments::CommandLine cli("icd_collision_overrun");
+  cli.integer("--queries", max_queries, "N", "queries at most (default 10000)", 1LL)
+      .real("--max-seconds", max_seconds, "S", "wall time at most (default 4)", 0.0)
+      .text("--csv", csv_path, "FILE", "also write the measurements as CSV");
+  if (const auto status = cli.parse(argc, argv)) return *status;
   // Workload: two deep octree trees over overlapping icospheres: a full
   // traversal takes longer than the largest budget.
   std::printf("building trees...\n");

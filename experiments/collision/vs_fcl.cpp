@@ -11,7 +11,6 @@
 // Usage: icd_collision_vs_fcl [--frames N] [--levels L]
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,6 +21,7 @@
 #include "collision/sphere_update.hpp"
 #include "collision/traversal.hpp"
 #include "experiments/collision/workloads.hpp"
+#include "experiments/common/command_line.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -161,16 +161,10 @@ void run_scene(const std::string& file, int frames, int levels) {
 
 int main(int argc, char** argv) {
   int frames = 20, levels = 4;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
-      frames = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--levels") && i + 1 < argc)
-      levels = std::atoi(argv[++i]);
-    else {
-      std::fprintf(stderr, "usage: %s [--frames N] [--levels L]\n", argv[0]);
-      return 2;
-    }
-  }
+  icd::experiments::CommandLine cli("icd_collision_vs_fcl");
+  cli.integer("--frames", frames, "N", "frames (default 20)", 1)
+      .integer("--levels", levels, "L", "sphere-tree levels (default 4)", 1);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     run_scene("ChineseDragon-10kv.off", frames, levels);
     run_scene("bunny00.off", frames, levels);

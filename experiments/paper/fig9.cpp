@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/paper/contact_moment.hpp"
 #include "experiments/runner/run.hpp"
 #include "icd/config.hpp"
@@ -23,40 +24,24 @@ namespace fs = std::filesystem;
 using namespace icd;
 using namespace icd::runner;
 
-namespace {
-
-void usage() {
-  std::printf(
-      "usage: fig9 [--out DIR] [--scene FILE] [--budgets a,b,...] [--max-frames N] [--after N]\n"
-      "  Default: experiments/scenes/bunny_dragon.json, critical times 1e-4,1e-3,1e-2,1e-1 s,\n"
-      "  3 frames after first contact (uninterrupted run). Writes DIR/budget_<t>/*.vtu and "
-      "DIR/manifest.csv.\n");
-}
-
-}  // namespace
+namespace {}  // namespace
 
 int main(int argc, char** argv) {
   fs::path out = "results/fig9";
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
   std::string budgets_text = "1e-4,1e-3,1e-2,1e-1";
   int max_frames = 200, after = 3;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
-      out = argv[++i];
-    else if (a == "--scene" && i + 1 < argc)
-      scene_path = argv[++i];
-    else if (a == "--budgets" && i + 1 < argc)
-      budgets_text = argv[++i];
-    else if (a == "--max-frames" && i + 1 < argc)
-      max_frames = std::stoi(argv[++i]);
-    else if (a == "--after" && i + 1 < argc)
-      after = std::stoi(argv[++i]);
-    else {
-      usage();
-      return a == "--help" || a == "-h" ? 0 : 2;
-    }
-  }
+  icd::experiments::CommandLine cli(
+      "fig9",
+      "  Default: experiments/scenes/bunny_dragon.json, critical times 1e-4,1e-3,1e-2,1e-1 s,\n"
+      "  3 frames after first contact (uninterrupted run). Writes DIR/budget_<t>/*.vtu and\n"
+      "  DIR/manifest.csv.");
+  cli.path("--out", out, "DIR", "output folder (default results/fig9)")
+      .path("--scene", scene_path, "FILE", "scene file")
+      .text("--budgets", budgets_text, "a,b,...", "critical times (s)")
+      .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1)
+      .integer("--after", after, "N", "frames after first contact (default 3)", 0);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   const fs::path cache = fs::path(ICD_SOURCE_DIR) / "assets";
   const fs::path tools = fs::canonical("/proc/self/exe").parent_path();
   std::ostringstream manifest;

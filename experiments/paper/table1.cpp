@@ -9,9 +9,11 @@
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/runner/world.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/atomic_write.hpp"
@@ -55,16 +57,6 @@ struct Row {
   double collision_ms = 0;  // mean collision time per frame in the window
 };
 
-void usage() {
-  std::printf(
-      "usage: table1 [--out DIR] [--scene FILE]... [--budgets a,b,...] [--max-frames N] [--after "
-      "N]\n"
-      "              [--paper-scale F]  (the paper's row at critical time x F sits beside ours)\n"
-      "  Runs each scene once per critical time (default 1e-4,1e-3,1e-2,1e-1,1 s) and\n"
-      "  records the list sizes N frames (--after, default 3) after first contact.\n"
-      "  Default scenes: the paper's dragon-dragon, bunny-bunny, bunny-dragon.\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -73,27 +65,27 @@ int main(int argc, char** argv) {
   std::vector<double> budgets = {1e-4, 1e-3, 1e-2, 1e-1, 1.0};
   int max_frames = 200, after = 3;
   double paper_scale = 1;  // our critical time x paper_scale = the paper's row we sit beside
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "--scene" && i + 1 < argc) {
-      scenes.emplace_back(argv[++i]);
-    } else if (a == "--budgets" && i + 1 < argc) {
-      budgets.clear();
-      std::stringstream ss(argv[++i]);
-      for (std::string t; std::getline(ss, t, ',');) budgets.push_back(std::stod(t));
-    } else if (a == "--max-frames" && i + 1 < argc) {
-      max_frames = std::stoi(argv[++i]);
-    } else if (a == "--paper-scale" && i + 1 < argc) {
-      paper_scale = std::stod(argv[++i]);
-    } else if (a == "--after" && i + 1 < argc) {
-      after = std::stoi(argv[++i]);
-    } else {
-      usage();
-      return a == "--help" || a == "-h" ? 0 : 2;
-    }
-  }
+  icd::experiments::CommandLine cli(
+      "table1",
+      "  Runs each scene once per critical time (default 1e-4,1e-3,1e-2,1e-1,1 s) and\n"
+      "  records the list sizes N frames (--after, default 3) after first contact.\n"
+      "  Default scenes: the paper's dragon-dragon, bunny-bunny, bunny-dragon.");
+  cli.path("--out", out, "DIR", "output folder (default results/table1)")
+      .custom("--scene", "FILE", "a scene to run (repeatable)",
+              [&](const std::string& v) { scenes.emplace_back(v); })
+      .custom("--budgets", "a,b,...", "critical times (s)",
+              [&](const std::string& v) {
+                budgets.clear();
+                std::stringstream ss(v);
+                for (std::string t; std::getline(ss, t, ',');)
+                  budgets.push_back(icd::experiments::CommandLine::parse_real(t, 0.0));
+                if (budgets.empty()) throw std::invalid_argument("needs at least one time");
+              })
+      .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1)
+      .real("--paper-scale", paper_scale, "F",
+            "the paper's row at critical time x F sits beside ours (default 1)", 0.0)
+      .integer("--after", after, "N", "frames after first contact (default 3)", 0);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   if (scenes.empty())
     for (const char* s : {"dragon_dragon", "bunny_bunny", "bunny_dragon"})
       scenes.push_back(fs::path(ICD_SOURCE_DIR) / "experiments/scenes" /

@@ -30,12 +30,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/reliability/soak_scene.hpp"
 #include "experiments/runner/world.hpp"
 #include "icd/config.hpp"
@@ -62,40 +62,25 @@ struct Args {
   std::string csv;
 };
 
-Args parse_args(int argc, char** argv) {
-  Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string k = argv[i];
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "soak: %s needs a value\n", k.c_str());
-      std::exit(2);
-    }
-    const char* v = argv[++i];
-    if (k == "--frames")
-      a.frames = std::atoi(v);
-    else if (k == "--every")
-      a.every = std::max(1, std::atoi(v));
-    else if (k == "--budget-tests") {
-      a.budget_tests = std::atoll(v);
-      a.budget_given = true;
-    } else if (k == "--scene")
-      a.scene = v;
-    else if (k == "--speed")
-      a.speed = std::atof(v);
-    else if (k == "--energy-factor")
-      a.energy_factor = std::atof(v);
-    else if (k == "--max-growth-mb")
-      a.max_growth_mb = std::atof(v);
-    else if (k == "--csv")
-      a.csv = v;
-    else if (k == "--relaunch")
-      a.relaunch = std::max(0, std::atoi(v));
-    else {
-      std::fprintf(stderr, "soak: unknown argument %s\n", k.c_str());
-      std::exit(2);
-    }
-  }
-  return a;
+/// The options, bound to the fields of `a`.
+icd::experiments::CommandLine command_line(Args& a) {
+  icd::experiments::CommandLine cli("soak", "  See the comment at the top of soak.cpp.");
+  cli.integer("--frames", a.frames, "N", "frames (default 100000)", 1)
+      .integer("--every", a.every, "K", "report every K frames (default 1000)", 1)
+      .custom("--budget-tests", "B", "sphere tests per query, -1: none (default 2000)",
+              [&a](const std::string& v) {
+                a.budget_tests = icd::experiments::CommandLine::parse_integer<long long>(v, -1);
+                a.budget_given = true;
+              })
+      .text("--scene", a.scene, "FILE", "soak this scene instead of the ball between walls")
+      .real("--speed", a.speed, "V", "initial speed (default 1)", 0.0)
+      .real("--energy-factor", a.energy_factor, "F", "energy bound over the initial (default 1.5)",
+            0.0)
+      .real("--max-growth-mb", a.max_growth_mb, "M", "resident memory growth allowed (default 16)",
+            0.0)
+      .integer("--relaunch", a.relaunch, "K", "relaunch every K frames, 0: never (default 0)", 0)
+      .text("--csv", a.csv, "FILE", "also write the rows as CSV");
+  return cli;
 }
 
 // Each deformable object gets its initial speed towards the centroid of the
@@ -126,7 +111,8 @@ double relaunch(icd::runner::World& world) {
 
 int main(int argc, char** argv) {
   using namespace icd;
-  const Args a = parse_args(argc, argv);
+  Args a;
+  if (const auto status = command_line(a).parse(argc, argv)) return *status;
   try {
     runner::Scene scene;
     if (a.scene.empty()) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/runner/world.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/atomic_write.hpp"
@@ -230,24 +231,15 @@ int main(int argc, char** argv) {
   int frames = 30;
   double max_seconds = 30;
   bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
-      out = argv[++i];
-    else if (a == "--frames" && i + 1 < argc)
-      frames = std::stoi(argv[++i]);
-    else if (a == "--max-seconds" && i + 1 < argc)
-      max_seconds = std::stod(argv[++i]);
-    else if (a == "--quick")
-      quick = true;
-    else {
-      std::printf(
-          "usage: stability_sweep [--out DIR] [--frames N] [--max-seconds S] [--quick]\n"
-          "  Runs every case for N frames (default 30 = 0.5 simulated second), at most S s of\n"
-          "  wall time each (default 30); --quick runs the extreme cases only.\n");
-      return a == "--help" || a == "-h" ? 0 : 2;
-    }
-  }
+  icd::experiments::CommandLine cli(
+      "stability_sweep",
+      "  Runs every case for N frames (default 30 = 0.5 simulated second), at most S s of\n"
+      "  wall time each (default 30); --quick runs the extreme cases only.");
+  cli.path("--out", out, "DIR", "output folder (default results/stability)")
+      .integer("--frames", frames, "N", "frames per case", 1)
+      .real("--max-seconds", max_seconds, "S", "wall-time limit per case", 0.0)
+      .flag("--quick", quick, "the extreme cases only");
+  if (const auto status = cli.parse(argc, argv)) return *status;
   std::ostringstream csv, md;
   csv << "group,case,status,frames,min_step,mean_step,energy_initial,energy_end,energy_drift,"
          "max_energy_gain,max_penetration,fps,message\n";

@@ -5,6 +5,7 @@
 // uninterrupted traversal (independent traversal orders), interrupted
 // answers stay conservative, identical resolutions give identical surfaces.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -251,6 +252,35 @@ TEST(ExperimentsReduced, StabilitySweep) {
   }
   EXPECT_GT(stable, 0);
   EXPECT_TRUE(fs::exists(out / "stability.md"));
+}
+
+TEST(ExperimentsReduced, BadOptionsStopWithStatusTwoAndNameTheOption) {
+  // The programs parse their options with experiments/common/command_line.hpp:
+  // a malformed number, a value out of range, a missing value or an unknown
+  // option is reported with the option's name before anything runs, and
+  // nothing but the log lands in the output folder.
+  struct Case {
+    std::string program, args, expected;
+  };
+  const std::vector<Case> cases = {
+      {"table1", "--max-frames 12x", "--max-frames expects a whole number, got '12x'"},
+      {"fig9", "--after -1", "--after must be in [0, "},
+      {"contact_error", "--reps 0", "--reps must be in [1, "},
+      {"deformation_error", "--frobnicate 3", "unknown option '--frobnicate'"},
+      {"sphere_update_error", "--every", "--every needs a value"},
+      {"stability_sweep", "--max-seconds nan", "--max-seconds expects a finite number"},
+  };
+  for (const Case& c : cases) {
+    const fs::path out = out_dir("bad_" + c.program);
+    const int status = run(c.program, c.args, out);
+    const std::string log = log_of(out);
+    ASSERT_TRUE(WIFEXITED(status)) << c.program;
+    EXPECT_EQ(WEXITSTATUS(status), 2) << c.program << ": " << log;
+    EXPECT_NE(log.find(c.expected), std::string::npos) << c.program << ": " << log;
+    EXPECT_NE(log.find("usage: " + c.program), std::string::npos) << c.program << ": " << log;
+    for (const auto& entry : fs::directory_iterator(out))
+      EXPECT_EQ(entry.path().filename(), "log.txt") << c.program << " wrote " << entry.path();
+  }
 }
 
 }  // namespace
