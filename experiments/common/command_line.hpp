@@ -10,6 +10,7 @@
 ///   CommandLine cli("fig9", "Writes DIR/manifest.csv.");
 ///   cli.path("--out", out, "DIR", "output folder").integer("--after", after, "N", "frames", 0);
 ///   if (const auto status = cli.parse(argc, argv)) return *status;
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,13 @@ class CommandLine {
   /// option list (defaults, outputs; may be empty).
   explicit CommandLine(std::string program, std::string summary = {})
       : m_program(std::move(program)), m_summary(std::move(summary)) {}
+
+  /// Names the positional arguments the program takes before its options
+  /// (shown in the usage only; the program reads them itself).
+  CommandLine& positional(std::string names) {
+    m_positional = std::move(names);
+    return *this;
+  }
 
   /// Any text.
   CommandLine& text(const std::string& name, std::string& target, const std::string& value_name,
@@ -61,6 +69,12 @@ class CommandLine {
                     double max = std::numeric_limits<double>::max()) {
     return add(name, value_name, help,
                [&target, min, max](const std::string& v) { target = parse_real(v, min, max); });
+  }
+
+  /// A yes/no option written 0 or 1.
+  CommandLine& boolean(const std::string& name, bool& target, const std::string& help) {
+    return add(name, "0|1", help,
+               [&target](const std::string& v) { target = parse_integer<int>(v, 0, 1) != 0; });
   }
 
   /// A switch without a value: sets `target` to true.
@@ -148,8 +162,8 @@ class CommandLine {
   /// "usage: program [--name VALUE]...", one line per option with its help,
   /// then the summary.
   std::string usage() const {
-    std::string out = "usage: " + m_program;
-    const size_t indent = out.size();
+    std::string out = "usage: " + m_program + (m_positional.empty() ? "" : " " + m_positional);
+    const size_t indent = std::min<size_t>(out.size(), 12);
     size_t line_start = 0;
     for (const Option& o : m_options) {
       const std::string item =
@@ -195,7 +209,7 @@ class CommandLine {
     return buffer;
   }
 
-  std::string m_program, m_summary;
+  std::string m_program, m_summary, m_positional;
   std::vector<Option> m_options;
 };
 

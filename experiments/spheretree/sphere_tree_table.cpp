@@ -38,12 +38,14 @@
 #include <filesystem>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "collision/octree_tree.hpp"
 #include "collision/sph_io.hpp"
 #include "collision/sphere_tree.hpp"
+#include "experiments/common/command_line.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/surface_reader.hpp"
 #include "mesh/io/vtk_writer.hpp"
@@ -179,36 +181,13 @@ icd::collision::SphereTree fit_leaves_to_probes(const icd::SurfaceMesh& mesh,
   return tree;
 }
 
-void print_usage(std::ostream& os) {
-  os << "usage: sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S]"
-        " [--medial-spacing REL] [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]"
-        " [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]"
-        " [--coverage-spacing UNITS] [--shell-samples N]"
-        " [--reduction split|merge|both]"
-        " [--diagnose N] [--exchange-rounds N] [--relieve-moves N] [--polish 0|1]"
-        " [--polish-rounds N] [--polish-evals N] [--polish-search N] [--polish-check N]"
-        " [--fit-probes 0|1] [--sum-passes N] [--sum-cap F] [--sum-share F] [--perturb E]"
-        " [--fill 0|1] [--prune 0|1]"
-        " [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]"
-        " [--split-stop-stuck 0|1] [--split-redivide N]"
-        " [--caps 1,8,64,N[,M]] [--branching B] [--build-branching B]"
-        " [--inner-worst-target REL] [--threads N] [--flat N]\n"
-        "       sphere_tree_table --help\n";
-}
-
 }  // namespace
 
 int run(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      print_usage(std::cout);
-      return 0;
-    }
-  }
-  // RESULTS_DIR first, then "--key value" pairs.
-  if (argc < 2 || std::string(argv[1]).rfind("-", 0) == 0 || argc % 2 != 0) {
-    print_usage(std::cerr);
+  // RESULTS_DIR first, then the options.
+  const bool help = argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
+  if (argc < 2 || (!help && std::string(argv[1]).rfind("-", 0) == 0)) {
+    std::cerr << "usage: sphere_tree_table RESULTS_DIR [options] (--help lists them)\n";
     return 2;
   }
   const fs::path results = argv[1];
@@ -222,122 +201,90 @@ int run(int argc, char** argv) {
   bool fit_probes = false;
   double perturb = 0;
   icd::mesh::EvaluationOptions evaluation;
-  for (int i = 2; i + 1 < argc; i += 2) {
-    const std::string key = argv[i];
-    const char* value = argv[i + 1];
-    if (key == "--models")
-      models_arg = value;
-    else if (key == "--time-limit")
-      options.time_limit = std::atof(value);
-    else if (key == "--medial-spacing")
-      options.medial_spacing = std::atof(value);
-    else if (key == "--cover-spacing")
-      options.cover_spacing = std::atof(value);
-    else if (key == "--joint")
-      options.joint_leaf_refinement = std::atoi(value) != 0;
-    else if (key == "--worst-share")
-      options.worst_share = std::atof(value);
-    else if (key == "--leaf-worst-target")
-      options.leaf_worst_target = std::atof(value);
-    else if (key == "--leaf-worst-factor")
-      options.leaf_worst_factor = std::atof(value);
-    else if (key == "--lloyd")
-      options.lloyd_iterations = std::atoi(value);
-    else if (key == "--octree")
-      with_octree = std::atoi(value) != 0;
-    else if (key == "--diagnose")
-      diagnose = std::atoi(value);
-    else if (key == "--exchange-rounds")
-      options.exchange_rounds = std::atoi(value);
-    else if (key == "--relieve-moves")
-      options.relieve_moves = std::atoi(value);
-    else if (key == "--fill")
-      options.fill_leaf_budget = std::atoi(value) != 0;
-    else if (key == "--prune")
-      options.prune_redundant_leaves = std::atoi(value) != 0;
-    else if (key == "--split-worst")
-      options.split_worst = std::atoi(value) != 0;
-    else if (key == "--split-relief")
-      options.worst_split.relief_fraction = std::atof(value);
-    else if (key == "--split-mean-rise")
-      options.worst_split.mean_rise_limit = std::atof(value);
-    else if (key == "--split-stop-stuck")
-      options.worst_split.stop_relief_when_stuck = std::atoi(value) != 0;
-    else if (key == "--split-redivide")
-      options.worst_split.redivide_siblings = std::atoi(value);
-    else if (key == "--split-tries")
-      options.worst_split.max_tries = std::atoi(value);
-    else if (key == "--threads")
-      options.threads = std::atoi(value);
-    else if (key == "--branching")
-      options.branching = std::atoi(value);
-    else if (key == "--inner-worst-target")
-      options.inner_worst_target = std::atof(value);
-    else if (key == "--build-branching")
-      options.build_branching = std::atoi(value);
-    else if (key == "--caps") {
-      // the spheres allowed per level, root first, e.g. 1,8,64,512,700:
-      // depth = count - 1
-      std::vector<int> caps;
-      std::stringstream list(value);
-      for (std::string item; std::getline(list, item, ',');)
-        caps.push_back(std::atoi(item.c_str()));
-      if (caps.size() < 2 || caps.front() != 1 ||
-          std::any_of(caps.begin(), caps.end(), [](int c) { return c < 1; })) {
-        std::cerr << "--caps: a comma-separated list of positive counts starting with 1 (the "
-                     "root), got "
-                  << value << "\n";
-        return 2;
-      }
-      options.depth = static_cast<int>(caps.size()) - 1;
-      options.max_spheres_per_level = caps;
-    } else if (key == "--flat") {
-      const int n = std::atoi(value);
-      options.depth = 1;
-      options.branching = std::max(2, n);
-      options.max_spheres_per_level = {1, n};
-    } else if (key == "--perturb")
-      perturb = std::atof(value);
-    else if (key == "--fit-probes")
-      fit_probes = std::atoi(value) != 0;
-    else if (key == "--polish")
-      options.protrusion_polish = std::atoi(value) != 0;
-    else if (key == "--sum-passes")
-      options.sum_exchange_passes = std::atoi(value);
-    else if (key == "--sum-share")
-      options.sum_exchange_max_share = std::atof(value);
-    else if (key == "--sum-cap")
-      options.sum_exchange_cap = std::atof(value);
-    else if (key == "--polish-rounds")
-      options.protrusion_exchange_rounds = std::atoi(value);
-    else if (key == "--polish-evals")
-      options.protrusion.max_evaluations = std::atoi(value);
-    else if (key == "--polish-search")
-      options.protrusion.search_directions = std::atoi(value);
-    else if (key == "--polish-check")
-      options.protrusion.check_directions = std::atoi(value);
-    else if (key == "--coverage-spacing")
-      evaluation.coverage_spacing = std::atof(value);
-    else if (key == "--shell-samples")
-      evaluation.shell_samples = std::atoi(value);
-    else if (key == "--reduction") {
-      const std::string v = value;
-      if (v == "split")
-        options.reduction = icd::mesh::ReductionMethod::split_lloyd;
-      else if (v == "merge")
-        options.reduction = icd::mesh::ReductionMethod::merge_burst;
-      else if (v == "both")
-        options.reduction = icd::mesh::ReductionMethod::best_of_both;
-      else {
-        std::cerr << "unknown reduction " << v << "\n";
-        return 2;
-      }
-    } else {
-      std::cerr << "unknown option " << key << "\n";
-      print_usage(std::cerr);
-      return 2;
-    }
-  }
+  using icd::experiments::CommandLine;
+  CommandLine cli("sphere_tree_table",
+                  "  Builds and evaluates the trees, writes .sph and VTU files into RESULTS_DIR\n"
+                  "  (see the comment at the top of sphere_tree_table.cpp and\n"
+                  "  experiments/spheretree/results/README.md). The builder checks the ranges.");
+  cli.positional("RESULTS_DIR");
+  icd::mesh::WorstSplitOptions& split = options.worst_split;
+  icd::mesh::ProtrusionPolishOptions& polish = options.protrusion;
+  cli.text("--models", models_arg, "bunny,dragon", "models to build")
+      .real("--time-limit", options.time_limit, "S", "CPU budget of a build (s)")
+      .real("--medial-spacing", options.medial_spacing, "REL", "medial sample spacing")
+      .real("--cover-spacing", options.cover_spacing, "REL", "coverage sample spacing")
+      .boolean("--joint", options.joint_leaf_refinement, "joint leaf refinement")
+      .integer("--lloyd", options.lloyd_iterations, "N", "Lloyd rounds of the reduction")
+      .boolean("--octree", with_octree, "also the octree baseline")
+      .real("--worst-share", options.worst_share, "F", "allocation: worst share")
+      .real("--leaf-worst-target", options.leaf_worst_target, "REL", "leaf worst bound target")
+      .real("--leaf-worst-factor", options.leaf_worst_factor, "F", "leaf worst bound factor")
+      .real("--coverage-spacing", evaluation.coverage_spacing, "UNITS",
+            "evaluation: dense coverage spacing")
+      .integer("--shell-samples", evaluation.shell_samples, "N", "evaluation: points per sphere")
+      .custom("--reduction", "split|merge|both", "reduction method",
+              [&](const std::string& v) {
+                if (v == "split")
+                  options.reduction = icd::mesh::ReductionMethod::split_lloyd;
+                else if (v == "merge")
+                  options.reduction = icd::mesh::ReductionMethod::merge_burst;
+                else if (v == "both")
+                  options.reduction = icd::mesh::ReductionMethod::best_of_both;
+                else
+                  throw std::invalid_argument("expects split, merge or both, got '" + v + "'");
+              })
+      .integer("--diagnose", diagnose, "N", "print the N leaves of largest 162-probe error", 0)
+      .integer("--exchange-rounds", options.exchange_rounds, "N", "boundary exchange rounds")
+      .integer("--relieve-moves", options.relieve_moves, "N", "relieve_worst moves")
+      .boolean("--polish", options.protrusion_polish, "protrusion polish")
+      .integer("--polish-rounds", options.protrusion_exchange_rounds, "N",
+               "exchange rounds of the polish")
+      .integer("--polish-evals", polish.max_evaluations, "N", "polish evaluations per sphere")
+      .integer("--polish-search", polish.search_directions, "N", "polish search directions")
+      .integer("--polish-check", polish.check_directions, "N", "polish check directions")
+      .boolean("--fit-probes", fit_probes,
+               "also the leaves re-polished against the 42 evaluation directions")
+      .integer("--sum-passes", options.sum_exchange_passes, "N", "lower_error_sum passes")
+      .real("--sum-cap", options.sum_exchange_cap, "F", "lower_error_sum cap fraction")
+      .real("--sum-share", options.sum_exchange_max_share, "F", "lower_error_sum receiver share")
+      .real("--perturb", perturb, "E", "build for the mesh scaled by 1 + E")
+      .boolean("--fill", options.fill_leaf_budget, "SphereTreeOptions::fill_leaf_budget")
+      .boolean("--prune", options.prune_redundant_leaves,
+               "SphereTreeOptions::prune_redundant_leaves")
+      .boolean("--split-worst", options.split_worst, "split_worst_leaves")
+      .integer("--split-tries", split.max_tries, "N", "split_worst: tries")
+      .real("--split-relief", split.relief_fraction, "F", "split_worst: relief fraction")
+      .real("--split-mean-rise", split.mean_rise_limit, "F", "split_worst: mean rise limit")
+      .boolean("--split-stop-stuck", split.stop_relief_when_stuck,
+               "split_worst: stop the relief when stuck")
+      .integer("--split-redivide", split.redivide_siblings, "N", "split_worst: siblings")
+      .custom(
+          "--caps", "1,8,64,N[,M]", "spheres allowed per level (depth = count - 1)",
+          [&](const std::string& v) {
+            std::vector<int> caps;
+            std::stringstream list(v);
+            for (std::string item; std::getline(list, item, ',');)
+              caps.push_back(CommandLine::parse_integer<int>(item, 1));
+            if (caps.size() < 2 || caps.front() != 1)
+              throw std::invalid_argument(
+                  "expects a list of positive counts starting with 1 (the root), got '" + v + "'");
+            options.depth = static_cast<int>(caps.size()) - 1;
+            options.max_spheres_per_level = caps;
+          })
+      .integer("--branching", options.branching, "B", "children per node at most")
+      .integer("--build-branching", options.build_branching, "B",
+               "SphereTreeOptions::build_branching")
+      .real("--inner-worst-target", options.inner_worst_target, "REL",
+            "SphereTreeOptions::inner_worst_target")
+      .integer("--threads", options.threads, "N", "worker threads (0: all cores)", 0)
+      .custom("--flat", "N", "diagnostic: one level of at most N spheres under the root",
+              [&](const std::string& v) {
+                const int n = CommandLine::parse_integer<int>(v, 1);
+                options.depth = 1;
+                options.branching = std::max(2, n);
+                options.max_spheres_per_level = {1, n};
+              });
+  if (const auto status = cli.parse(argc - (help ? 0 : 1), argv + (help ? 0 : 1))) return *status;
   fs::create_directories(results);
   const char* env = std::getenv("ICD_DATA_DIR");
   const fs::path data = env ? fs::path(env) : fs::path(ICD_DATA_DIR);

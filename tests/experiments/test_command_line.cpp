@@ -20,6 +20,7 @@ struct Values {
   long long queries = 10;
   double seconds = 1.5;
   bool quick = false;
+  bool octree = true;
   std::vector<double> list;
 };
 
@@ -31,6 +32,7 @@ CommandLine make(Values& v) {
       .integer("--queries", v.queries, "N", "queries", 0LL)
       .real("--max-seconds", v.seconds, "S", "time limit", 0.0)
       .flag("--quick", v.quick, "extreme cases only")
+      .boolean("--octree", v.octree, "also the octree baseline")
       .custom("--item", "X", "appended to a list",
               [&v](const std::string& s) { v.list.push_back(CommandLine::parse_real(s, 0.0)); });
   return cli;
@@ -54,7 +56,7 @@ TEST(CommandLine, AppliesEveryKindOfOptionAndKeepsDefaults) {
   EXPECT_EQ(v.reps, 5);
   EXPECT_TRUE(make(v).apply({"--out", "dir/x", "--reps", "7", "--queries", "123456789012",
                              "--max-seconds", "2.5e-1", "--quick", "--budgets", "1e-4,1", "--item",
-                             "3", "--item", "0.5", "--reps", "8"}));
+                             "3", "--item", "0.5", "--reps", "8", "--octree", "0"}));
   EXPECT_EQ(v.out, "dir/x");
   EXPECT_EQ(v.reps, 8);  // the later value wins
   EXPECT_EQ(v.queries, 123456789012LL);
@@ -62,6 +64,9 @@ TEST(CommandLine, AppliesEveryKindOfOptionAndKeepsDefaults) {
   EXPECT_TRUE(v.quick);
   EXPECT_EQ(v.budgets, "1e-4,1");
   EXPECT_EQ(v.list, (std::vector<double>{3.0, 0.5}));
+  EXPECT_FALSE(v.octree);
+  EXPECT_TRUE(make(v).apply({"--octree", "1"}));
+  EXPECT_TRUE(v.octree);
 }
 
 TEST(CommandLine, HelpStopsBeforeLaterOptions) {
@@ -92,6 +97,8 @@ TEST(CommandLine, EveryBadCommandLineNamesTheOptionAndTheProblem) {
       {{"--max-seconds", "1s"}, "--max-seconds expects a finite number, got '1s'"},
       {{"--max-seconds", "-2"}, "--max-seconds must be in [0, "},
       {{"--item", "x"}, "--item expects a finite number, got 'x'"},
+      {{"--octree", "2"}, "--octree must be in [0, 1], got '2'"},
+      {{"--octree", "yes"}, "--octree expects a whole number, got 'yes'"},
       {{"--item", "-1"}, "--item must be in [0, "},
   };
   for (const Case& c : cases) {
