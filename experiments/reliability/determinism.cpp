@@ -11,7 +11,6 @@
 // Without --scene the two-sphere scene of experiments/scenes is used.
 // Exit status 0 when identical, 1 with the first difference otherwise.
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -22,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/reliability/soak_scene.hpp"
 #include "experiments/runner/run.hpp"
 #include "icd/config.hpp"
@@ -104,27 +104,15 @@ int main(int argc, char** argv) {
   int frames = 60, vtu_every = 10;
   long long budget = 2000;
   fs::path out = fs::temp_directory_path() / "icd_determinism";
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string k = argv[i];
-    if (k == "--scene")
-      scene_path = argv[i + 1];
-    else if (k == "--frames")
-      frames = std::atoi(argv[i + 1]);
-    else if (k == "--budget-tests")
-      budget = std::atoll(argv[i + 1]);
-    else if (k == "--vtu-every")
-      vtu_every = std::atoi(argv[i + 1]);
-    else if (k == "--out")
-      out = argv[i + 1];
-    else {
-      std::fprintf(stderr, "determinism: unknown argument %s\n", k.c_str());
-      return 2;
-    }
-  }
-  if (argc % 2 == 0) {
-    std::fprintf(stderr, "determinism: %s needs a value\n", argv[argc - 1]);
-    return 2;
-  }
+  icd::experiments::CommandLine cli(
+      "determinism", "  Two runs of the scene compared file by file, then 1 and 2 FEM threads.");
+  cli.text("--scene", scene_path, "FILE", "scene (default two_spheres.json)")
+      .integer("--frames", frames, "N", "frames (default 60)", 1)
+      .integer("--budget-tests", budget, "B", "sphere tests per query, -1: none (default 2000)",
+               -1LL)
+      .integer("--vtu-every", vtu_every, "K", "VTU output every K frames (default 10)", 0)
+      .path("--out", out, "DIR", "scratch folder");
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     runner::Scene scene = runner::load_scene(scene_path);
     reliability::use_test_budget(scene, budget);

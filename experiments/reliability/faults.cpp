@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <functional>
 #include <limits>
@@ -19,6 +18,7 @@
 #include <typeinfo>
 #include <vector>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/runner/json.hpp"
 #include "experiments/runner/world.hpp"
 #include "icd/config.hpp"
@@ -119,7 +119,9 @@ Outcome run_case(const Case& c, int frames) {
 
 int main(int argc, char** argv) {
   int frames = 120;
-  if (argc == 3 && std::string(argv[1]) == "--frames") frames = std::atoi(argv[2]);
+  icd::experiments::CommandLine cli("faults", "  Fault cases of the full loop, each reported.");
+  cli.integer("--frames", frames, "N", "frames per case (default 120)", 1);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   std::vector<Case> cases;
   cases.push_back({"zero_budget", "budget of 0 sphere tests: refused at scene validation"});
   cases.back().collision = R"("budget_tests": 0)";
