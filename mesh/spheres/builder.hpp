@@ -161,9 +161,11 @@ struct SphereTreeOptions {
   WorstSplitOptions worst_split;  ///< see split_worst_leaves (its deadline is time_limit's)
   /// Worker threads (0: std::thread::hardware_concurrency(); 1: none). The
   /// per-node steps (each level's reduction and fitting of a parent's
-  /// children, the protrusion polish) run one node per task; the tree does
-  /// not depend on the number of threads (as long as the CPU budget below is
-  /// not reached: it counts the CPU time of all threads).
+  /// children, the leaf polish between boundary exchanges, the protrusion
+  /// polish) run one node per task, split_worst_leaves one candidate
+  /// division per task; the tree does not depend on the number of threads
+  /// (as long as the CPU budget below is not reached: it counts the CPU time
+  /// of all threads).
   int threads = 0;
   /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),
   /// not wall-clock time, so a loaded machine does not change the tree; > 0).
