@@ -6,52 +6,22 @@
 #include <filesystem>
 #include <string>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/runner/run.hpp"
 #include "icd/config.hpp"
-
-namespace {
-
-void usage() {
-  std::printf(
-      "usage: icd-main [--out DIR] [--scene FILE] [--frames N]\n"
-      "  --out DIR     results folder (default: results/main)\n"
-      "  --scene FILE  scene to run (default: %s/experiments/scenes/bunny_dragon.json)\n"
-      "  --frames N    override the scene's frame count\n",
-      ICD_SOURCE_DIR);
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   std::filesystem::path out = "results/main";
   std::filesystem::path scene_path =
       std::filesystem::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
   int frames = -1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "--scene" && i + 1 < argc) {
-      scene_path = argv[++i];
-    } else if (a == "--frames" && i + 1 < argc) {
-      try {
-        frames = std::stoi(argv[++i]);
-      } catch (const std::exception&) {
-        frames = -2;
-      }
-      if (frames < 0) {
-        std::fprintf(stderr, "icd-main: --frames: expected a non-negative integer\n");
-        return 2;
-      }
-    } else if (a == "--help" || a == "-h") {
-      usage();
-      return 0;
-    } else {
-      std::fprintf(stderr, "icd-main: unknown argument '%s'\n", a.c_str());
-      usage();
-      return 2;
-    }
-  }
+  icd::experiments::CommandLine cli("icd-main",
+                                    "  The project's main job: the paper's bunny-dragon scene.");
+  cli.path("--out", out, "DIR", "results folder (default: results/main)")
+      .path("--scene", scene_path, "FILE",
+            "scene to run (default: experiments/scenes/bunny_dragon.json)")
+      .integer("--frames", frames, "N", "override the scene's frame count", 0);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     const icd::runner::Scene scene = icd::runner::load_scene(scene_path);
     std::printf("scene \"%s\" (%s)\n", scene.name.c_str(), scene_path.c_str());
