@@ -51,8 +51,8 @@ void check_options(const SphereTreeOptions& o) {
       o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
       !(o.worst_split.mean_rise_limit >= 0)) {
     fail(
-        "worst_split: measure/choice directions must be >= 1, max_tries >= 0, relief_fraction >= "
-        "0");
+        "worst_split: measure/choice directions must be >= 1, max_tries >= 0, "
+        "relief_fraction >= 0");
   }
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
   if (o.threads < 0) fail("threads must be >= 0, got " + std::to_string(o.threads));
@@ -102,12 +102,6 @@ long long level_cap(const SphereTreeOptions& options, int l) {
   return cap;
 }
 
-/// The radius sphere `sp` needs to cover sample s with margin
-/// (ReductionProblem::reach).
-double reach(const ReductionProblem& problem, const FittedSphere& sp, int s) {
-  return problem.reach(s, sp.center);
-}
-
 /// True when every ancestor of leaf `leaf` (of the last level) covers sample
 /// s with margin: the condition for moving s to that leaf without growing
 /// any inner node.
@@ -117,7 +111,7 @@ bool ancestors_cover(const ReductionProblem& dense, const std::vector<std::vecto
   for (size_t l = levels.size() - 1; l >= 1; --l) {
     node = parent_of[l][static_cast<size_t>(node)];
     const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
-    if (reach(dense, a, s) > a.radius) return false;
+    if (dense.reach(s, a) > a.radius) return false;
   }
   return true;
 }
@@ -187,7 +181,7 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
       continue;
     }
     double r = 0;
-    for (int m : sp.members) r = std::max(r, reach(dense, sp, m));
+    for (int m : sp.members) r = std::max(r, dense.reach(m, sp));
     sp.radius = r;
     sp.error = r - sp.depth;
     leaves[i].sphere = sp;
@@ -228,7 +222,7 @@ void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<No
       std::sort(unions[p].begin(), unions[p].end());
       sp.members = std::move(unions[p]);
       double r = 0;
-      for (int s : sp.members) r = std::max(r, reach(dense, sp, s));
+      for (int s : sp.members) r = std::max(r, dense.reach(s, sp));
       sp.radius = r;
       sp.error = r - sp.depth;
     }
@@ -261,7 +255,7 @@ void exchange_across_leaves(const ReductionProblem& dense,
     for (size_t l = last; l >= 1; --l) {
       node = parent_of[l][static_cast<size_t>(node)];
       const FittedSphere& a = levels[l - 1][static_cast<size_t>(node)].sphere;
-      const double r = reach(dense, a, s);
+      const double r = dense.reach(s, a);
       if (r > a.radius && r - a.depth > level_worst[l - 1]) return false;
     }
     return true;
@@ -324,7 +318,7 @@ int prune_redundant_leaves(const ReductionProblem& dense, std::vector<std::vecto
     for (int s : members) {
       size_t k = n;
       for (size_t j : near[i]) {
-        if (!gone[j] && reach(dense, leaves[j].sphere, s) <= leaves[j].sphere.radius &&
+        if (!gone[j] && dense.reach(s, leaves[j].sphere) <= leaves[j].sphere.radius &&
             ancestors_cover(dense, levels, parent_of, static_cast<int>(j), s)) {
           k = j;
           break;

@@ -16,7 +16,6 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
     throw ParameterError("ExchangeOptions: rounds must be >= 0 and max_moves_per_sphere >= 1");
   }
   const int n = static_cast<int>(spheres.size());
-  auto reach = [&](int s, const FittedSphere& sp) { return problem.reach(s, sp.center); };
   int moved_total = 0;
   for (int round = 0; round < options.rounds; ++round) {
     // Spheres that overlap (only they can hold a sample of each other).
@@ -44,7 +43,8 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
       // Members farthest first, popped lazily from a heap (most never leave).
       std::vector<std::pair<double, int>> heap;
       heap.reserve(sp.members.size());
-      for (int s : sp.members) heap.emplace_back(reach(s, sp), -s);  // ties: smaller index first
+      for (int s : sp.members)
+        heap.emplace_back(problem.reach(s, sp), -s);  // ties: smaller index first
       std::make_heap(heap.begin(), heap.end());
       std::vector<int> leaving;
       while (heap.size() > 1 && static_cast<int>(leaving.size()) < options.max_moves_per_sphere) {
@@ -52,7 +52,7 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
         int receiver = -1;
         for (int k : overlapping[static_cast<size_t>(j)]) {
           const FittedSphere& other = spheres[static_cast<size_t>(k)];
-          if (reach(s, other) <= other.radius && (!accepts || accepts(k, s))) {
+          if (problem.reach(s, other) <= other.radius && (!accepts || accepts(k, s))) {
             receiver = k;
             break;
           }
@@ -89,14 +89,13 @@ int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& sp
   if (max_moves < 0) throw ParameterError("relieve_worst: max_moves must be >= 0");
   const int n = static_cast<int>(spheres.size());
   if (n < 2) return 0;
-  auto reach = [&](int s, const FittedSphere& sp) { return problem.reach(s, sp.center); };
   // Per sphere: a max-heap of (reach, -sample) over its current members.
   std::vector<std::vector<std::pair<double, int>>> heaps(static_cast<size_t>(n));
   std::vector<int> size(static_cast<size_t>(n));
   for (int j = 0; j < n; ++j) {
     auto& h = heaps[static_cast<size_t>(j)];
     for (int s : spheres[static_cast<size_t>(j)].members)
-      h.emplace_back(reach(s, spheres[static_cast<size_t>(j)]), -s);
+      h.emplace_back(problem.reach(s, spheres[static_cast<size_t>(j)]), -s);
     std::make_heap(h.begin(), h.end());
     size[static_cast<size_t>(j)] = static_cast<int>(h.size());
   }
@@ -115,7 +114,7 @@ int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& sp
     for (int k = 0; k < n; ++k) {
       if (k == j) continue;
       const FittedSphere& other = spheres[static_cast<size_t>(k)];
-      const double r = std::max(other.radius, reach(s, other));
+      const double r = std::max(other.radius, problem.reach(s, other));
       const double e = r - other.depth;
       if (e < receiver_error && (!accepts || accepts(k, s))) receiver_error = e, receiver = k;
     }
@@ -125,7 +124,7 @@ int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& sp
     hj.pop_back();
     size[static_cast<size_t>(j)] -= 1;
     FittedSphere& other = spheres[static_cast<size_t>(receiver)];
-    const double rs = reach(s, other);
+    const double rs = problem.reach(s, other);
     auto& hk = heaps[static_cast<size_t>(receiver)];
     hk.emplace_back(rs, -s);
     std::push_heap(hk.begin(), hk.end());

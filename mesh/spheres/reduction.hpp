@@ -40,6 +40,8 @@ struct ReductionProblem {
   double reach(int s, const Eigen::Vector3d& c) const {
     return (points.row(s).transpose() - c).norm() + gap[s];
   }
+  /// The same for a sphere's centre.
+  double reach(int s, const FittedSphere& sphere) const { return reach(s, sphere.center); }
 };
 
 /// Options of reduce_to_spheres().

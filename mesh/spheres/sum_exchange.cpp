@@ -15,7 +15,6 @@ int lower_error_sum(const ReductionProblem& problem, std::vector<FittedSphere>& 
     throw ParameterError("SumExchangeOptions: passes must be >= 0 and cap_fraction in (0, 1]");
   }
   const int n = static_cast<int>(spheres.size());
-  auto reach = [&](int s, const FittedSphere& sp) { return problem.reach(s, sp.center); };
   int moved_total = 0;
   for (int pass = 0; pass < options.passes; ++pass) {
     std::vector<int> order(static_cast<size_t>(n));
@@ -31,7 +30,7 @@ int lower_error_sum(const ReductionProblem& problem, std::vector<FittedSphere>& 
       std::vector<int> cap, rest;
       double new_radius = 0;
       for (int s : A.members) {
-        const double r = reach(s, A);
+        const double r = problem.reach(s, A);
         if (r > threshold) {
           cap.push_back(s);
         } else {
@@ -56,7 +55,7 @@ int lower_error_sum(const ReductionProblem& problem, std::vector<FittedSphere>& 
           const FittedSphere& B = spheres[static_cast<size_t>(b)];
           auto it = planned.find(b);
           const double current = it == planned.end() ? B.radius : it->second;
-          const double growth = std::max(reach(cap[i], B), current) - current;
+          const double growth = std::max(problem.reach(cap[i], B), current) - current;
           if ((receiver_of[i] < 0 || growth < best) && (!accepts || accepts(b, cap[i])))
             best = growth, receiver_of[i] = b;
         }
@@ -66,7 +65,7 @@ int lower_error_sum(const ReductionProblem& problem, std::vector<FittedSphere>& 
         }
         const FittedSphere& B = spheres[static_cast<size_t>(receiver_of[i])];
         auto [it, inserted] = planned.emplace(receiver_of[i], B.radius);
-        it->second = std::max(it->second, reach(cap[i], B));
+        it->second = std::max(it->second, problem.reach(cap[i], B));
       }
       if (!possible) continue;
       double growth = 0;

@@ -51,23 +51,17 @@ std::vector<FittedSphere> settle(const ReductionProblem& dense, const MeshOracle
 }
 
 /// The principal axes of a leaf's coverage samples (columns, increasing
-/// spread) and their mean.
-struct Axes {
+/// spread).
+Eigen::Matrix3d principal_axes(const ReductionProblem& dense, const FittedSphere& leaf) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
-};
-
-Axes principal_axes(const ReductionProblem& dense, const FittedSphere& leaf) {
-  Axes out;
-  for (int m : leaf.members) out.mean += dense.points.row(m).transpose();
-  out.mean /= static_cast<double>(leaf.members.size());
+  for (int m : leaf.members) mean += dense.points.row(m).transpose();
+  mean /= static_cast<double>(leaf.members.size());
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (int m : leaf.members) {
-    const Eigen::Vector3d d = dense.points.row(m).transpose() - out.mean;
+    const Eigen::Vector3d d = dense.points.row(m).transpose() - mean;
     cov += d * d.transpose();
   }
-  out.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
-  return out;
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
 }
 
 /// The candidate two-sphere divisions of a leaf, numbered 0 to
@@ -80,14 +74,15 @@ constexpr int kNumCandidates = 3;
 std::vector<FittedSphere> candidate(int k, const ReductionProblem& coarse,
                                     const ReductionProblem& dense, const MeshOracle& oracle,
                                     const ReductionOptions& reduction, const FittedSphere& leaf,
-                                    const std::vector<int>& leaf_medial, const Axes& axes) {
+                                    const std::vector<int>& leaf_medial,
+                                    const Eigen::Matrix3d& axes) {
   if (k == 0) {
     if (leaf_medial.size() < 2) return {};
     std::vector<FittedSphere> h = reduce_to_spheres(coarse, leaf_medial, 2, reduction)[1];
     if (h.size() != 2) return {};
     return settle(dense, oracle, leaf, std::move(h));
   }
-  const Eigen::Vector3d n = axes.axes.col(3 - k);  // k = 1: largest spread
+  const Eigen::Vector3d n = axes.col(3 - k);  // k = 1: largest spread
   std::vector<double> projection(leaf.members.size());
   for (size_t i = 0; i < leaf.members.size(); ++i)
     projection[i] = n.dot(dense.points.row(leaf.members[i]).transpose());
@@ -118,7 +113,7 @@ Halves split_in_two(const ReductionProblem& coarse, const ReductionProblem& dens
   Halves out;
   if (leaf.members.size() < 2) return out;
   const MeshOracle& oracle = *oracles.front();
-  const Axes axes = principal_axes(dense, leaf);
+  const Eigen::Matrix3d axes = principal_axes(dense, leaf);
   struct Tried {
     std::vector<FittedSphere> halves;
     double error[2] = {0, 0};
