@@ -34,11 +34,20 @@ class CommandLine {
   explicit CommandLine(std::string program, std::string summary = {})
       : m_program(std::move(program)), m_summary(std::move(summary)) {}
 
-  /// Names the positional arguments the program takes before its options
-  /// (shown in the usage only; the program reads them itself).
-  CommandLine& positional(std::string names) {
-    m_positional = std::move(names);
+  /// A positional argument: a word that does not start with '-', bound to
+  /// the arguments in the order they are declared (they may stand before,
+  /// between or after the options). A required one missing is an error; an
+  /// optional one keeps its default. More words than arguments is an error.
+  CommandLine& argument(const std::string& name, const std::string& help, bool required,
+                        std::function<void(const std::string&)> apply) {
+    m_arguments.push_back({name, {}, help, std::move(apply), required});
     return *this;
+  }
+
+  /// A positional argument naming a file or folder.
+  CommandLine& argument(const std::string& name, std::filesystem::path& target,
+                        const std::string& help, bool required) {
+    return argument(name, help, required, [&target](const std::string& v) { target = v; });
   }
 
   /// Any text.
@@ -79,7 +88,7 @@ class CommandLine {
 
   /// A switch without a value: sets `target` to true.
   CommandLine& flag(const std::string& name, bool& target, const std::string& help) {
-    m_options.push_back({name, {}, help, [&target](const std::string&) { target = true; }});
+    m_options.push_back({name, {}, help, [&target](const std::string&) { target = true; }, false});
     return *this;
   }
 
@@ -125,11 +134,23 @@ class CommandLine {
   /// std::invalid_argument with a message naming the option on any error.
   /// Returns false when --help or -h was given (nothing after it is applied).
   bool apply(const std::vector<std::string>& args) const {
+    size_t next_argument = 0;
     for (size_t i = 0; i < args.size(); ++i) {
       const std::string& a = args[i];
       if (a == "--help" || a == "-h") return false;
+      if (!a.empty() && a[0] != '-' && next_argument < m_arguments.size()) {
+        const Option& argument = m_arguments[next_argument++];
+        try {
+          argument.apply(a);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(argument.name + " " + e.what());
+        }
+        continue;
+      }
       const Option* option = find(a);
-      if (option == nullptr) throw std::invalid_argument("unknown option '" + a + "'");
+      if (option == nullptr)
+        throw std::invalid_argument(!a.empty() && a[0] != '-' ? "unexpected argument '" + a + "'"
+                                                              : "unknown option '" + a + "'");
       if (option->value_name.empty()) {
         option->apply({});
         continue;
@@ -141,6 +162,8 @@ class CommandLine {
         throw std::invalid_argument(a + " " + e.what());
       }
     }
+    for (size_t k = next_argument; k < m_arguments.size(); ++k)
+      if (m_arguments[k].required) throw std::invalid_argument("missing " + m_arguments[k].name);
     return true;
   }
 
@@ -162,7 +185,8 @@ class CommandLine {
   /// "usage: program [--name VALUE]...", one line per option with its help,
   /// then the summary.
   std::string usage() const {
-    std::string out = "usage: " + m_program + (m_positional.empty() ? "" : " " + m_positional);
+    std::string out = "usage: " + m_program;
+    for (const Option& a : m_arguments) out += a.required ? " " + a.name : " [" + a.name + "]";
     const size_t indent = std::min<size_t>(out.size(), 12);
     size_t line_start = 0;
     for (const Option& o : m_options) {
@@ -176,6 +200,11 @@ class CommandLine {
       out += item;
     }
     out += "\n";
+    for (const Option& a : m_arguments) {
+      std::string left = "  " + a.name;
+      if (left.size() < 28) left.resize(28, ' ');
+      out += left + " " + a.help + "\n";
+    }
     for (const Option& o : m_options) {
       std::string left = "  " + o.name + (o.value_name.empty() ? "" : " " + o.value_name);
       if (left.size() < 28) left.resize(28, ' ');
@@ -189,11 +218,13 @@ class CommandLine {
   struct Option {
     std::string name, value_name, help;
     std::function<void(const std::string&)> apply;
+    bool required = false;  // positional arguments only
   };
 
   CommandLine& add(const std::string& name, const std::string& value_name, const std::string& help,
                    std::function<void(const std::string&)> apply) {
-    m_options.push_back({name, value_name.empty() ? "VALUE" : value_name, help, std::move(apply)});
+    m_options.push_back(
+        {name, value_name.empty() ? "VALUE" : value_name, help, std::move(apply), false});
     return *this;
   }
 
@@ -209,8 +240,8 @@ class CommandLine {
     return buffer;
   }
 
-  std::string m_program, m_summary, m_positional;
-  std::vector<Option> m_options;
+  std::string m_program, m_summary;
+  std::vector<Option> m_options, m_arguments;
 };
 
 }  // namespace icd::experiments

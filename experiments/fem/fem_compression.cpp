@@ -15,11 +15,13 @@
 // Usage: fem_compression [output.txt]   (also prints to stdout)
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
 
+#include "experiments/common/command_line.hpp"
 #include "fem/constitutive.hpp"
 #include "fem/stable_step.hpp"
 #include "mesh/io/primitives.hpp"
@@ -77,8 +79,17 @@ double dense_omega_max(Model& model, const MatX3d& x) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  using icd::experiments::CommandLine;
+  std::filesystem::path out_path;
+  CommandLine cli("fem_compression", "  Prints the table; OUTPUT gets a copy.");
+  cli.argument("OUTPUT", out_path, "also write the table to this file", false);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  FILE* out = argc > 1 ? std::fopen(argv[1], "w") : nullptr;
+  FILE* out = nullptr;
+  if (!out_path.empty() && (out = std::fopen(out_path.c_str(), "w")) == nullptr) {
+    std::fprintf(stderr, "fem_compression: cannot write %s\n", out_path.c_str());
+    return 1;
+  }
   auto emit = [&](const char* line) {
     std::fputs(line, stdout);
     if (out) std::fputs(line, out);

@@ -11,11 +11,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "experiments/common/command_line.hpp"
 #include "fem/simulator.hpp"
 #include "fem/static_solver.hpp"
 #include "mesh/io/primitives.hpp"
@@ -73,14 +74,13 @@ double static_tip(int r, MaterialModel mm) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out = "fem_error_vs_time.csv";
+  using icd::experiments::CommandLine;
+  std::filesystem::path out = "fem_error_vs_time.csv";
   bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--quick") == 0)
-      quick = true;
-    else
-      out = argv[i];
-  }
+  CommandLine cli("fem_error_vs_time");
+  cli.argument("OUT.csv", out, "the table (default fem_error_vs_time.csv)", false)
+      .flag("--quick", quick, "the two coarsest meshes only");
+  if (const auto status = cli.parse(argc, argv)) return *status;
   const double G = kYoung / (2 * (1 + kPoisson)), A = 0.01, I = 1e-4 / 12,
                q = kDensity * kGravity * A;
   const double kappa = 10 * (1 + kPoisson) / (12 + 11 * kPoisson);
@@ -100,6 +100,10 @@ int main(int argc, char** argv) {
                                             Integrator::BackwardEuler};
 
   std::ofstream csv(out);
+  if (!csv) {
+    std::fprintf(stderr, "fem_error_vs_time: cannot write %s\n", out.string().c_str());
+    return 1;
+  }
   csv << "tets,r,material,integrator,step_s,substeps,sim_time_s,wall_s,wall_per_sim_s,tip_m,"
          "analytic_tip_m,fine_static_tip_m,same_mesh_static_tip_m,err_analytic,err_fine_static,err_"
          "same_mesh_static\n";
@@ -142,6 +146,6 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::printf("wrote %s\n", out.c_str());
+  std::printf("wrote %s\n", out.string().c_str());
   return 0;
 }

@@ -35,13 +35,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "experiments/common/command_line.hpp"
 #include "experiments/fem/clamped_bar.hpp"
 #include "fem/lane_loops.hpp"
 #include "fem/simulator.hpp"
@@ -98,8 +98,21 @@ double cpu_per_call(Op&& op) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool block = argc > 1 && std::string(argv[1]) == "block";
-  const int threads = argc > 2 ? std::atoi(argv[2]) : 1;
+  using icd::experiments::CommandLine;
+  bool block = false;
+  int threads = 1;
+  CommandLine cli("fem_realtime", "  Prints the table (about 2 min for the bar).");
+  cli.argument("MESH", "bar (40 x 4 x 4 cells, default) or block (10 x 8 x 8)", false,
+               [&block](const std::string& v) {
+                 if (v != "bar" && v != "block")
+                   throw std::invalid_argument("must be bar or block, got '" + v + "'");
+                 block = v == "block";
+               })
+      .argument("THREADS", "threads of the force evaluation (default 1)", false,
+                [&threads](const std::string& v) {
+                  threads = CommandLine::parse_integer<int>(v, 1, 256);
+                });
+  if (const auto status = cli.parse(argc, argv)) return *status;
   BoxMeshOptions bo;
   bo.nx = block ? 10 : 40;
   bo.ny = block ? 8 : 4;

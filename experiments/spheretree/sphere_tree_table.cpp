@@ -184,13 +184,7 @@ icd::collision::SphereTree fit_leaves_to_probes(const icd::SurfaceMesh& mesh,
 }  // namespace
 
 int run(int argc, char** argv) {
-  // RESULTS_DIR first, then the options.
-  const bool help = argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
-  if (argc < 2 || (!help && std::string(argv[1]).rfind("-", 0) == 0)) {
-    std::cerr << "usage: sphere_tree_table RESULTS_DIR [options] (--help lists them)\n";
-    return 2;
-  }
-  const fs::path results = argv[1];
+  fs::path results;
   std::string models_arg = "bunny,dragon";
   icd::mesh::SphereTreeOptions options;
   options.branching = 8;
@@ -206,7 +200,7 @@ int run(int argc, char** argv) {
                   "  Builds and evaluates the trees, writes .sph and VTU files into RESULTS_DIR\n"
                   "  (see the comment at the top of sphere_tree_table.cpp and\n"
                   "  experiments/spheretree/results/README.md). The builder checks the ranges.");
-  cli.positional("RESULTS_DIR");
+  cli.argument("RESULTS_DIR", results, "output folder (created)", true);
   icd::mesh::WorstSplitOptions& split = options.worst_split;
   icd::mesh::ProtrusionPolishOptions& polish = options.protrusion;
   cli.text("--models", models_arg, "bunny,dragon", "models to build")
@@ -284,7 +278,7 @@ int run(int argc, char** argv) {
                 options.branching = std::max(2, n);
                 options.max_spheres_per_level = {1, n};
               });
-  if (const auto status = cli.parse(argc - (help ? 0 : 1), argv + (help ? 0 : 1))) return *status;
+  if (const auto status = cli.parse(argc, argv)) return *status;
   fs::create_directories(results);
   const char* env = std::getenv("ICD_DATA_DIR");
   const fs::path data = env ? fs::path(env) : fs::path(ICD_DATA_DIR);

@@ -83,7 +83,8 @@ TEST(CommandLine, EveryBadCommandLineNamesTheOptionAndTheProblem) {
   };
   const std::vector<Case> cases = {
       {{"--frobnicate"}, "unknown option '--frobnicate'"},
-      {{"out"}, "unknown option 'out'"},
+      {{"out"}, "unexpected argument 'out'"},
+      {{"-"}, "unknown option '-'"},
       {{"--reps"}, "--reps needs a value"},
       {{"--reps", "12x"}, "--reps expects a whole number, got '12x'"},
       {{"--reps", ""}, "--reps expects a whole number, got ''"},
@@ -106,6 +107,48 @@ TEST(CommandLine, EveryBadCommandLineNamesTheOptionAndTheProblem) {
     EXPECT_NE(message.find(c.expected), std::string::npos)
         << "args " << ::testing::PrintToString(c.args) << ": got '" << message << "'";
   }
+}
+
+TEST(CommandLine, PositionalArgumentsBindInOrderAnywhereAmongTheOptions) {
+  std::filesystem::path dir;
+  int threads = 1;
+  bool quick = false;
+  auto make_positional = [&] {
+    CommandLine cli("prog");
+    cli.argument("DIR", dir, "output folder", true)
+        .argument("THREADS", "worker threads", false,
+                  [&threads](const std::string& v) {
+                    threads = CommandLine::parse_integer<int>(v, 1, 64);
+                  })
+        .flag("--quick", quick, "quick");
+    return cli;
+  };
+  EXPECT_TRUE(make_positional().apply({"--quick", "out/a", "--quick", "4"}));
+  EXPECT_EQ(dir, "out/a");
+  EXPECT_EQ(threads, 4);
+  EXPECT_TRUE(quick);
+  threads = 1;
+  EXPECT_TRUE(make_positional().apply({"out/b"}));  // the optional one keeps its default
+  EXPECT_EQ(dir, "out/b");
+  EXPECT_EQ(threads, 1);
+  auto error = [&](const std::vector<std::string>& args) -> std::string {
+    try {
+      make_positional().apply(args);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error({}), "missing DIR");
+  EXPECT_EQ(error({"--quick"}), "missing DIR");
+  EXPECT_EQ(error({"d", "0"}), "THREADS must be in [1, 64], got '0'");
+  EXPECT_EQ(error({"d", "2x"}), "THREADS expects a whole number, got '2x'");
+  EXPECT_EQ(error({"d", "2", "extra"}), "unexpected argument 'extra'");
+  EXPECT_EQ(error({"d", "--slow"}), "unknown option '--slow'");
+  EXPECT_FALSE(make_positional().apply({"--help"}));  // help needs no DIR
+  const std::string usage = make_positional().usage();
+  EXPECT_NE(usage.find("usage: prog DIR [THREADS] [--quick]"), std::string::npos) << usage;
+  EXPECT_NE(usage.find("  THREADS"), std::string::npos) << usage;
 }
 
 TEST(CommandLine, UsageListsEveryOptionAndTheSummary) {

@@ -283,4 +283,36 @@ TEST(ExperimentsReduced, BadOptionsStopWithStatusTwoAndNameTheOption) {
   }
 }
 
+TEST(ExperimentsReduced, FemProgramsCheckTheirArguments) {
+  // The FEM experiments take positional arguments (fem_realtime [bar|block]
+  // [THREADS], fem_error_vs_time [OUT.csv] [--quick], fem_compression
+  // [OUTPUT]); a bad one stops them with status 2 before they write
+  // anything (they run in an empty folder, which must stay empty but for
+  // the log).
+  struct Case {
+    std::string program, args, expected;
+  };
+  const std::vector<Case> cases = {
+      {"fem_realtime", "slab", "MESH must be bar or block, got 'slab'"},
+      {"fem_realtime", "block 0", "THREADS must be in [1, 256], got '0'"},
+      {"fem_realtime", "bar 2x", "THREADS expects a whole number, got '2x'"},
+      {"fem_error_vs_time", "a.csv --quick b.csv", "unexpected argument 'b.csv'"},
+      {"fem_error_vs_time", "--fast", "unknown option '--fast'"},
+      {"fem_compression", "x.txt y.txt", "unexpected argument 'y.txt'"},
+  };
+  for (const Case& c : cases) {
+    const fs::path out = out_dir("bad_" + c.program);
+    const std::string cmd = "cd " + out.string() + " && " + std::string(ICD_FEM_BIN_DIR) + "/" +
+                            c.program + " " + c.args + " > log.txt 2>&1";
+    const int status = std::system(cmd.c_str());
+    const std::string log = log_of(out);
+    ASSERT_TRUE(WIFEXITED(status)) << c.program;
+    EXPECT_EQ(WEXITSTATUS(status), 2) << c.program << " " << c.args << ": " << log;
+    EXPECT_NE(log.find(c.expected), std::string::npos) << c.program << ": " << log;
+    EXPECT_NE(log.find("usage: " + c.program), std::string::npos) << c.program << ": " << log;
+    for (const auto& entry : fs::directory_iterator(out))
+      EXPECT_EQ(entry.path().filename(), "log.txt") << c.program << " wrote " << entry.path();
+  }
+}
+
 }  // namespace
