@@ -657,7 +657,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   MedialAxisOptions medial_options;
   medial_options.refinement_iterations = options.refinement_iterations;
   medial_options.error_tolerance = options.refinement_tolerance * scale;
-  const MedialSpheres medial = approximate_medial_axis(oracle, medial_samples, medial_options);
+  const MedialSpheres medial = approximate_medial_axis(oracles, medial_samples, medial_options);
   out.num_medial_spheres = static_cast<int>(medial.radii.size());
   out.num_refinement_points = medial.num_inserted;
   const PointGrid grid(medial.centers, scale / 64.0);

@@ -14,6 +14,7 @@
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include "mesh/io/error.hpp"
+#include "mesh/spheres/parallel.hpp"
 
 namespace icd::mesh {
 namespace {
@@ -64,22 +65,41 @@ struct InnerVertex {
   int corner[4];
 };
 
-std::vector<InnerVertex> inner_vertices(Delaunay& dt, const MeshOracle& oracle) {
+/// Classifies the cells not tested yet (circumcentre inside the mesh?), one
+/// block of cells per task on the workers' oracles; each task writes only
+/// its own cells' infos.
+void classify_new_cells(Delaunay& dt, const std::vector<const MeshOracle*>& oracles) {
+  std::vector<Delaunay::Cell_handle> fresh;
+  for (auto cell = dt.finite_cells_begin(); cell != dt.finite_cells_end(); ++cell) {
+    if (cell->info().state == 0) fresh.push_back(cell);
+  }
+  constexpr size_t kBlock = 512;
+  parallel_for((fresh.size() + kBlock - 1) / kBlock, static_cast<int>(oracles.size()),
+               [&](size_t block, int worker) {
+                 const MeshOracle& oracle = *oracles[static_cast<size_t>(worker)];
+                 const size_t end = std::min(fresh.size(), (block + 1) * kBlock);
+                 for (size_t i = block * kBlock; i < end; ++i) {
+                   CellInfo& info = fresh[i]->info();
+                   Eigen::Vector3d corners[4];
+                   for (int k = 0; k < 4; ++k) corners[k] = to_eigen(fresh[i]->vertex(k)->point());
+                   Eigen::Vector3d center;
+                   info.state = 1;
+                   if (circumcenter(corners, center) && oracle.inside(center)) {
+                     info.state = 2;
+                     for (int k = 0; k < 3; ++k) info.center[k] = center[k];
+                     info.circumradius = (center - corners[0]).norm();
+                     info.inscribed = oracle.distance(center);
+                   }
+                 }
+               });
+}
+
+std::vector<InnerVertex> inner_vertices(Delaunay& dt,
+                                        const std::vector<const MeshOracle*>& oracles) {
+  classify_new_cells(dt, oracles);
   std::vector<InnerVertex> out;
   for (auto cell = dt.finite_cells_begin(); cell != dt.finite_cells_end(); ++cell) {
-    CellInfo& info = cell->info();
-    if (info.state == 0) {
-      Eigen::Vector3d corners[4];
-      for (int k = 0; k < 4; ++k) corners[k] = to_eigen(cell->vertex(k)->point());
-      Eigen::Vector3d center;
-      info.state = 1;
-      if (circumcenter(corners, center) && oracle.inside(center)) {
-        info.state = 2;
-        for (int k = 0; k < 3; ++k) info.center[k] = center[k];
-        info.circumradius = (center - corners[0]).norm();
-        info.inscribed = oracle.distance(center);
-      }
-    }
+    const CellInfo& info = cell->info();
     if (info.state != 2) continue;
     InnerVertex v;
     v.center = Eigen::Vector3d(info.center[0], info.center[1], info.center[2]);
@@ -95,6 +115,15 @@ std::vector<InnerVertex> inner_vertices(Delaunay& dt, const MeshOracle& oracle) 
 
 MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSamples& samples,
                                       const MedialAxisOptions& options) {
+  return approximate_medial_axis(std::vector<const MeshOracle*>{&oracle}, samples, options);
+}
+
+MedialSpheres approximate_medial_axis(const std::vector<const MeshOracle*>& oracles,
+                                      const SurfaceSamples& samples,
+                                      const MedialAxisOptions& options) {
+  if (oracles.empty() || std::find(oracles.begin(), oracles.end(), nullptr) != oracles.end())
+    throw ParameterError("approximate_medial_axis: needs at least one oracle, and no null one");
+  const MeshOracle& oracle = *oracles.front();
   if (options.refinement_iterations < 0 || options.max_insertions_per_iteration < 0) {
     throw ParameterError(
         "MedialAxisOptions: refinement_iterations and max_insertions_per_iteration must be >= 0");
@@ -116,7 +145,7 @@ MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSam
   if (dt.dimension() < 3) throw InputError("approximate_medial_axis: the samples are coplanar");
 
   MedialSpheres out;
-  std::vector<InnerVertex> inner = inner_vertices(dt, oracle);
+  std::vector<InnerVertex> inner = inner_vertices(dt, oracles);
   int next_info = ns;  // inserted points get infos >= ns (not samples)
   for (int it = 0; it < options.refinement_iterations; ++it) {
     // Worst spheres first, so that the insertion budget goes where the error is.
@@ -131,10 +160,15 @@ MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSam
     if (static_cast<int>(bad.size()) > options.max_insertions_per_iteration) {
       bad.resize(static_cast<size_t>(options.max_insertions_per_iteration));
     }
+    // The surface points nearest the bad centres do not depend on the
+    // insertions: found in parallel, inserted in order.
+    std::vector<Eigen::Vector3d> nearest(bad.size());
+    parallel_for(bad.size(), static_cast<int>(oracles.size()), [&](size_t k, int worker) {
+      nearest[k] = oracles[static_cast<size_t>(worker)]->closest_point(
+          inner[static_cast<size_t>(bad[k].second)].center);
+    });
     int inserted = 0;
-    for (const auto& [neg_err, i] : bad) {
-      (void)neg_err;
-      const Eigen::Vector3d q = oracle.closest_point(inner[static_cast<size_t>(i)].center);
+    for (const Eigen::Vector3d& q : nearest) {
       const Point p(q.x(), q.y(), q.z());
       Delaunay::Locate_type lt;
       int li, lj;
@@ -146,7 +180,7 @@ MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSam
     }
     out.num_inserted += inserted;
     if (inserted == 0) break;
-    inner = inner_vertices(dt, oracle);
+    inner = inner_vertices(dt, oracles);
   }
 
   // Cover spheres for samples that no inner cell touches (thin features).

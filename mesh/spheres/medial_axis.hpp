@@ -2,6 +2,8 @@
 /// Adaptive medial-axis approximation (Bradshaw & O'Sullivan 2004, sec. 3):
 /// the Voronoi vertices of surface samples that lie inside the object, with
 /// their distance to the surface, refined where they are poor.
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "mesh/io/types.hpp"
@@ -41,6 +43,16 @@ struct MedialSpheres {
 /// inner Delaunay cell touches. Deterministic. Throws ParameterError for bad
 /// options and InputError when fewer than 4 non-coplanar samples are given.
 MedialSpheres approximate_medial_axis(const MeshOracle& oracle, const SurfaceSamples& samples,
+                                      const MedialAxisOptions& options);
+
+/// The same on oracles.size() worker threads, one oracle of the same mesh
+/// per worker (MeshOracle's inside test is not safe for concurrent use); the
+/// inside tests and distances of the Delaunay cells and the refinement's
+/// nearest surface points are computed in parallel, the triangulation is
+/// built serially. The result does not depend on the number of workers.
+/// Throws ParameterError when `oracles` is empty or holds a null pointer.
+MedialSpheres approximate_medial_axis(const std::vector<const MeshOracle*>& oracles,
+                                      const SurfaceSamples& samples,
                                       const MedialAxisOptions& options);
 
 }  // namespace icd::mesh

@@ -47,6 +47,33 @@ TEST(MedialAxis, SphereMedialAxisIsNearTheCentre) {
   EXPECT_GE(medial.num_voronoi, 1);
 }
 
+TEST(MedialAxis, SameSpheresOnEveryNumberOfWorkers) {
+  // A torus refined over two rounds (so that cells are classified again
+  // after insertions): 1, 2 and 3 workers give the same spheres, bit for bit.
+  const auto torus = icd::make_torus(1.0, 0.35, 24, 12);
+  const MeshOracle a(torus), b(torus), c(torus);
+  const auto samples = sample_surface(torus.V, torus.F, SamplingOptions{0.05});
+  MedialAxisOptions options;
+  options.error_tolerance = 0.005;
+  const MedialSpheres one = approximate_medial_axis(a, samples, options);
+  ASSERT_GT(one.num_inserted, 0);
+  ASSERT_GT(one.num_voronoi, 100);
+  for (const std::vector<const MeshOracle*>& oracles :
+       {std::vector<const MeshOracle*>{&a, &b}, std::vector<const MeshOracle*>{&a, &b, &c}}) {
+    const MedialSpheres many = approximate_medial_axis(oracles, samples, options);
+    EXPECT_EQ(many.num_voronoi, one.num_voronoi);
+    EXPECT_EQ(many.num_inserted, one.num_inserted);
+    ASSERT_EQ(many.centers.rows(), one.centers.rows());
+    EXPECT_TRUE(many.centers == one.centers);
+    EXPECT_TRUE(many.radii == one.radii);
+    EXPECT_TRUE(many.circumradii == one.circumradii);
+  }
+  EXPECT_THROW(approximate_medial_axis(std::vector<const MeshOracle*>{}, samples, options),
+               icd::ParameterError);
+  EXPECT_THROW(approximate_medial_axis(std::vector<const MeshOracle*>{&a, nullptr}, samples, options),
+               icd::ParameterError);
+}
+
 TEST(MedialAxis, RejectsBadOptionsAndTooFewSamples) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   const MeshOracle oracle(box);
