@@ -1,6 +1,7 @@
 #include "mesh/spheres/protrusion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -25,56 +26,6 @@ void check_options(const ProtrusionPolishOptions& o) {
         "max_evaluations >= 0, initial_step and min_step > 0");
   }
 }
-
-/// r(c) = max over the members of |s - c| + gap[s], evaluated on a shell of
-/// members: rebuilt around c0, it holds every member that can be the farthest
-/// from any c with |c - c0| <= reach (exact there): a member with
-/// |s - c0| + gap < R0 - 2 reach is nearer to c than r(c) >= R0 - reach.
-class CoverRadius {
- public:
-  CoverRadius(const ReductionProblem& problem, const std::vector<int>& members, double reach)
-      : m_problem(problem), m_members(members), m_reach(reach) {}
-
-  double operator()(const Eigen::Vector3d& c) {
-    if (m_shell.empty() || (c - m_c0).norm() > m_reach) rebuild(c);
-    return on_shell(c);
-  }
-
-  /// The caller will stay within `reach` of `c` for a while: a thinner shell
-  /// is built around c when that halves the current reach or more.
-  void narrow(const Eigen::Vector3d& c, double reach) {
-    if (reach > 0.5 * m_reach) return;
-    m_reach = reach;
-    rebuild(c);
-  }
-
- private:
-  double on_shell(const Eigen::Vector3d& c) const {
-    double r = 0;
-    for (const Eigen::Vector4d& s : m_shell) r = std::max(r, (s.head<3>() - c).norm() + s[3]);
-    return r;
-  }
-
-  void rebuild(const Eigen::Vector3d& c0) {
-    m_c0 = c0;
-    double r0 = 0;
-    for (int s : m_members) r0 = std::max(r0, reach_of(s, c0));
-    m_shell.clear();
-    for (int s : m_members) {
-      if (reach_of(s, c0) >= r0 - 2 * m_reach) {
-        const Eigen::Vector3d p = m_problem.points.row(s).transpose();
-        m_shell.emplace_back(p.x(), p.y(), p.z(), m_problem.gap[s]);
-      }
-    }
-  }
-  double reach_of(int s, const Eigen::Vector3d& c) const { return m_problem.reach(s, c); }
-
-  const ReductionProblem& m_problem;
-  const std::vector<int>& m_members;
-  double m_reach;
-  Eigen::Vector3d m_c0 = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector4d> m_shell;
-};
 
 /// Protrusion of a moving sphere on fixed directions, with bounds carried
 /// from move to move: the signed protrusion of a point (distance outside,
@@ -160,6 +111,69 @@ Eigen::Matrix3d random_rotation(unsigned seed) {
 }
 
 }  // namespace
+
+CoverRadius::CoverRadius(const ReductionProblem& problem, const std::vector<int>& members,
+                         double reach)
+    : m_problem(problem), m_members(members), m_reach(reach) {
+  if (members.empty()) throw ParameterError("CoverRadius: no members");
+  if (!(reach >= 0))
+    throw ParameterError("CoverRadius: reach must be >= 0, got " + std::to_string(reach));
+}
+
+double CoverRadius::operator()(const Eigen::Vector3d& c) {
+  if (m_shell.empty() || (c - m_c0).norm() > m_reach) rebuild(c);
+  const double moved = (c - m_c0).norm();
+  const double slack = moved + 1e-9 * (m_r0 + moved);
+  double r = 0;
+  for (int b = 0; b < kBands; ++b) {
+    if (m_band_begin[b] == m_band_begin[b + 1]) continue;
+    if (m_band_max[b] + slack < r) break;  // this band and the next cannot reach r
+    for (size_t k = m_band_begin[b]; k < m_band_begin[b + 1]; ++k) {
+      const Eigen::Vector4d& s = m_shell[k];
+      r = std::max(r, (s.head<3>() - c).norm() + s[3]);
+    }
+  }
+  return r;
+}
+
+void CoverRadius::narrow(const Eigen::Vector3d& c, double reach) {
+  if (reach > 0.5 * m_reach) return;
+  m_reach = reach;
+  rebuild(c);
+}
+
+void CoverRadius::rebuild(const Eigen::Vector3d& c0) {
+  m_c0 = c0;
+  m_reach0.resize(m_members.size());
+  m_r0 = 0;
+  for (size_t k = 0; k < m_members.size(); ++k) {
+    m_reach0[k] = m_problem.reach(m_members[k], c0);
+    m_r0 = std::max(m_r0, m_reach0[k]);
+  }
+  // Band b holds the reaches in (r0 - (b + 1) w, r0 - b w], w = 2 reach / kBands.
+  const double width = 2 * m_reach / kBands;
+  auto band_of = [&](double reach0) {
+    return width > 0 ? std::min(kBands - 1, static_cast<int>((m_r0 - reach0) / width)) : 0;
+  };
+  std::array<size_t, kBands + 1> count{};
+  m_band_max.fill(-std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k < m_members.size(); ++k) {
+    if (m_reach0[k] < m_r0 - 2 * m_reach) continue;
+    const int b = band_of(m_reach0[k]);
+    ++count[static_cast<size_t>(b) + 1];
+    m_band_max[b] = std::max(m_band_max[b], m_reach0[k]);
+  }
+  for (int b = 0; b < kBands; ++b) count[b + 1] += count[b];
+  m_band_begin = count;
+  m_shell.resize(count[kBands]);
+  for (size_t k = 0; k < m_members.size(); ++k) {
+    if (m_reach0[k] < m_r0 - 2 * m_reach) continue;
+    const int s = m_members[k];
+    const Eigen::Vector3d p = m_problem.points.row(s).transpose();
+    m_shell[count[static_cast<size_t>(band_of(m_reach0[k]))]++] =
+        Eigen::Vector4d(p.x(), p.y(), p.z(), m_problem.gap[s]);
+  }
+}
 
 MatX3d spiral_directions(int count) {
   if (count < 1)

@@ -2,6 +2,9 @@
 /// The true error of a sphere (how far its surface sticks out of the object,
 /// measured on sphere-surface points) and a centre polish that lowers it
 /// while the sphere keeps covering its samples (issue 5).
+#include <array>
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "mesh/io/types.hpp"
@@ -23,6 +26,43 @@ MatX3d spiral_directions(int count);
 /// the farthest ones until one lies outside.
 double sphere_protrusion(const MeshOracle& oracle, const Eigen::Vector3d& center, double radius,
                          const Eigen::Ref<const MatX3d>& directions);
+
+/// r(c) = max over `members` of |s - c| + gap[s] (the smallest radius that
+/// covers them with margin from centre c), for a centre that moves in small
+/// steps. It keeps a shell of members, rebuilt around c0 when c leaves the
+/// ball of radius `reach` around it: every member that can be the farthest
+/// from such a c (a member with |s - c0| + gap < R0 - 2 reach is nearer to c
+/// than r(c) >= R0 - reach). The shell is stored in bands of decreasing reach
+/// from c0; an evaluation stops before the first band whose largest reach
+/// from c0 plus |c - c0| (with a margin for rounding) is below the largest
+/// reach found. The result is the exact maximum over all members (the same
+/// number). `problem` and `members` must outlive it.
+class CoverRadius {
+ public:
+  /// Throws ParameterError for no members or a negative reach.
+  CoverRadius(const ReductionProblem& problem, const std::vector<int>& members, double reach);
+
+  /// r(c).
+  double operator()(const Eigen::Vector3d& c);
+
+  /// The caller will stay within `reach` of `c` for a while: a thinner shell
+  /// is built around c when that halves the current reach or more.
+  void narrow(const Eigen::Vector3d& c, double reach);
+
+ private:
+  static constexpr int kBands = 8;
+  void rebuild(const Eigen::Vector3d& c0);
+
+  const ReductionProblem& m_problem;
+  const std::vector<int>& m_members;
+  double m_reach;
+  Eigen::Vector3d m_c0 = Eigen::Vector3d::Zero();
+  double m_r0 = 0;                       // largest reach from c0
+  std::vector<double> m_reach0;          // scratch of rebuild(): each member's reach from c0
+  std::vector<Eigen::Vector4d> m_shell;  // point, gap
+  std::array<size_t, kBands + 1> m_band_begin{};  // band b: m_shell[begin[b], begin[b + 1])
+  std::array<double, kBands> m_band_max{};        // largest reach from c0 in each band
+};
 
 /// Options of polish_protrusion().
 struct ProtrusionPolishOptions {

@@ -29,6 +29,82 @@ double box_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
   return (lo - p).cwiseMax(p - hi).cwiseMax(Eigen::Vector3d::Zero()).norm();
 }
 
+TEST(Protrusion, CoverRadiusEqualsTheLargestReachOverAllMembers) {
+  // Two member sets, each evaluated from centres that move around as the
+  // polish moves them; every value must equal the brute-force maximum
+  // exactly. (a) A cap of the unit sphere (x > 0.5) and a whole sphere of
+  // radius 1 - 3w inside it (w: the width of CoverRadius' bands): seen from
+  // the origin, bands 1 and 2 are empty, and once the centre moves by more
+  // than 2w towards the cap the farthest member is on the inner sphere,
+  // three bands down. (b) Three shells (radii 1, 0.97, 0.6), random walks
+  // with steps of three sizes, narrowing half-way.
+  std::mt19937 rng(17);
+  std::normal_distribution<double> gauss;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto random_unit = [&] {
+    return Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+  };
+  MedialSpheres medial;
+  medial.centers = icd::MatX3d::Zero(1, 3);
+  medial.radii = Eigen::VectorXd::Ones(1);
+  medial.circumradii = medial.radii;
+  const PointGrid grid(medial.centers, 1.0);
+  auto check = [&](const icd::MatX3d& points, const Eigen::VectorXd& gap, double reach,
+                   const std::vector<Eigen::Vector3d>& centres, int narrow_at) {
+    const ReductionProblem problem{points, gap, medial, grid};
+    std::vector<int> members(static_cast<size_t>(points.rows()));
+    for (size_t i = 0; i < members.size(); ++i) members[i] = static_cast<int>(i);
+    CoverRadius cover(problem, members, reach);
+    for (size_t k = 0; k < centres.size(); ++k) {
+      if (static_cast<int>(k) == narrow_at) cover.narrow(centres[k], reach / 2);
+      double brute = 0;
+      for (int s : members) brute = std::max(brute, problem.reach(s, centres[k]));
+      ASSERT_EQ(cover(centres[k]), brute) << "reach " << reach << ", centre " << k;
+    }
+  };
+  {
+    const double reach = 0.04, w = 2 * reach / 8;
+    icd::MatX3d points(2000, 3);
+    Eigen::VectorXd gap(2000);
+    for (int i = 0; i < 2000; ++i) {
+      Eigen::Vector3d d = random_unit();
+      if (i < 500) {
+        while (d.x() <= 0.5) d = random_unit();
+        points.row(i) = d.transpose();
+      } else {
+        points.row(i) = (1 - 3 * w) * d.transpose();
+      }
+      gap[i] = 1e-4 * unit(rng);
+    }
+    std::vector<Eigen::Vector3d> centres{Eigen::Vector3d::Zero()};
+    for (int k = 1; k <= 40; ++k) centres.push_back(Eigen::Vector3d(reach * k / 41.0, 0, 0));
+    for (int k = 0; k < 100; ++k) centres.push_back(reach * unit(rng) * random_unit());
+    check(points, gap, reach, centres, -1);
+  }
+  {
+    const int n = 3000;
+    icd::MatX3d points(n, 3);
+    Eigen::VectorXd gap(n);
+    for (int i = 0; i < n; ++i) {
+      const double radius = i % 3 == 0 ? 1.0 : i % 3 == 1 ? 0.97 : 0.6;
+      points.row(i) = radius * random_unit().transpose();
+      gap[i] = 0.01 * unit(rng);
+    }
+    for (double step : {0.2, 0.02, 0.002}) {
+      std::vector<Eigen::Vector3d> centres;
+      Eigen::Vector3d c(0.1, -0.05, 0.02);
+      for (int k = 0; k < 300; ++k) centres.push_back(c += step * unit(rng) * random_unit());
+      check(points, gap, 2 * step, centres, 150);
+    }
+  }
+  const icd::MatX3d none(0, 3);
+  const Eigen::VectorXd no_gap(0);
+  const ReductionProblem empty{none, no_gap, medial, grid};
+  EXPECT_THROW(CoverRadius(empty, {}, 1.0), icd::ParameterError);
+  const std::vector<int> one{0};
+  EXPECT_THROW(CoverRadius(empty, one, -1.0), icd::ParameterError);
+}
+
 TEST(Protrusion, SpiralDirectionsAreUnitAndCoverTheSphere) {
   EXPECT_THROW(spiral_directions(0), icd::ParameterError);
   const int n = 256;
