@@ -680,14 +680,17 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     owners = medial_owners(coarse, options.medial_spacing * scale);
   }
   const int build_branching = std::max(options.branching, options.build_branching);
-  auto reduce = [&](const std::vector<int>& members, int max_k) {
+  // `threads` > 1 only where one node is reduced (the root's children).
+  auto reduce = [&](const std::vector<int>& members, int max_k, int threads) {
+    ReductionOptions split_options = reduction;
+    split_options.threads = threads;
     if (options.reduction == ReductionMethod::split_lloyd) {
-      return reduce_to_spheres(coarse, members, max_k, reduction);
+      return reduce_to_spheres(coarse, members, max_k, split_options);
     }
     std::vector<std::vector<FittedSphere>> mb =
         merge_burst_reduce(coarse, owners, members, max_k, reduction, merge_burst);
     if (options.reduction == ReductionMethod::best_of_both) {
-      const auto split = reduce_to_spheres(coarse, members, max_k, reduction);
+      const auto split = reduce_to_spheres(coarse, members, max_k, split_options);
       for (size_t k = 0; k < mb.size(); ++k) {
         if (better_config(split[k], mb[k])) mb[k] = split[k];
       }
@@ -716,8 +719,10 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     const std::vector<Node>& parents = levels.back();
     std::vector<ParentChoices> choices(parents.size());
     const int max_k = l >= 2 ? build_branching : options.branching;
-    parallel_for(parents.size(), workers,
-                 [&](size_t p, int) { choices[p].configs = reduce(parents[p].medial, max_k); });
+    const int reduce_threads = parents.size() == 1 ? workers : 1;
+    parallel_for(parents.size(), workers, [&](size_t p, int) {
+      choices[p].configs = reduce(parents[p].medial, max_k, reduce_threads);
+    });
     long long cap =
         std::max<long long>(level_cap(options, l), static_cast<long long>(parents.size()));
     // What regroup_tree can place under the parents with `branching` each.

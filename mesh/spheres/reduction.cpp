@@ -13,6 +13,7 @@
 
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
+#include "mesh/spheres/parallel.hpp"
 
 namespace icd::mesh {
 
@@ -238,18 +239,23 @@ void refit_radius(const ReductionProblem& problem, FittedSphere& sphere) {
   sphere.error = r - sphere.depth;
 }
 
-/// Lloyd assignment: member -> index of the sphere minimizing |s - c| - depth.
+/// Lloyd assignment: member -> index of the sphere minimizing |s - c| - depth
+/// (blocks of members on `threads` workers).
 std::vector<int> assign(const ReductionProblem& problem, const std::vector<int>& members,
-                        const std::vector<FittedSphere>& spheres) {
+                        const std::vector<FittedSphere>& spheres, int threads = 1) {
   std::vector<int> owner(members.size(), 0);
-  for (size_t m = 0; m < members.size(); ++m) {
-    const Eigen::Vector3d s = problem.points.row(members[m]);
-    double best = kInf;
-    for (size_t j = 0; j < spheres.size(); ++j) {
-      const double v = (s - spheres[j].center).norm() - spheres[j].depth;
-      if (v < best) best = v, owner[m] = static_cast<int>(j);
+  constexpr size_t kBlock = 16384;
+  parallel_for((members.size() + kBlock - 1) / kBlock, threads, [&](size_t block, int) {
+    const size_t end = std::min(members.size(), (block + 1) * kBlock);
+    for (size_t m = block * kBlock; m < end; ++m) {
+      const Eigen::Vector3d s = problem.points.row(members[m]);
+      double best = kInf;
+      for (size_t j = 0; j < spheres.size(); ++j) {
+        const double v = (s - spheres[j].center).norm() - spheres[j].depth;
+        if (v < best) best = v, owner[m] = static_cast<int>(j);
+      }
     }
-  }
+  });
   return owner;
 }
 
@@ -415,12 +421,22 @@ void polish_sphere(const ReductionProblem& problem, const MeshOracle& oracle, Fi
   if (sphere.error > start.error) sphere = std::move(start);
 }
 
+namespace {
+
+/// assign_and_refit() on `threads` workers.
+void assign_and_refit_on(const ReductionProblem& problem, const std::vector<int>& members,
+                         std::vector<FittedSphere>& spheres, int threads) {
+  if (spheres.empty()) return;
+  const std::vector<int> owner = assign(problem, members, spheres, threads);
+  distribute(members, owner, spheres);
+  parallel_for(spheres.size(), threads, [&](size_t j, int) { refit_radius(problem, spheres[j]); });
+}
+
+}  // namespace
+
 void assign_and_refit(const ReductionProblem& problem, const std::vector<int>& members,
                       std::vector<FittedSphere>& spheres) {
-  if (spheres.empty()) return;
-  const std::vector<int> owner = assign(problem, members, spheres);
-  distribute(members, owner, spheres);
-  for (auto& s : spheres) refit_radius(problem, s);
+  assign_and_refit_on(problem, members, spheres, 1);
 }
 
 void refine_jointly(const ReductionProblem& problem, std::vector<FittedSphere>& spheres,
@@ -467,9 +483,13 @@ std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem&
   std::vector<FittedSphere> spheres{fit_sphere(problem, members, nullptr, options)};
   result.push_back(spheres);
 
+  if (options.threads < 1)
+    throw ParameterError("ReductionOptions::threads must be >= 1, got " +
+                         std::to_string(options.threads));
+  const int threads = options.threads;
   for (int k = 2; k <= max_k; ++k) {
     // Seed: the sample whose assignment cost (error it causes) is largest.
-    const std::vector<int> owner = assign(problem, members, spheres);
+    const std::vector<int> owner = assign(problem, members, spheres, threads);
     double worst = -kInf;
     size_t worst_m = 0;
     for (size_t m = 0; m < members.size(); ++m) {
@@ -496,19 +516,19 @@ std::vector<std::vector<FittedSphere>> reduce_to_spheres(const ReductionProblem&
     added.depth = problem.medial.radii[best_idx];
     added.radius = search;
     spheres.push_back(added);
-    assign_and_refit(problem, members, spheres);
+    assign_and_refit_on(problem, members, spheres, threads);
 
     std::vector<FittedSphere> best_config = spheres;
     double best_obj = objective(spheres);
     for (int it = 0; it < options.lloyd_iterations; ++it) {
       if (CpuClock::now() > options.deadline) break;
+      parallel_for(spheres.size(), threads, [&](size_t j, int) {
+        const FittedSphere hint = spheres[j];
+        spheres[j] = fit_sphere(problem, hint.members, &hint, options);
+      });
       std::vector<std::vector<int>> before;
-      for (auto& s : spheres) {
-        const FittedSphere hint = s;
-        s = fit_sphere(problem, s.members, &hint, options);
-        before.push_back(s.members);
-      }
-      assign_and_refit(problem, members, spheres);
+      for (const auto& s : spheres) before.push_back(s.members);
+      assign_and_refit_on(problem, members, spheres, threads);
       const double obj = objective(spheres);
       if (obj < best_obj) best_obj = obj, best_config = spheres;
       bool stable = spheres.size() == before.size();

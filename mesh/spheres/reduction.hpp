@@ -52,6 +52,11 @@ struct ReductionOptions {
   /// Past this process CPU time only the greedy splits run (no Lloyd rounds):
   /// the result is still valid.
   CpuClock::time_point deadline = CpuClock::time_point::max();
+  /// Worker threads of one reduce_to_spheres() call (the assignment and the
+  /// spheres' refits; >= 1). The result does not depend on it. The builder
+  /// uses more than one only for the root's reduction, where there is one
+  /// node to reduce.
+  int threads = 1;
 };
 
 /// Fits one sphere to the samples `members`: the candidate centre with the
