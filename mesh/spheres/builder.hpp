@@ -163,9 +163,12 @@ struct SphereTreeOptions {
   /// per-node steps (each level's reduction and fitting of a parent's
   /// children, the leaf polish between boundary exchanges, the protrusion
   /// polish) run one node per task, split_worst_leaves one candidate
-  /// division per task; the tree does not depend on the number of threads
-  /// (as long as the CPU budget below is not reached: it counts the CPU time
-  /// of all threads).
+  /// division per task; the medial axis' inside tests and the root's
+  /// reduction (one node) are split into blocks of samples or spheres.
+  /// Serial: the Delaunay triangulation and the boundary exchanges across
+  /// the leaf level (greedy, order-dependent). The tree does not depend on
+  /// the number of threads (as long as the CPU budget below is not reached:
+  /// it counts the CPU time of all threads).
   int threads = 0;
   /// Budget in CPU seconds of this process (clock_gettime(CLOCK_PROCESS_CPUTIME_ID),
   /// not wall-clock time, so a loaded machine does not change the tree; > 0).
