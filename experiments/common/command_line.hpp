@@ -1,11 +1,12 @@
 #pragma once
 /// Command-line options of the experiment programs: `--name value` options
-/// bound to variables and `--name` flags, one usage text built from them, and
-/// one error path. An unknown option, a missing value, a malformed number
-/// ("12x", "", "nan") or a value out of its range is reported with the
-/// option's name and what is wrong, followed by the usage, and the program
-/// exits with status 2 before doing anything; `--help` / `-h` prints the
-/// usage and exits with 0.
+/// bound to variables, `--name` flags and positional arguments, one usage
+/// text built from them, and one error path. An unknown option, a missing
+/// value or required argument, an extra argument, a malformed number ("12x",
+/// "", "nan") or a value out of its range is reported with the option's (or
+/// argument's) name and what is wrong, followed by the usage, and the
+/// program exits with status 2 before doing anything; `--help` / `-h` prints
+/// the usage and exits with 0.
 ///
 ///   CommandLine cli("fig9", "Writes DIR/manifest.csv.");
 ///   cli.path("--out", out, "DIR", "output folder").integer("--after", after, "N", "frames", 0);
