@@ -11,14 +11,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "experiments/common/command_line.hpp"
 #include "fem/simulator.hpp"
 #include "fem/static_solver.hpp"
+#include "mesh/io/atomic_write.hpp"
 #include "mesh/io/primitives.hpp"
 
 namespace {
@@ -81,6 +83,11 @@ int main(int argc, char** argv) {
   cli.argument("OUT.csv", out, "the table (default fem_error_vs_time.csv)", false)
       .flag("--quick", quick, "the two coarsest meshes only");
   if (const auto status = cli.parse(argc, argv)) return *status;
+  if (const auto folder = out.parent_path();
+      !folder.empty() && !std::filesystem::is_directory(folder)) {
+    std::fprintf(stderr, "fem_error_vs_time: %s: no such folder\n", folder.string().c_str());
+    return 1;
+  }
   const double G = kYoung / (2 * (1 + kPoisson)), A = 0.01, I = 1e-4 / 12,
                q = kDensity * kGravity * A;
   const double kappa = 10 * (1 + kPoisson) / (12 + 11 * kPoisson);
@@ -99,11 +106,9 @@ int main(int argc, char** argv) {
   const std::vector<Integrator> integrators{Integrator::RK4, Integrator::SymplecticEuler,
                                             Integrator::BackwardEuler};
 
-  std::ofstream csv(out);
-  if (!csv) {
-    std::fprintf(stderr, "fem_error_vs_time: cannot write %s\n", out.string().c_str());
-    return 1;
-  }
+  // Written at the end through a temporary file: an interrupted or failed
+  // run leaves no partial table behind (the rows are printed as they come).
+  std::ostringstream csv;
   csv << "tets,r,material,integrator,step_s,substeps,sim_time_s,wall_s,wall_per_sim_s,tip_m,"
          "analytic_tip_m,fine_static_tip_m,same_mesh_static_tip_m,err_analytic,err_fine_static,err_"
          "same_mesh_static\n";
@@ -136,7 +141,6 @@ int main(int argc, char** argv) {
             << ',' << substeps << ',' << sim_time << ',' << wall << ',' << wall / sim_time << ','
             << t << ',' << delta << ',' << fine << ',' << same << ',' << std::abs(t / delta - 1)
             << ',' << std::abs(t / fine - 1) << ',' << std::abs(t / same - 1) << '\n';
-        csv.flush();
         std::printf(
             "  %6ld tets %-18s %-16s step %.2e s  wall/sim %.3f  err analytic %.4f  fine %.4f  "
             "same-mesh %.2e\n",
@@ -145,6 +149,12 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
     }
+  }
+  try {
+    icd::write_file_atomically(out, csv.str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fem_error_vs_time: %s\n", e.what());
+    return 1;
   }
   std::printf("wrote %s\n", out.string().c_str());
   return 0;
