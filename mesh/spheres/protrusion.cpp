@@ -121,8 +121,11 @@ CoverRadius::CoverRadius(const ReductionProblem& problem, const std::vector<int>
 }
 
 double CoverRadius::operator()(const Eigen::Vector3d& c) {
-  if (m_shell.empty() || (c - m_c0).norm() > m_reach) rebuild(c);
-  const double moved = (c - m_c0).norm();
+  double moved = (c - m_c0).norm();
+  if (m_shell.empty() || moved > m_reach) {
+    rebuild(c);
+    moved = 0;  // c is the new c0
+  }
   const double slack = moved + 1e-9 * (m_r0 + moved);
   double r = 0;
   for (int b = 0; b < kBands; ++b) {
