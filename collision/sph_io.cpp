@@ -81,9 +81,18 @@ SphereTree read_sph(std::istream& in, const std::string& name, const SphReadOpti
   std::vector<int32_t> compact_prev;  // complete index (within previous level) -> compact id or -1
   std::vector<int32_t> compact_cur;
   while (next_content_line(in, line, line_no)) {
-    if (count >= expected)
+    if (count >= expected) {
+      // A text after the complete node list (the toolkit's programs append
+      // their options and evaluation, starting "Options :") ends the tree;
+      // one more line that starts with a number is an extra node line.
+      std::istringstream first(line);
+      std::string token;
+      double ignored = 0;
+      first >> token;
+      if (!parse_double(token, ignored)) break;
       fail(line_no,
            "more node lines than the " + std::to_string(expected) + " declared by the header");
+    }
     std::istringstream ls(line);
     double x, y, z, r, occ;
     std::string tx, ty, tz, tr;

@@ -19,7 +19,9 @@ struct SphReadOptions {
 
 /// Reads a `.sph` tree from a stream into the compact layout: unused nodes
 /// (r < 0) are dropped, the remaining nodes keep breadth-first order, and
-/// rest_spheres == spheres. `name` is used in error messages.
+/// rest_spheres == spheres. `name` is used in error messages. A text after
+/// the declared node lines whose first line does not start with a number
+/// (the reference toolkit appends its options and evaluation so) is ignored.
 /// Throws icd::InputError for a malformed header, a count of node lines that
 /// differs from the header, non-numeric or non-finite values, an unused root,
 /// or a used node below an unused parent. Memory grows only with the lines

@@ -134,6 +134,24 @@ TEST(SphIo, RandomTreesRoundTrip) {
   }
 }
 
+TEST(SphIo, IgnoresTheToolkitsTrailingOptionsAndEvaluation) {
+  // makeTreeMedial appends its options and evaluation after the tree.
+  const std::string tree = "2 2\n0 0 0 2 1\n-1 0 0 1 1\n1 0 0 1 1\n";
+  std::stringstream plain(tree), with_notes(tree +
+                                            "\n\nOptions :\n\ttesterLevels\t: 2\n"
+                                            "\tbranch\t: 2\n\toptimise\t: OFF\n\n\n"
+                                            "Level 0 : 1 spheres, Error 12.5\n");
+  const SphereTree a = read_sph(plain), b = read_sph(with_notes);
+  ASSERT_EQ(b.num_nodes(), 3);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(a.spheres[i].x, b.spheres[i].x);
+    EXPECT_EQ(a.spheres[i].r, b.spheres[i].r);
+  }
+  // A numeric line after the declared nodes is still one node line too many.
+  std::stringstream extra(tree + "\n\n1 1 1 1 1\nOptions :\n");
+  EXPECT_THROW(read_sph(extra), InputError);
+}
+
 TEST(SphIo, MalformedFilesThrowInputError) {
   // The child of an unused node: 7 lines of a depth-3 binary tree.
   const std::string child_of_unused =
