@@ -46,6 +46,7 @@
 #include "collision/sph_io.hpp"
 #include "collision/sphere_tree.hpp"
 #include "experiments/common/command_line.hpp"
+#include "experiments/spheretree/tree_report.hpp"
 #include "icd/config.hpp"
 #include "mesh/io/surface_reader.hpp"
 #include "mesh/io/vtk_writer.hpp"
@@ -84,20 +85,6 @@ void write_tree(const fs::path& dir, const std::string& stem,
   }
 }
 
-void print_table(const std::string& model, const std::string& method, double seconds,
-                 const std::vector<icd::mesh::LevelMetrics>& levels) {
-  for (const auto& m : levels) {
-    std::printf(
-        "%-7s %-7s %5d %7d %9.1f %8.2f %9.1f %8.2f %10.5f%% %8lld %7.2f %6d %9.1f %8.2f %6d %8.2f "
-        "%8.2f %7.2f\n",
-        model.c_str(), method.c_str(), m.level, m.num_spheres, m.worst_error_42, m.mean_error_42,
-        m.worst_error_162, m.mean_error_162, 100.0 * m.uncovered_area_fraction,
-        m.num_uncovered_samples, m.max_uncovered_gap, m.num_uncovered_vertices,
-        m.max_child_protrusion, seconds, m.num_redundant_spheres, m.mean_error_42_covering,
-        m.mean_error_162_covering, m.shell_thickness);
-  }
-}
-
 /// The `count` leaves with the largest 162-probe error: what limits the worst error.
 void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTreeBuild& build,
                         double to_2000, int count) {
@@ -133,26 +120,6 @@ void print_worst_leaves(const icd::SurfaceMesh& mesh, const icd::mesh::SphereTre
         to_2000 * build.node_depth[static_cast<size_t>(i)],
         build.node_samples[static_cast<size_t>(i)].size(), p,
         p >= 0 ? tree.child_count[static_cast<size_t>(p)] : 0);
-  }
-}
-
-/// Worst and mean true error of each level, measured on 2562 directions (a
-/// 4 times subdivided icosahedron): close to the continuous protrusion.
-void print_dense_errors(const std::string& model, const icd::SurfaceMesh& mesh,
-                        const icd::collision::SphereTree& tree, double to_2000) {
-  const icd::mesh::MeshOracle oracle(icd::mesh::close_holes(mesh));
-  const icd::MatX3d dirs = icd::mesh::probe_directions(4);
-  for (int l = 0; l < tree.num_levels(); ++l) {
-    double worst = 0, sum = 0;
-    const int begin = tree.level_offset[static_cast<size_t>(l)],
-              end = tree.level_offset[static_cast<size_t>(l) + 1];
-    for (int i = begin; i < end; ++i) {
-      const auto& s = tree.spheres[static_cast<size_t>(i)];
-      const double e = to_2000 * icd::mesh::sphere_protrusion(oracle, s.center(), s.r, dirs);
-      worst = std::max(worst, e), sum += e;
-    }
-    std::printf("# %s level %d: error on 2562 directions: worst %.1f mean %.2f\n", model.c_str(), l,
-                worst, sum / (end - begin));
   }
 }
 
@@ -289,18 +256,7 @@ int run(int argc, char** argv) {
     if (name == "dragon") models.push_back({"dragon", "ChineseDragon-10kv.off"});
   }
 
-  std::printf(
-      "# errors in units where the longest bounding-box side is 2000; error = largest distance\n"
-      "# from a probe outside the (hole-closed) mesh to the surface; coverage on a dense\n"
-      "# sampling (spacing 1 unit), gap = largest distance of an uncovered sample to a sphere;\n"
-      "# redund = spheres that cover no vertex or dense sample alone (each removable alone\n"
-      "# without uncovering anything), mean42c / mean162c = means over the other spheres;\n"
-      "# shell = volume of the level's union outside the object / surface area (the mean\n"
-      "# thickness of the shell it adds; independent of the sphere count).\n");
-  std::printf("%-7s %-7s %5s %7s %9s %8s %9s %8s %11s %8s %7s %6s %9s %8s %6s %8s %8s %7s\n",
-              "model", "method", "level", "spheres", "worst42", "mean42", "worst162", "mean162",
-              "uncovered", "unc.pts", "gap", "unc.v", "protrude", "build_s", "redund", "mean42c",
-              "mean162c", "shell");
+  icd::experiments::print_level_table_header();
   for (const auto& model : models) {
     const fs::path path = data / model.file;
     if (!fs::exists(path)) {
@@ -328,11 +284,13 @@ int run(int argc, char** argv) {
     const double octree_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    print_table(model.name, "medial", ours.seconds,
-                icd::mesh::evaluate_sphere_tree(mesh, ours.tree, evaluation));
+    icd::experiments::print_level_table(
+        model.name, "medial", ours.seconds,
+        icd::mesh::evaluate_sphere_tree(mesh, ours.tree, evaluation));
     if (with_octree)
-      print_table(model.name, "octree", octree_s,
-                  icd::mesh::evaluate_sphere_tree(mesh, octree, evaluation));
+      icd::experiments::print_level_table(
+          model.name, "octree", octree_s,
+          icd::mesh::evaluate_sphere_tree(mesh, octree, evaluation));
     std::printf(
         "# %s: %lld coverage samples, %d medial spheres (%d refinement points), medial axis %.2f "
         "s, build CPU time %.1f s, wall %.1f s on %d threads (protrusion polish %.1f s, %d nodes "
@@ -342,8 +300,7 @@ int run(int argc, char** argv) {
         ours.seconds, icd::mesh::worker_count(options.threads), ours.polish_cpu_seconds,
         ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // Model units -> the table's (longest bounding-box side 2000).
-    const double to_2000 =
-        2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    const double to_2000 = icd::experiments::to_normalized_units(mesh);
     if (options.prune_redundant_leaves || options.fill_leaf_budget) {
       std::printf("# %s: %d redundant leaves pruned, %d leaves split to fill the budget\n",
                   model.name.c_str(), ours.num_pruned, ours.num_budget_splits);
@@ -384,12 +341,12 @@ int run(int argc, char** argv) {
                   model.name.c_str(), l, worst, sum / (end - begin));
     }
     if (diagnose > 0) print_worst_leaves(mesh, ours, to_2000, diagnose);
-    print_dense_errors(model.name, mesh, ours.tree, to_2000);
+    icd::experiments::print_dense_errors(model.name, mesh, ours.tree, to_2000);
     if (fit_probes) {
       const icd::collision::SphereTree fitted = fit_leaves_to_probes(mesh, ours);
-      print_table(model.name, "fit42", 0.0,
-                  icd::mesh::evaluate_sphere_tree(mesh, fitted, evaluation));
-      print_dense_errors(model.name + " fit42", mesh, fitted, to_2000);
+      icd::experiments::print_level_table(
+          model.name, "fit42", 0.0, icd::mesh::evaluate_sphere_tree(mesh, fitted, evaluation));
+      icd::experiments::print_dense_errors(model.name + " fit42", mesh, fitted, to_2000);
     }
     std::fflush(stdout);
     write_tree(results, model.name + "_medial", ours.tree);

@@ -118,14 +118,25 @@ void check_tree(const collision::SphereTree& tree) {
 
 MatX3d probe_directions(int subdivisions) { return make_icosphere(subdivisions, 1.0).V; }
 
+Eigen::Matrix3d toolkit_probe_frame() {
+  Eigen::Matrix3d frame;
+  frame << 0, 0, 1, 0, 1, 0, 1, 0, 0;
+  return frame;
+}
+
 std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
                                                const collision::SphereTree& tree,
                                                const EvaluationOptions& options) {
   if (!(options.normalized_size > 0) || !(options.coverage_spacing > 0) ||
-      options.shell_samples < 0) {
+      options.shell_samples < 0 || options.probe_rotations < 0) {
     throw ParameterError(
         "EvaluationOptions: normalized_size and coverage_spacing must be positive, "
-        "shell_samples >= 0");
+        "shell_samples and probe_rotations >= 0");
+  }
+  const Eigen::Matrix3d& frame = options.probe_frame;
+  if (!frame.allFinite() ||
+      !(frame.transpose() * frame).isApprox(Eigen::Matrix3d::Identity(), 1e-9)) {
+    throw ParameterError("EvaluationOptions: probe_frame must be an orthogonal matrix");
   }
   check_tree(tree);
   const double side = longest_bounding_box_side(mesh.V);
@@ -137,7 +148,8 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
   for (auto& s : spheres) s.x *= scale, s.y *= scale, s.z *= scale, s.r *= scale;
 
   const MeshOracle oracle(close_holes(scaled));
-  const MatX3d probes42 = probe_directions(1), probes162 = probe_directions(2);
+  const MatX3d probes42 = probe_directions(1) * frame.transpose(),
+               probes162 = probe_directions(2) * frame.transpose();
   auto sphere_error = [&](const collision::Sphere& s, const MatX3d& dirs) {
     double err = 0;
     for (Eigen::Index d = 0; d < dirs.rows(); ++d) {
@@ -145,6 +157,21 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
       if (!oracle.inside(p)) err = std::max(err, oracle.distance(p));
     }
     return err;
+  };
+  // Random orientations of the 42 probes, per sphere and fixed by its index.
+  const MatX3d unturned42 = probe_directions(1);
+  auto rotated_error = [&](int node, const collision::Sphere& s) {
+    if (options.probe_rotations == 0) return 0.0;
+    std::mt19937 rng(static_cast<unsigned>(node) * 2246822519u + 977u);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    double sum = 0;
+    for (int k = 0; k < options.probe_rotations; ++k) {
+      // A normalized Gaussian quaternion is a uniformly random rotation.
+      const Eigen::Quaterniond q =
+          Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+      sum += sphere_error(s, unturned42 * q.toRotationMatrix().transpose());
+    }
+    return sum / options.probe_rotations;
   };
 
   const int num_levels = tree.num_levels();
@@ -175,6 +202,9 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     for (int i = begin; i < end; ++i) {
       const auto& s = spheres[static_cast<size_t>(i)];
       const double e42 = sphere_error(s, probes42), e162 = sphere_error(s, probes162);
+      const double e42r = rotated_error(i, s);
+      m.worst_error_42_rotated = std::max(m.worst_error_42_rotated, e42r);
+      m.mean_error_42_rotated += e42r / m.num_spheres;
       m.worst_error_42 = std::max(m.worst_error_42, e42);
       m.worst_error_162 = std::max(m.worst_error_162, e162);
       m.mean_error_42 += e42 / m.num_spheres;

@@ -2,6 +2,8 @@
 /// Per-level quality of a sphere tree against its surface (issue 5 metrics).
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "collision/sphere_tree.hpp"
 #include "mesh/io/types.hpp"
 
@@ -20,6 +22,15 @@ struct EvaluationOptions {
   /// Points per sphere of the shell-volume estimate (LevelMetrics::shell_thickness;
   /// 0 skips it; >= 0).
   int shell_samples = 256;
+  /// Orientation of the probe directions (orthogonal): the probes of a
+  /// sphere are c + r * probe_frame * d, d from probe_directions(). The
+  /// identity is our icosahedron; toolkit_probe_frame() turns it into the
+  /// reference toolkit's.
+  Eigen::Matrix3d probe_frame = Eigen::Matrix3d::Identity();
+  /// Random orientations of the 42 probes per sphere behind
+  /// LevelMetrics::worst_error_42_rotated / mean_error_42_rotated (>= 0; 0
+  /// skips them).
+  int probe_rotations = 16;
 };
 
 /// Metrics of one level of the tree (normalized units).
@@ -31,6 +42,14 @@ struct LevelMetrics {
   /// lie outside the closed mesh (0 when none does). Worst and mean over the level.
   double worst_error_42 = 0, mean_error_42 = 0;
   double worst_error_162 = 0, mean_error_162 = 0;
+  /// The 42-probe error of each sphere averaged over
+  /// EvaluationOptions::probe_rotations uniformly random orientations of the
+  /// probes (one set per sphere, fixed seeds); worst and mean over the level.
+  /// A tree fitted against one fixed set of probe directions (as the
+  /// reference toolkit fits its spheres against its own 42 points) looks
+  /// better on those directions than on any other 42; these numbers belong
+  /// to no frame and are the 42-probe figures to compare trees by.
+  double worst_error_42_rotated = 0, mean_error_42_rotated = 0;
   double uncovered_area_fraction = 0;   ///< area of dense samples outside every sphere / total area
   long long num_dense_samples = 0;      ///< dense samples tested
   long long num_uncovered_samples = 0;  ///< dense samples outside every sphere of the level
@@ -72,5 +91,12 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
 /// The probe directions: vertices of the icosahedron subdivided `subdivisions`
 /// times (12, 42, 162, ... unit vectors).
 MatX3d probe_directions(int subdivisions);
+
+/// The frame in which probe_directions(s) are the sphere points of the
+/// reference Sphere Tree Construction Toolkit (Bradshaw 2003; its
+/// icosahedron has vertices (+-X, 0, +-Z), (0, +-Z, +-X), (+-Z, +-X, 0) with
+/// Z > X, subdivided the same way; its makeTreeMedial fits each sphere
+/// against 42 of them with `-testerLevels 2`): ours with x and z swapped.
+Eigen::Matrix3d toolkit_probe_frame();
 
 }  // namespace icd::mesh

@@ -3,8 +3,13 @@
 // cap cuts a disk out of each face), uncovered corners, child protrusion.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
+#include <utility>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include "collision/sphere_tree.hpp"
 #include "mesh/io/error.hpp"
@@ -167,6 +172,163 @@ TEST(Evaluation, RejectsBadOptionsAndTrees) {
   tree.spheres[1].r = std::nan("");
   EXPECT_THROW(evaluate_sphere_tree(cube, tree), icd::ParameterError);
   EXPECT_THROW(evaluate_sphere_tree(cube, icd::collision::SphereTree{}), icd::ParameterError);
+}
+
+/// Index of the row of `dirs` within `tol` of `d`, or -1.
+int find_direction(const icd::MatX3d& dirs, const Eigen::Vector3d& d, double tol) {
+  for (Eigen::Index k = 0; k < dirs.rows(); ++k)
+    if ((dirs.row(k).transpose() - d).norm() < tol) return static_cast<int>(k);
+  return -1;
+}
+
+TEST(Evaluation, ToolkitFrameGivesTheToolkitsFortyTwoPoints) {
+  // The reference toolkit's icosahedron, from its published constants, and
+  // its once-subdivided set: the vertices plus the normalized midpoints of
+  // the 30 edges (the pairs at the shortest distance).
+  const double X = .525731112119133606, Z = .850650808352039932;
+  std::vector<Eigen::Vector3d> points = {{-X, 0, Z}, {X, 0, Z},  {-X, 0, -Z}, {X, 0, -Z},
+                                         {0, Z, X},  {0, Z, -X}, {0, -Z, X},  {0, -Z, -X},
+                                         {Z, X, 0},  {-Z, X, 0}, {Z, -X, 0},  {-Z, -X, 0}};
+  const double edge = (points[0] - points[1]).norm();
+  int edges = 0;
+  for (int a = 0; a < 12; ++a) {
+    for (int b = a + 1; b < 12; ++b) {
+      if ((points[static_cast<size_t>(a)] - points[static_cast<size_t>(b)]).norm() > edge + 1e-9)
+        continue;
+      ++edges;
+      points.push_back(
+          (points[static_cast<size_t>(a)] + points[static_cast<size_t>(b)]).normalized());
+    }
+  }
+  ASSERT_EQ(edges, 30);
+  const icd::MatX3d toolkit = probe_directions(1) * toolkit_probe_frame().transpose();
+  std::vector<int> matched;
+  for (const auto& p : points) {
+    const int k = find_direction(toolkit, p, 1e-6);
+    EXPECT_GE(k, 0) << p.transpose();
+    matched.push_back(k);
+  }
+  std::sort(matched.begin(), matched.end());
+  EXPECT_EQ(std::unique(matched.begin(), matched.end()), matched.end());  // a bijection
+  // Our own frame is another one: it lacks the toolkit's first vertex.
+  EXPECT_LT(find_direction(probe_directions(1), points[0], 1e-3), 0);
+}
+
+/// The mesh and the tree mapped by x -> M x (faces flipped when det M < 0).
+std::pair<icd::SurfaceMesh, icd::collision::SphereTree> mapped(
+    const icd::SurfaceMesh& mesh, const icd::collision::SphereTree& tree,
+    const Eigen::Matrix3d& M) {
+  icd::SurfaceMesh m = mesh;
+  m.V = mesh.V * M.transpose();
+  if (M.determinant() < 0) m.F.col(1).swap(m.F.col(2));
+  icd::collision::SphereTree t = tree;
+  for (auto& s : t.spheres) {
+    const Eigen::Vector3d c = M * s.center();
+    s = {c.x(), c.y(), c.z(), s.r};
+  }
+  t.rest_spheres = t.spheres;
+  return {m, t};
+}
+
+TEST(Evaluation, ProbeFrameTurnsTheProbesAsTurningTheModelWould) {
+  // Probing in frame Q is probing the model turned by Q^T in our frame
+  // (errors compared in model units: turning changes the bounding box).
+  // A box turned off the axes: along an axis (a direction both frames
+  // contain) the probes would see the same largest distance.
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+  const auto box = mapped(icd::make_box_surface({-1, -0.6, -0.3}, {1, 0.6, 0.3}),
+                          two_level_tree(1, {0, 0, 0}, 1), turn)
+                       .first;
+  const auto tree = two_level_tree(1.25, {0.35, 0.2, 0.1}, 0.55);
+  std::mt19937 rng(0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const Eigen::Matrix3d random =
+      Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+          .normalized()
+          .toRotationMatrix();
+  for (const Eigen::Matrix3d& Q : {random, toolkit_probe_frame()}) {
+    EvaluationOptions in_frame;
+    in_frame.coverage_spacing = 50.0;
+    in_frame.shell_samples = 0;
+    in_frame.probe_rotations = 0;
+    in_frame.probe_frame = Q;
+    const auto a = evaluate_sphere_tree(box, tree, in_frame);
+    const auto [turned_box, turned_tree] = mapped(box, tree, Q.transpose());
+    EvaluationOptions ours = in_frame;
+    ours.probe_frame.setIdentity();
+    const auto b = evaluate_sphere_tree(turned_box, turned_tree, ours);
+    const auto side = [](const icd::SurfaceMesh& m) {
+      return (m.V.colwise().maxCoeff() - m.V.colwise().minCoeff()).maxCoeff();
+    };
+    const double to_model_a = side(box) / 2000.0, to_model_b = side(turned_box) / 2000.0;
+    for (size_t l = 0; l < 2; ++l) {
+      EXPECT_NEAR(a[l].worst_error_42 * to_model_a, b[l].worst_error_42 * to_model_b, 1e-9);
+      EXPECT_NEAR(a[l].mean_error_162 * to_model_a, b[l].mean_error_162 * to_model_b, 1e-9);
+    }
+    EXPECT_GT(a[1].worst_error_42, 0.0);
+  }
+  // The frame changes what the probes see on this model.
+  EvaluationOptions plain;
+  plain.coverage_spacing = 50.0;
+  plain.shell_samples = 0;
+  EvaluationOptions toolkit = plain;
+  toolkit.probe_frame = toolkit_probe_frame();
+  EXPECT_NE(evaluate_sphere_tree(box, tree, plain)[1].worst_error_42,
+            evaluate_sphere_tree(box, tree, toolkit)[1].worst_error_42);
+  EvaluationOptions bad = plain;
+  bad.probe_frame(0, 0) = 2.0;
+  EXPECT_THROW(evaluate_sphere_tree(box, tree, bad), icd::ParameterError);
+  bad = plain;
+  bad.probe_rotations = -1;
+  EXPECT_THROW(evaluate_sphere_tree(box, tree, bad), icd::ParameterError);
+}
+
+TEST(Evaluation, RotatedProbesAverageTheErrorOverOrientations) {
+  // Spheres of radius r, centres at depth h under the top face of a wide,
+  // deep slab: a probe c + r u sticks out by r u_z - h, so a sphere's error in
+  // a frame turned by R is r max_k (R u_k)_z - h, and over uniformly random
+  // R its mean is r E - h with E = mean over unit w of max_k u_k . w (the
+  // 42-point set's mean half-width), integrated here on a Fibonacci lattice.
+  const double r = 100, h = 50;
+  const auto slab = icd::make_box_surface({-1000, -1000, -500}, {1000, 1000, 0});  // side 2000
+  std::vector<icd::collision::Sphere> spheres;
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j < 7; ++j) spheres.push_back({-600.0 + 200 * i, -600.0 + 200 * j, -h, r});
+  auto tree = root_over(spheres);
+  tree.spheres[0] = {0, 0, -250, 1500};
+  tree.rest_spheres = tree.spheres;
+
+  const icd::MatX3d u = probe_directions(1);
+  const int lattice = 200000;
+  double E = 0;
+  for (int n = 0; n < lattice; ++n) {
+    const double z = 1.0 - (2.0 * n + 1.0) / lattice, rho = std::sqrt(1.0 - z * z);
+    const double phi = n * M_PI * (3.0 - std::sqrt(5.0));
+    const Eigen::Vector3d w(rho * std::cos(phi), rho * std::sin(phi), z);
+    E += (u * w).maxCoeff() / lattice;
+  }
+  ASSERT_GT(E, 0.95);
+  ASSERT_LT(E, 1.0);
+
+  EvaluationOptions options;
+  options.coverage_spacing = 100.0;
+  options.shell_samples = 0;
+  options.probe_rotations = 64;
+  const auto metrics = evaluate_sphere_tree(slab, tree, options);
+  const LevelMetrics& m = metrics[1];
+  // Our frame has a probe straight up (the midpoint of (0, 1, t) and (0, -1, t)).
+  EXPECT_NEAR(m.mean_error_42, r - h, 1e-6);
+  // 49 spheres x 64 orientations: the sampling spread of the mean is ~0.03.
+  EXPECT_NEAR(m.mean_error_42_rotated, r * E - h, 0.25);
+  EXPECT_LT(m.mean_error_42_rotated, m.mean_error_42 - 1.0);
+  EXPECT_GE(m.worst_error_42_rotated, m.mean_error_42_rotated);
+  EXPECT_LE(m.worst_error_42_rotated, r - h + 1e-9);
+  // Fixed seeds: the same numbers again.
+  EXPECT_EQ(evaluate_sphere_tree(slab, tree, options)[1].mean_error_42_rotated,
+            m.mean_error_42_rotated);
+  options.probe_rotations = 0;
+  EXPECT_EQ(evaluate_sphere_tree(slab, tree, options)[1].mean_error_42_rotated, 0.0);
 }
 
 }  // namespace

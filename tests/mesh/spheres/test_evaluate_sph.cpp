@@ -1,0 +1,133 @@
+// The evaluate_sph program on a tree written as the reference toolkit writes
+// it (trailing options and evaluation after the nodes): its rows for our
+// probe frame and the toolkit's against the closed-form distance to a cube,
+// and its refusals of bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "mesh/io/primitives.hpp"
+#include "mesh/io/surface_writer.hpp"
+#include "mesh/spheres/evaluation.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+#ifdef ICD_EVALUATE_SPH
+struct ProgramRun {
+  int status = -1;
+  std::string output;
+};
+
+ProgramRun run_program(const std::string& args, const fs::path& dir) {
+  const fs::path log = dir / "log.txt";
+  const std::string cmd =
+      std::string(ICD_EVALUATE_SPH) + " " + args + " > " + log.string() + " 2>&1";
+  const int raw = std::system(cmd.c_str());
+  ProgramRun r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.output = ss.str();
+  return r;
+}
+
+/// The table row (whitespace-separated fields) of `method` at `level`.
+std::vector<std::string> row(const std::string& output, const std::string& method, int level) {
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::vector<std::string> f;
+    for (std::string x; fields >> x;) f.push_back(x);
+    if (f.size() >= 10 && f[1] == method && f[2] == std::to_string(level)) return f;
+  }
+  return {};
+}
+
+/// The cube [-1, 1]^3 turned by `turn`, off the axes (along an axis, a
+/// direction both probe frames contain, they would see the same distance).
+const Eigen::Matrix3d kTurn =
+    Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+
+/// Largest distance from the probes c + r d (d: rows of dirs) to the turned
+/// cube, in normalized units (its bounding box's longest side is 2000).
+double turned_cube_error(const Eigen::Vector3d& c, double r, const icd::MatX3d& dirs, double side) {
+  double e = 0;
+  for (Eigen::Index k = 0; k < dirs.rows(); ++k) {
+    const Eigen::Vector3d p = kTurn.transpose() * (c + r * dirs.row(k).transpose());
+    e = std::max(e, (p.cwiseAbs().array() - 1.0).max(0.0).matrix().norm());
+  }
+  return e * 2000.0 / side;
+}
+#endif
+
+TEST(EvaluateSphProgram, EvaluatesAToolkitFileInBothFramesAndRefusesBadInput) {
+#ifndef ICD_EVALUATE_SPH
+  GTEST_SKIP() << "evaluate_sph is not built";
+#else
+  const fs::path dir =
+      fs::temp_directory_path() / ("icd_evaluate_sph_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  icd::SurfaceMesh cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
+  cube.V = cube.V * kTurn.transpose();
+  const double side = (cube.V.colwise().maxCoeff() - cube.V.colwise().minCoeff()).maxCoeff();
+  icd::write_off(dir / "cube.off", cube);
+  const Eigen::Vector3d child(0.3, 0.1, -0.2);
+  const double child_r = 1.05;
+  {
+    std::ofstream sph(dir / "cube-medial.sph");
+    sph << std::setprecision(17) << "2 2\n0 0 0 1.8 1\n"
+        << child.x() << " " << child.y() << " " << child.z() << " " << child_r << " 1\n"
+        << "0 0 0 -1 0\n\n\nOptions :\n\ttesterLevels\t: 2\n\tbranch\t: 2\n\n\n"
+        << "Level 0 : 1 spheres\n";
+  }
+  const std::string common = " --coverage-spacing 40 --shell-samples 0 --rotations 2 --dense 0";
+  const ProgramRun ok = run_program(
+      (dir / "cube.off").string() + " " + (dir / "cube-medial.sph").string() + common, dir);
+  ASSERT_EQ(ok.status, 0) << ok.output;
+  const icd::MatX3d ours = icd::mesh::probe_directions(1);
+  const icd::MatX3d toolkit = ours * icd::mesh::toolkit_probe_frame().transpose();
+  const double expected_ours = turned_cube_error(child, child_r, ours, side);
+  const double expected_toolkit = turned_cube_error(child, child_r, toolkit, side);
+  ASSERT_GT(std::abs(expected_ours - expected_toolkit), 1.0);  // the frames differ here
+  const auto a = row(ok.output, "ours", 1), b = row(ok.output, "toolkit", 1);
+  ASSERT_FALSE(a.empty()) << ok.output;
+  ASSERT_FALSE(b.empty()) << ok.output;
+  EXPECT_EQ(a[3], "1");                                // spheres
+  EXPECT_NEAR(std::stod(a[4]), expected_ours, 0.051);  // worst42, one decimal
+  EXPECT_NEAR(std::stod(b[4]), expected_toolkit, 0.051);
+  EXPECT_FALSE(row(ok.output, "ours", 0).empty());
+
+  // A NaN radius: status 1, the file and the node named.
+  {
+    std::ofstream sph(dir / "bad.sph");
+    sph << "1 2\n0 0 0 nan 1\n";
+  }
+  const ProgramRun bad =
+      run_program((dir / "cube.off").string() + " " + (dir / "bad.sph").string() + common, dir);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.output.find("bad.sph: line 2: node 0 has a non-finite value"), std::string::npos)
+      << bad.output;
+  // A missing argument: status 2 and the usage.
+  const ProgramRun usage = run_program((dir / "cube.off").string(), dir);
+  EXPECT_EQ(usage.status, 2);
+  EXPECT_NE(usage.output.find("TREE"), std::string::npos) << usage.output;
+  fs::remove_all(dir);
+#endif
+}
+
+}  // namespace
