@@ -7,23 +7,27 @@ import statistics
 import sys
 
 builds = []  # (E, {level: metrics})
+header = []  # the table's column names, from its header line (older logs have fewer)
+names = {"spheres": "leaves", "unc.pts": "uncovered"}
+kept = ["spheres", "worst42", "mean42", "worst42r", "mean42r", "worst162", "mean162", "unc.pts",
+        "redund", "mean42c", "mean162c", "shell"]
+counts = {"spheres", "unc.pts", "redund"}
 for line in open(sys.argv[1]):
     if line.startswith("## perturb"):
         builds.append((line.split()[2], {}, {}))
         continue
+    f = line.split()
+    if f[:3] == ["model", "method", "level"]:
+        header = f
+        continue
     if not builds:
         continue
     _, per_level, extra = builds[-1]
-    f = line.split()
-    if len(f) > 10 and f[1] == "medial":
-        per_level.setdefault(int(f[2]), {}).update(
-            leaves=int(f[3]), worst42=float(f[4]), mean42=float(f[5]), worst162=float(f[6]),
-            mean162=float(f[7]), uncovered=int(f[9]))
-        if len(f) > 16:
-            per_level[int(f[2])].update(redund=int(f[14]), mean42c=float(f[15]),
-                                        mean162c=float(f[16]))
-        if len(f) > 17:
-            per_level[int(f[2])].update(shell=float(f[17]))
+    if len(f) == len(header) and f[1] == "medial":
+        values = dict(zip(header, f))
+        per_level.setdefault(int(values["level"]), {}).update(
+            (names.get(c, c), (int if c in counts else float)(values[c]))
+            for c in kept if c in values)
     m = re.match(r"# \w+ level (\d+): error on 2562 directions: worst ([\d.]+) mean ([\d.]+)", line)
     if m and "fit42" not in line:
         per_level.setdefault(int(m.group(1)), {}).update(
@@ -46,6 +50,8 @@ for e, per_level, extra in builds:
 cols = ["leaves", "worst42", "mean42", "mean162", "mean2562", "worst2562", "uncovered", "cpu"]
 if any("redund" in r for r in rows):
     cols[3:3] = ["redund", "mean42c", "mean162c"]
+if any("mean42r" in r for r in rows):
+    cols.insert(cols.index("mean42") + 1, "mean42r")
 if any("shell" in r for r in rows):
     cols.insert(cols.index("mean2562") + 1, "shell")
 if any("wall" in extra for _, _, extra in builds):
