@@ -1,5 +1,5 @@
 // evaluate_sph MESH TREE.sph [--name NAME] [--coverage-spacing UNITS] [--shell-samples N]
-//              [--rotations N] [--dense 0|1]
+//              [--rotations N] [--dense 0|1] [--centred 0|1]
 //
 // Evaluates any sphere tree in the `.sph` format (ours, or one written by
 // another tool such as the reference Sphere Tree Construction Toolkit's
@@ -10,6 +10,9 @@
 // toolkit's (method "toolkit": the 42 points the toolkit fits its spheres
 // against with -testerLevels 2); the rotated 42-probe errors, the shell and
 // the 2562-direction errors belong to no frame (the same on both rows).
+// --centred 1: the tree's coordinates have the mesh's bounding-box centre at
+// the origin, as makeTreeMedial writes them (it centres and scales the model,
+// and undoes only the scale when saving).
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -28,7 +31,7 @@ int run(int argc, char** argv) {
   std::filesystem::path mesh_path, tree_path;
   std::string name = "tree";
   icd::mesh::EvaluationOptions evaluation;
-  bool dense = true;
+  bool dense = true, centred = false;
   icd::experiments::CommandLine cli(
       "evaluate_sph", "  Evaluates a .sph sphere tree against its surface mesh (issue 5 metrics).");
   cli.argument("MESH", mesh_path, "surface mesh (OFF, OBJ, PLY, STL) the tree was built for", true)
@@ -39,11 +42,19 @@ int run(int argc, char** argv) {
       .integer("--shell-samples", evaluation.shell_samples, "N", "shell points per sphere", 0)
       .integer("--rotations", evaluation.probe_rotations, "N",
                "random orientations of the 42 probes per sphere", 0)
-      .boolean("--dense", dense, "also the errors on 2562 directions");
+      .boolean("--dense", dense, "also the errors on 2562 directions")
+      .boolean("--centred", centred,
+               "the tree is centred on the mesh's bounding-box centre (makeTreeMedial's output)");
   if (const auto status = cli.parse(argc, argv)) return *status;
 
   const icd::SurfaceMesh mesh = icd::read_surface_mesh(mesh_path);
-  const icd::collision::SphereTree tree = icd::collision::read_sph(tree_path.string());
+  icd::collision::SphereTree tree = icd::collision::read_sph(tree_path.string());
+  if (centred) {
+    const Eigen::Vector3d centre =
+        0.5 * (mesh.V.colwise().minCoeff() + mesh.V.colwise().maxCoeff());
+    for (auto& s : tree.spheres) s.x += centre.x(), s.y += centre.y(), s.z += centre.z();
+    tree.rest_spheres = tree.spheres;
+  }
   std::printf("# %s: %s (%d nodes, %d levels) on %s (%lld vertices, %lld triangles)\n",
               name.c_str(), tree_path.string().c_str(), tree.num_nodes(), tree.num_levels(),
               mesh_path.string().c_str(), static_cast<long long>(mesh.V.rows()),

@@ -12,6 +12,7 @@
 #include <iomanip>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -82,22 +83,32 @@ TEST(EvaluateSphProgram, EvaluatesAToolkitFileInBothFramesAndRefusesBadInput) {
       fs::temp_directory_path() / ("icd_evaluate_sph_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
+  // The turned cube moved to `shift`, its bounding-box centre.
+  const Eigen::Vector3d shift(5, -3, 2);
   icd::SurfaceMesh cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
   cube.V = cube.V * kTurn.transpose();
+  cube.V.rowwise() += shift.transpose();
   const double side = (cube.V.colwise().maxCoeff() - cube.V.colwise().minCoeff()).maxCoeff();
   icd::write_off(dir / "cube.off", cube);
-  const Eigen::Vector3d child(0.3, 0.1, -0.2);
+  const Eigen::Vector3d child(0.3, 0.1, -0.2);  // relative to the cube's centre
   const double child_r = 1.05;
-  {
-    std::ofstream sph(dir / "cube-medial.sph");
-    sph << std::setprecision(17) << "2 2\n0 0 0 1.8 1\n"
-        << child.x() << " " << child.y() << " " << child.z() << " " << child_r << " 1\n"
+  // The tree in the mesh's coordinates (cube.sph), and centred on the
+  // bounding-box centre with the options and evaluation appended, as
+  // makeTreeMedial writes it (cube-medial.sph).
+  const std::vector<std::pair<std::string, Eigen::Vector3d> > files = {
+      {"cube.sph", shift}, {"cube-medial.sph", Eigen::Vector3d::Zero()}};
+  for (const auto& [file, origin] : files) {
+    const Eigen::Vector3d c = origin + child;
+    std::ofstream sph(dir / file);
+    sph << std::setprecision(17) << "2 2\n"
+        << origin.x() << " " << origin.y() << " " << origin.z() << " 1.8 1\n"
+        << c.x() << " " << c.y() << " " << c.z() << " " << child_r << " 1\n"
         << "0 0 0 -1 0\n\n\nOptions :\n\ttesterLevels\t: 2\n\tbranch\t: 2\n\n\n"
         << "Level 0 : 1 spheres\n";
   }
   const std::string common = " --coverage-spacing 40 --shell-samples 0 --rotations 2 --dense 0";
-  const ProgramRun ok = run_program(
-      (dir / "cube.off").string() + " " + (dir / "cube-medial.sph").string() + common, dir);
+  const std::string mesh_arg = (dir / "cube.off").string() + " ";
+  const ProgramRun ok = run_program(mesh_arg + (dir / "cube.sph").string() + common, dir);
   ASSERT_EQ(ok.status, 0) << ok.output;
   const icd::MatX3d ours = icd::mesh::probe_directions(1);
   const icd::MatX3d toolkit = ours * icd::mesh::toolkit_probe_frame().transpose();
@@ -111,6 +122,22 @@ TEST(EvaluateSphProgram, EvaluatesAToolkitFileInBothFramesAndRefusesBadInput) {
   EXPECT_NEAR(std::stod(a[4]), expected_ours, 0.051);  // worst42, one decimal
   EXPECT_NEAR(std::stod(b[4]), expected_toolkit, 0.051);
   EXPECT_FALSE(row(ok.output, "ours", 0).empty());
+
+  // The centred file with --centred 1: the same rows; without it, elsewhere.
+  const ProgramRun centred =
+      run_program(mesh_arg + (dir / "cube-medial.sph").string() + common + " --centred 1", dir);
+  ASSERT_EQ(centred.status, 0) << centred.output;
+  for (const char* method : {"ours", "toolkit"}) {
+    for (int level : {0, 1}) {
+      const auto expected = row(ok.output, method, level), got = row(centred.output, method, level);
+      ASSERT_EQ(got.size(), expected.size()) << centred.output;
+      for (size_t k = 4; k < got.size(); ++k) EXPECT_EQ(got[k], expected[k]) << method << " " << k;
+    }
+  }
+  const ProgramRun uncentred =
+      run_program(mesh_arg + (dir / "cube-medial.sph").string() + common, dir);
+  ASSERT_EQ(uncentred.status, 0) << uncentred.output;
+  EXPECT_NE(row(uncentred.output, "ours", 1).at(4), a[4]);
 
   // A NaN radius: status 1, the file and the node named.
   {
