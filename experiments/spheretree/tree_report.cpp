@@ -12,8 +12,9 @@ void print_level_table_header() {
   std::printf(
       "# errors in units where the longest bounding-box side is 2000; error = largest distance\n"
       "# from a probe outside the (hole-closed) mesh to the surface (42 or 162 probes in our\n"
-      "# frame; worst42r / mean42r: 42 probes averaged over 16 random orientations per sphere,\n"
-      "# which no tree can have been fitted to); coverage on a dense sampling (spacing 1 unit),\n"
+      "# frame; worst42r / mean42r: 42 probes averaged over random orientations, 16 per sphere\n"
+      "# unless said otherwise, which no tree can have been fitted to); coverage on a dense\n"
+      "# sampling (spacing 1 unit unless said otherwise),\n"
       "# gap = largest distance of an uncovered sample to a sphere; redund = spheres that cover\n"
       "# no vertex or dense sample alone (each removable alone without uncovering anything),\n"
       "# mean42c / mean162c = means over the other spheres; shell = volume of the level's union\n"
