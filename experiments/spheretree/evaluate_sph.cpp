@@ -55,10 +55,13 @@ int run(int argc, char** argv) {
     for (auto& s : tree.spheres) s.x += centre.x(), s.y += centre.y(), s.z += centre.z();
     tree.rest_spheres = tree.spheres;
   }
-  std::printf("# %s: %s (%d nodes, %d levels) on %s (%lld vertices, %lld triangles)\n",
-              name.c_str(), tree_path.string().c_str(), tree.num_nodes(), tree.num_levels(),
-              mesh_path.string().c_str(), static_cast<long long>(mesh.V.rows()),
-              static_cast<long long>(mesh.F.rows()));
+  std::printf(
+      "# %s: %s (%d nodes, %d levels) on %s (%lld vertices, %lld triangles); %d probe "
+      "orientations per sphere, coverage spacing %g, %d shell points per sphere\n",
+      name.c_str(), tree_path.string().c_str(), tree.num_nodes(), tree.num_levels(),
+      mesh_path.string().c_str(), static_cast<long long>(mesh.V.rows()),
+      static_cast<long long>(mesh.F.rows()), evaluation.probe_rotations,
+      evaluation.coverage_spacing, evaluation.shell_samples);
   icd::experiments::print_level_table_header();
   icd::experiments::print_level_table(name, "ours", 0.0,
                                       icd::mesh::evaluate_sphere_tree(mesh, tree, evaluation));
