@@ -10,7 +10,7 @@ builds = []  # (E, {level: metrics})
 header = []  # the table's column names, from its header line (older logs have fewer)
 names = {"spheres": "leaves", "unc.pts": "uncovered"}
 kept = ["spheres", "worst42", "mean42", "worst42r", "mean42r", "worst162", "mean162", "unc.pts",
-        "redund", "mean42c", "mean162c", "shell"]
+        "redund", "mean42c", "mean162c", "shell", "t50", "t90"]
 counts = {"spheres", "unc.pts", "redund"}
 for line in open(sys.argv[1]):
     if line.startswith("## perturb"):
@@ -54,6 +54,8 @@ if any("mean42r" in r for r in rows):
     cols.insert(cols.index("mean42") + 1, "mean42r")
 if any("shell" in r for r in rows):
     cols.insert(cols.index("mean2562") + 1, "shell")
+if any("t50" in r for r in rows):
+    cols[cols.index("shell") + 1:cols.index("shell") + 1] = ["t50", "t90"]
 if any("wall" in extra for _, _, extra in builds):
     cols.append("wall")
 print("E".ljust(8) + "".join(c.rjust(10) for c in cols))

@@ -18,12 +18,15 @@ void print_level_table_header() {
       "# gap = largest distance of an uncovered sample to a sphere; redund = spheres that cover\n"
       "# no vertex or dense sample alone (each removable alone without uncovering anything),\n"
       "# mean42c / mean162c = means over the other spheres; shell = volume of the level's union\n"
-      "# outside the object / surface area (the mean thickness of the shell it adds).\n");
+      "# outside the object / surface area (the mean thickness of the shell it adds); t50 / t90 =\n"
+      "# area-weighted median / 90th percentile over the surface of how far the spheres\n"
+      "# containing a point reach from it along the outward normal.\n");
   std::printf(
-      "%-7s %-7s %5s %7s %9s %8s %9s %8s %9s %8s %11s %8s %7s %6s %9s %8s %6s %8s %8s %7s\n",
+      "%-7s %-7s %5s %7s %9s %8s %9s %8s %9s %8s %11s %8s %7s %6s %9s %8s %6s %8s %8s %7s %7s "
+      "%7s\n",
       "model", "method", "level", "spheres", "worst42", "mean42", "worst42r", "mean42r", "worst162",
       "mean162", "uncovered", "unc.pts", "gap", "unc.v", "protrude", "build_s", "redund", "mean42c",
-      "mean162c", "shell");
+      "mean162c", "shell", "t50", "t90");
 }
 
 void print_level_table(const std::string& model, const std::string& method, double seconds,
@@ -31,12 +34,13 @@ void print_level_table(const std::string& model, const std::string& method, doub
   for (const auto& m : levels) {
     std::printf(
         "%-7s %-7s %5d %7d %9.1f %8.2f %9.1f %8.2f %9.1f %8.2f %10.5f%% %8lld %7.2f %6d %9.1f "
-        "%8.2f %6d %8.2f %8.2f %7.2f\n",
+        "%8.2f %6d %8.2f %8.2f %7.2f %7.2f %7.2f\n",
         model.c_str(), method.c_str(), m.level, m.num_spheres, m.worst_error_42, m.mean_error_42,
         m.worst_error_42_rotated, m.mean_error_42_rotated, m.worst_error_162, m.mean_error_162,
         100.0 * m.uncovered_area_fraction, m.num_uncovered_samples, m.max_uncovered_gap,
         m.num_uncovered_vertices, m.max_child_protrusion, seconds, m.num_redundant_spheres,
-        m.mean_error_42_covering, m.mean_error_162_covering, m.shell_thickness);
+        m.mean_error_42_covering, m.mean_error_162_covering, m.shell_thickness, m.thickness_median,
+        m.thickness_p90);
   }
 }
 

@@ -49,25 +49,43 @@ class SphereGrid {
     }
   }
 
+  /// Calls visit(i) for each sphere i that contains p, until it returns true.
+  template <class Visit>
+  void for_each_containing(const Eigen::Vector3d& p, Visit&& visit) const {
+    for (int i : m_big) {
+      if (inside(i, p) && visit(i)) return;
+    }
+    auto it = m_cells.find(key(cell(p)));
+    if (it == m_cells.end()) return;
+    for (int i : it->second) {
+      if (inside(i, p) && visit(i)) return;
+    }
+  }
+
   /// Number of spheres that contain p, counted up to `limit`; `found` (if
   /// not null) is set to the last one found (with a count of 1, the only one).
   int count_containing(const Eigen::Vector3d& p, int limit, int* found = nullptr) const {
     int count = 0;
-    auto visit = [&](int i) {
-      if (!inside(i, p)) return false;
+    for_each_containing(p, [&](int i) {
       if (found != nullptr) *found = i;
       return ++count >= limit;
-    };
-    for (int i : m_big) {
-      if (visit(i)) return count;
-    }
-    auto it = m_cells.find(key(cell(p)));
-    if (it != m_cells.end()) {
-      for (int i : it->second) {
-        if (visit(i)) return count;
-      }
-    }
+    });
     return count;
+  }
+
+  /// How far along the unit direction n the spheres containing p reach from
+  /// p (0 when none does).
+  double reach_along(const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
+    double reach = 0;
+    for_each_containing(p, [&](int i) {
+      const auto& s = m_spheres[static_cast<size_t>(i)];
+      const Eigen::Vector3d d = s.center() - p;
+      const double along = d.dot(n);
+      reach = std::max(
+          reach, along + std::sqrt(std::max(0.0, s.r * s.r - d.squaredNorm() + along * along)));
+      return false;
+    });
+    return reach;
   }
 
   /// Distance from p to the nearest sphere (<= 0 when covered); brute force.
@@ -226,13 +244,19 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     }
   }
 
-  // Dense coverage, streamed triangle by triangle (no sample storage).
+  // Dense coverage, streamed triangle by triangle (no sample storage), and
+  // the area-weighted histogram of each level's reach along the normal.
   std::vector<double> uncovered_area(static_cast<size_t>(num_levels), 0.0);
+  constexpr double kThicknessBin = 0.5;  // normalized units
+  constexpr int kThicknessBins = 16000;  // the last bin takes everything beyond
+  std::vector<std::vector<double>> thickness(static_cast<size_t>(num_levels),
+                                             std::vector<double>(kThicknessBins, 0.0));
   double total_area = 0;
   for (Eigen::Index f = 0; f < scaled.F.rows(); ++f) {
     const Eigen::Vector3d a = scaled.V.row(scaled.F(f, 0)), b = scaled.V.row(scaled.F(f, 1)),
                           c = scaled.V.row(scaled.F(f, 2));
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
     const int n = std::max(1, static_cast<int>(std::ceil(longest / options.coverage_spacing)));
     const double sub_area = 0.5 * (b - a).cross(c - a).norm() / (static_cast<double>(n) * n);
     total_area += sub_area * n * n;
@@ -248,7 +272,12 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
         for (int l = 0; l < num_levels; ++l) {
           LevelMetrics& m = out[static_cast<size_t>(l)];
           ++m.num_dense_samples;
-          if (note_coverage(l, p)) continue;
+          const bool covered = note_coverage(l, p);
+          const double reach = covered ? grids[static_cast<size_t>(l)].reach_along(p, normal) : 0.0;
+          const int bin =
+              std::min(kThicknessBins - 1, static_cast<int>(std::floor(reach / kThicknessBin)));
+          thickness[static_cast<size_t>(l)][static_cast<size_t>(bin)] += weight;
+          if (covered) continue;
           ++m.num_uncovered_samples;
           uncovered_area[static_cast<size_t>(l)] += weight;
           m.max_uncovered_gap = std::max(m.max_uncovered_gap, grids[static_cast<size_t>(l)].gap(p));
@@ -290,6 +319,20 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     LevelMetrics& m = out[static_cast<size_t>(l)];
     m.uncovered_area_fraction =
         total_area > 0 ? uncovered_area[static_cast<size_t>(l)] / total_area : 0.0;
+    // Area-weighted quantiles of the reach (bin centres).
+    const auto& hist = thickness[static_cast<size_t>(l)];
+    auto quantile = [&](double q) {
+      double cumulative = 0;
+      for (int bin = 0; bin < kThicknessBins; ++bin) {
+        cumulative += hist[static_cast<size_t>(bin)];
+        if (cumulative >= q * total_area) return (bin + 0.5) * kThicknessBin;
+      }
+      return (kThicknessBins - 0.5) * kThicknessBin;
+    };
+    if (total_area > 0) {
+      m.thickness_median = quantile(0.5);
+      m.thickness_p90 = quantile(0.9);
+    }
     int covering = 0;
     for (int i = 0; i < m.num_spheres; ++i) {
       if (!alone[static_cast<size_t>(l)][static_cast<size_t>(i)]) continue;

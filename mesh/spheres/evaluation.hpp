@@ -73,6 +73,13 @@ struct LevelMetrics {
   /// depth (EvaluationOptions::shell_samples points, fixed seed), each point
   /// weighted by one over the number of spheres that contain it.
   double shell_thickness = 0;
+  /// Over the surface (the dense samples, weighted by area): how far the
+  /// level's spheres that contain a point reach from it along the outward
+  /// normal of its triangle (0 for an uncovered point); the area-weighted
+  /// median and 90th percentile (normalized units, to 0.25). What a contact
+  /// at a typical point sees: the level reports it that far before the
+  /// surfaces touch.
+  double thickness_median = 0, thickness_p90 = 0;
   /// How far the level's spheres stick out of their parents (max over nodes
   /// of |c - c_parent| + r - r_parent, >= 0; 0 for the root).
   double max_child_protrusion = 0;

@@ -331,4 +331,38 @@ TEST(Evaluation, RotatedProbesAverageTheErrorOverOrientations) {
   EXPECT_EQ(evaluate_sphere_tree(slab, tree, options)[1].mean_error_42_rotated, 0.0);
 }
 
+TEST(Evaluation, ThicknessQuantilesMatchTheCapOverACubeFace) {
+  // A sphere of radius R about the centre of the cube [-1, 1]^3: from the
+  // point (x, y, 1) of a face it reaches sqrt(R^2 - x^2 - y^2) - 1 along the
+  // normal, where covered (x^2 + y^2 <= R^2 - 1), else the point counts 0.
+  // The area-weighted quantiles over the surface are those over one face,
+  // taken here on a fine grid of the square (normalized units: x 1000).
+  const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
+  for (const double R : {2.0, 1.2}) {
+    std::vector<double> reach;
+    const int n = 1000;
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const double x = -1 + (2.0 * i + 1) / n, y = -1 + (2.0 * j + 1) / n;
+        const double left = R * R - x * x - y * y;
+        reach.push_back(left >= 1.0 ? 1000.0 * (std::sqrt(left) - 1.0) : 0.0);
+      }
+    }
+    std::sort(reach.begin(), reach.end());
+    const double median = reach[reach.size() / 2], p90 = reach[reach.size() * 9 / 10];
+    EvaluationOptions options;
+    options.coverage_spacing = 4.0;
+    options.shell_samples = 0;
+    options.probe_rotations = 0;
+    const auto m = evaluate_sphere_tree(cube, two_level_tree(R, {0, 0, 0}, R), options);
+    SCOPED_TRACE("R = " + std::to_string(R));
+    EXPECT_NEAR(m[1].thickness_median, median, 0.5);
+    EXPECT_NEAR(m[1].thickness_p90, p90, 0.5);
+    if (R < 1.5) {
+      EXPECT_EQ(median, 0.0);  // most of each face is uncovered
+      EXPECT_GT(p90, 100.0);
+    }
+  }
+}
+
 }  // namespace
