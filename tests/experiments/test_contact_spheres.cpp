@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
+#include <string>
 
 #include "collision/sphere_tree.hpp"
 #include "experiments/runner/run.hpp"
@@ -43,8 +46,17 @@ int find_node(const collision::SphereTree& tree, const Eigen::Vector3d& c, doubl
 // small test budget, was interrupted with pairs left untested.
 void expect_written_pairs_overlap(const std::string& collision, bool expect_untested) {
   World world(head_on_scene(collision), "", "");
-  const fs::path dir = fs::path(::testing::TempDir()) / "icd_contact_spheres";
+  // One folder per test and process: CTest runs these tests side by side.
+  const fs::path dir =
+      fs::path(::testing::TempDir()) /
+      ("icd_contact_spheres_" +
+       std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+       std::to_string(::getpid()));
   fs::create_directories(dir);
+  struct RemoveOnExit {
+    fs::path dir;
+    ~RemoveOnExit() { fs::remove_all(dir); }
+  } cleanup{dir};
   for (int f = 0; f < 30; ++f) {
     world.step();
     const collision::CollisionResult& r = world.results()[0];
