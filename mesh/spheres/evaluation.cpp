@@ -256,9 +256,10 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     const Eigen::Vector3d a = scaled.V.row(scaled.F(f, 0)), b = scaled.V.row(scaled.F(f, 1)),
                           c = scaled.V.row(scaled.F(f, 2));
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-    const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const Eigen::Vector3d normal = cross.normalized();
     const int n = std::max(1, static_cast<int>(std::ceil(longest / options.coverage_spacing)));
-    const double sub_area = 0.5 * (b - a).cross(c - a).norm() / (static_cast<double>(n) * n);
+    const double sub_area = 0.5 * cross.norm() / (static_cast<double>(n) * n);
     total_area += sub_area * n * n;
     for (int j = 0; j <= n; ++j) {
       for (int i = 0; i + j <= n; ++i) {
