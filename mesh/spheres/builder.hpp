@@ -124,9 +124,9 @@ struct SphereTreeOptions {
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.
   /// With worst_share 1 and leaf_worst_target = leaf_worst_factor = 0 it
-  /// gives the thinnest leaf shell measured for a tree (7 perturbed dragon
-  /// builds, medians: union volume outside per area 33 -> 23.4, below the
-  /// reference toolkit's 24.1; median reach beyond the surface 41 -> 23;
+  /// gives a leaf shell thinner than the reference toolkit's (7 perturbed
+  /// dragon builds, medians: union volume outside per area 33 -> 23.4, the
+  /// toolkit's 24.1; median reach beyond the surface 41 -> 23;
   /// worst42 <= 80 in 7 of 7) at a higher per-sphere mean (mean42 16.9 ->
   /// 19.5) and a thicker level 2; on the bunny it lowers both. Off because
   /// the default is tuned for the per-sphere mean (experiments/spheretree/
