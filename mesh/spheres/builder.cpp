@@ -116,14 +116,64 @@ bool ancestors_cover(const ReductionProblem& dense, const std::vector<std::vecto
   return true;
 }
 
+/// True when the children of every inner node divide its coverage samples:
+/// each sample of a node is a member of exactly one of its children, and the
+/// children hold no other sample (the invariant the later steps rely on).
+bool children_divide_samples(const std::vector<std::vector<Node>>& levels,
+                             const std::vector<std::vector<int>>& parent_of) {
+  for (size_t l = 1; l < levels.size(); ++l) {
+    std::vector<std::vector<int>> unions(levels[l - 1].size());
+    for (size_t i = 0; i < levels[l].size(); ++i) {
+      const auto& m = levels[l][i].sphere.members;
+      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
+      u.insert(u.end(), m.begin(), m.end());
+    }
+    for (size_t p = 0; p < unions.size(); ++p) {
+      std::sort(unions[p].begin(), unions[p].end());
+      std::vector<int> own = levels[l - 1][p].sphere.members;
+      std::sort(own.begin(), own.end());
+      if (unions[p] != own) return false;  // a duplicate, a missing or a foreign sample
+    }
+  }
+  return true;
+}
+
+/// Removes the nodes of level `l` whose `keep` entry is 0 (they must have no
+/// children), keeping the order of the others, and renumbers the parent
+/// indices of level l + 1.
+void remove_nodes(std::vector<std::vector<Node>>& levels, std::vector<std::vector<int>>& parent_of,
+                  size_t l, const std::vector<char>& keep) {
+  assert(keep.size() == levels[l].size());
+  if (std::all_of(keep.begin(), keep.end(), [](char k) { return k != 0; })) return;
+  std::vector<int> renumber(keep.size(), -1);
+  std::vector<Node> nodes;
+  std::vector<int> parents;
+  for (size_t i = 0; i < keep.size(); ++i) {
+    if (!keep[i]) continue;
+    renumber[i] = static_cast<int>(nodes.size());
+    nodes.push_back(std::move(levels[l][i]));
+    if (l >= 1) parents.push_back(parent_of[l][i]);
+  }
+  levels[l] = std::move(nodes);
+  if (l >= 1) parent_of[l] = std::move(parents);
+  if (l + 1 < levels.size()) {
+    for (int& p : parent_of[l + 1]) {
+      assert(renumber[static_cast<size_t>(p)] >= 0 && "a removed node had children");
+      p = renumber[static_cast<size_t>(p)];
+    }
+  }
+}
+
 /// Jointly re-optimises the leaf level across sibling groups (a leaf may take
 /// samples from a neighbour of its parent), then restores the wrapped-tree
 /// invariant bottom-up: each inner node's samples become the union of its
-/// children's, and its sphere is re-centred and refitted to cover them.
+/// children's, and its sphere is re-centred and refitted to cover them. A
+/// leaf left without samples is removed (an inner node left without children
+/// too), so that the children still divide their parent's samples.
 void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense,
                    const MeshOracle& oracle, const SurfaceSamples& dense_samples, const MatX3i& F,
                    const ReductionOptions& reduction, std::vector<std::vector<Node>>& levels,
-                   const std::vector<std::vector<int>>& parent_of) {
+                   std::vector<std::vector<int>>& parent_of) {
   std::vector<Node>& leaves = levels.back();
   std::vector<FittedSphere> spheres;
   for (size_t i = 0; i < leaves.size(); ++i) {
@@ -132,6 +182,8 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
     spheres.push_back(std::move(s));
   }
   refine_jointly(coarse, spheres, reduction);
+  std::vector<std::vector<int>> medial(spheres.size());  // the new medial members
+  for (size_t j = 0; j < spheres.size(); ++j) medial[j] = spheres[j].members;
 
   // Dense samples go to the best sphere among their current leaf and the
   // owners of the coarse samples at their triangle's corners (the first #V
@@ -174,19 +226,26 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
     if (!sp.members.empty()) polish_sphere(dense, oracle, sp);
   }
   reassign();
+  // Every dense sample now has exactly one leaf. A leaf left with none is
+  // dropped (its slot is free for split_worst_leaves), so that the leaves
+  // still divide the samples.
+  std::vector<char> keep(leaves.size(), 1);
   for (size_t i = 0; i < leaves.size(); ++i) {
     FittedSphere& sp = spheres[i];
-    if (sp.members
-            .empty()) {  // lost everything: keep the old leaf (still valid, covers its old share)
+    if (sp.members.empty()) {
+      keep[i] = 0;
       continue;
     }
     double r = 0;
     for (int m : sp.members) r = std::max(r, dense.reach(m, sp));
     sp.radius = r;
     sp.error = r - sp.depth;
-    leaves[i].sphere = sp;
+    leaves[i].sphere = std::move(sp);
+    if (!medial[i].empty()) leaves[i].medial = std::move(medial[i]);  // else keep it placeable
   }
-  // Bottom-up: inner nodes cover the union of their children's samples.
+  remove_nodes(levels, parent_of, levels.size() - 1, keep);
+  // Bottom-up: inner nodes cover the union of their children's samples; one
+  // whose children were all dropped is dropped too.
   for (size_t l = levels.size() - 1; l >= 1; --l) {
     std::vector<Node>& parents = levels[l - 1];
     std::vector<std::vector<int>> unions(parents.size());
@@ -195,12 +254,17 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
       auto& u = unions[static_cast<size_t>(parent_of[l][i])];
       u.insert(u.end(), m.begin(), m.end());
     }
+    std::vector<char> kept(parents.size(), 1);
     for (size_t p = 0; p < parents.size(); ++p) {
       std::sort(unions[p].begin(), unions[p].end());
-      unions[p].erase(std::unique(unions[p].begin(), unions[p].end()), unions[p].end());
+      if (unions[p].empty()) {
+        kept[p] = 0;
+        continue;
+      }
       parents[p].sphere.members = std::move(unions[p]);
       polish_sphere(dense, oracle, parents[p].sphere);
     }
+    remove_nodes(levels, parent_of, l - 1, kept);
   }
 }
 
@@ -834,6 +898,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   }
   if (options.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
+    assert(children_divide_samples(levels, parent_of));
   }
   if (options.leaf_exchange && levels.size() > 1)
     exchange_across_leaves(dense, oracles, levels, parent_of, 3, options.relieve_moves);
@@ -897,6 +962,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     end_step("regroup");
   }
 
+  assert(children_divide_samples(levels, parent_of));
   // Flatten breadth-first: level by level, children of a node contiguous.
   collision::SphereTree& tree = out.tree;
   int offset = 0;

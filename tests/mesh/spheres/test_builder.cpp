@@ -87,13 +87,19 @@ icd::MatX3d dense_random_points(const icd::SurfaceMesh& m, int count, unsigned s
   return P;
 }
 
-/// Every node of `build` covers its samples with their margins, and the
-/// children of every inner node divide its samples among them (none empty),
-/// so each node covers the union of its children's patches.
+/// Every node of `build` covers its samples with their margins, the root
+/// holds every sample once, and the children of every inner node divide its
+/// samples among them (none empty, no sample in two children), so each node
+/// covers the union of its children's patches.
 void expect_nodes_cover_and_children_divide(const SphereTreeBuild& build) {
   const auto& tree = build.tree;
   const auto& P = build.samples.points;
   ASSERT_EQ(static_cast<int>(build.node_samples.size()), tree.num_nodes());
+  std::vector<int> all(static_cast<size_t>(P.rows()));
+  std::iota(all.begin(), all.end(), 0);
+  std::vector<int> root = build.node_samples[0];
+  std::sort(root.begin(), root.end());
+  EXPECT_EQ(root, all) << "the root must hold every sample exactly once";
   for (int i = 0; i < tree.num_nodes(); ++i) {
     const auto& s = tree.spheres[i];
     for (int m : build.node_samples[i]) {
@@ -206,20 +212,31 @@ TEST(SphereTreeBuilder, ErrorDecreasesFromLevelToLevel) {
     }
 }
 
+SphereTreeOptions lossy_leaf_options();
+
 TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
-  // The joint option moves leaves across parents and refits the inner nodes
-  // bottom-up: every node must still cover its samples with margin, children
-  // divide their parent's samples, and every level covers a dense sampling.
-  const Case torus = cases()[2];
-  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
-  o.joint_leaf_refinement = true;
-  const SphereTreeBuild build = build_sphere_tree(torus.mesh, o);
-  const auto& tree = build.tree;
-  EXPECT_NO_THROW(icd::collision::validate(tree));
-  expect_nodes_cover_and_children_divide(build);
-  const icd::MatX3d D = dense_random_points(torus.mesh, 5000, 11);
-  for (int l = 0; l < tree.num_levels(); ++l)
-    EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+  // The joint option moves leaves across parents (a leaf may lose all its
+  // samples and is then removed) and refits the inner nodes bottom-up: every
+  // node must still cover its samples with margin, children divide their
+  // parent's samples, and every level covers a dense sampling. Every small
+  // case, with the small options and with coarse medial samples under
+  // branching 8 (leaves of very different sizes).
+  for (const Case& c : cases()) {
+    for (int variant = 0; variant < 2; ++variant) {
+      SCOPED_TRACE(c.name + (variant == 0 ? " small options" : " lossy options"));
+      SphereTreeOptions o =
+          variant == 0 ? small_options(ReductionMethod::split_lloyd) : lossy_leaf_options();
+      o.joint_leaf_refinement = true;
+      const SphereTreeBuild build = build_sphere_tree(c.mesh, o);
+      const auto& tree = build.tree;
+      EXPECT_NO_THROW(icd::collision::validate(tree));
+      for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+      expect_nodes_cover_and_children_divide(build);
+      const icd::MatX3d D = dense_random_points(c.mesh, 5000, 11);
+      for (int l = 0; l < tree.num_levels(); ++l)
+        EXPECT_EQ(uncovered_on_level(tree, l, D), 0) << "level " << l;
+    }
+  }
 }
 
 /// Options of the leaf-budget tests: the icosphere's coarse medial samples
