@@ -116,20 +116,30 @@ bool ancestors_cover(const ReductionProblem& dense, const std::vector<std::vecto
   return true;
 }
 
+/// For each node of level l - 1 (l >= 1): the members of its children on
+/// level l, joined and sorted (duplicates kept: children_divide_samples
+/// looks for them).
+std::vector<std::vector<int>> children_members(const std::vector<std::vector<Node>>& levels,
+                                               const std::vector<std::vector<int>>& parent_of,
+                                               size_t l) {
+  std::vector<std::vector<int>> unions(levels[l - 1].size());
+  for (size_t i = 0; i < levels[l].size(); ++i) {
+    const auto& m = levels[l][i].sphere.members;
+    auto& u = unions[static_cast<size_t>(parent_of[l][i])];
+    u.insert(u.end(), m.begin(), m.end());
+  }
+  for (auto& u : unions) std::sort(u.begin(), u.end());
+  return unions;
+}
+
 /// True when the children of every inner node divide its coverage samples:
 /// each sample of a node is a member of exactly one of its children, and the
 /// children hold no other sample (the invariant the later steps rely on).
 bool children_divide_samples(const std::vector<std::vector<Node>>& levels,
                              const std::vector<std::vector<int>>& parent_of) {
   for (size_t l = 1; l < levels.size(); ++l) {
-    std::vector<std::vector<int>> unions(levels[l - 1].size());
-    for (size_t i = 0; i < levels[l].size(); ++i) {
-      const auto& m = levels[l][i].sphere.members;
-      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
-      u.insert(u.end(), m.begin(), m.end());
-    }
+    const std::vector<std::vector<int>> unions = children_members(levels, parent_of, l);
     for (size_t p = 0; p < unions.size(); ++p) {
-      std::sort(unions[p].begin(), unions[p].end());
       std::vector<int> own = levels[l - 1][p].sphere.members;
       std::sort(own.begin(), own.end());
       if (unions[p] != own) return false;  // a duplicate, a missing or a foreign sample
@@ -248,15 +258,9 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
   // whose children were all dropped is dropped too.
   for (size_t l = levels.size() - 1; l >= 1; --l) {
     std::vector<Node>& parents = levels[l - 1];
-    std::vector<std::vector<int>> unions(parents.size());
-    for (size_t i = 0; i < levels[l].size(); ++i) {
-      const auto& m = levels[l][i].sphere.members;
-      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
-      u.insert(u.end(), m.begin(), m.end());
-    }
+    std::vector<std::vector<int>> unions = children_members(levels, parent_of, l);
     std::vector<char> kept(parents.size(), 1);
     for (size_t p = 0; p < parents.size(); ++p) {
-      std::sort(unions[p].begin(), unions[p].end());
       if (unions[p].empty()) {
         kept[p] = 0;
         continue;
@@ -275,15 +279,9 @@ void refine_leaves(const ReductionProblem& coarse, const ReductionProblem& dense
 void refit_inner_nodes(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
                        const std::vector<std::vector<int>>& parent_of) {
   for (size_t l = levels.size() - 1; l >= 1; --l) {
-    std::vector<std::vector<int>> unions(levels[l - 1].size());
-    for (size_t i = 0; i < levels[l].size(); ++i) {
-      const auto& m = levels[l][i].sphere.members;
-      auto& u = unions[static_cast<size_t>(parent_of[l][i])];
-      u.insert(u.end(), m.begin(), m.end());
-    }
+    std::vector<std::vector<int>> unions = children_members(levels, parent_of, l);
     for (size_t p = 0; p < unions.size(); ++p) {
       FittedSphere& sp = levels[l - 1][p].sphere;
-      std::sort(unions[p].begin(), unions[p].end());
       sp.members = std::move(unions[p]);
       double r = 0;
       for (int s : sp.members) r = std::max(r, dense.reach(s, sp));
