@@ -30,7 +30,6 @@
 #include <Eigen/Geometry>
 
 #include "collision/aabb_tree.hpp"
-#include "collision/sph_io.hpp"
 #include "collision/traversal.hpp"
 #include "experiments/common/command_line.hpp"
 #include "experiments/spheretree/tree_report.hpp"
@@ -101,7 +100,8 @@ struct Counts {
 
 int run(int argc, char** argv) {
   std::filesystem::path mesh_path;
-  std::string trees_arg, gaps_arg = "0.5,1,2,4,8,16,32,64";
+  std::string trees_arg;
+  std::vector<double> gaps = {0.5, 1, 2, 4, 8, 16, 32, 64};
   int poses = 100;
   unsigned seed = 1;
   double step = 0.5;
@@ -113,19 +113,22 @@ int run(int argc, char** argv) {
   cli.text("--trees", trees_arg, "NAME=TREE.sph[:centred],...", "the trees to compare (required)")
       .integer("--poses", poses, "N", "random approach poses", 1)
       .integer("--seed", seed, "S", "seed of the poses")
-      .text("--gaps", gaps_arg, "G,...", "gaps past the touching pose (normalized units, > 0)")
+      .custom("--gaps", "G,...", "gaps past the touching pose (normalized units, > 0)",
+              [&](const std::string& v) {
+                gaps.clear();
+                for (const std::string& g : split(v, ',')) {
+                  gaps.push_back(icd::experiments::CommandLine::parse_real(g, 0.0));
+                  if (!(gaps.back() > 0)) throw std::invalid_argument("must be > 0, got " + g);
+                }
+                if (gaps.empty()) throw std::invalid_argument("needs at least one gap");
+              })
       .real("--step", step, "UNITS", "marching step towards the touching pose (normalized units)");
   if (const auto status = cli.parse(argc, argv)) return *status;
   if (!(step > 0)) throw std::invalid_argument("--step must be > 0");
 
   const icd::SurfaceMesh mesh = icd::read_surface_mesh(mesh_path);
   const double to_2000 = icd::experiments::to_normalized_units(mesh);
-  const Eigen::Vector3d centre = 0.5 * (mesh.V.colwise().minCoeff() + mesh.V.colwise().maxCoeff());
-  std::vector<double> gaps;
-  for (const std::string& g : split(gaps_arg, ',')) {
-    gaps.push_back(std::stod(g));
-    if (!(gaps.back() > 0)) throw std::invalid_argument("--gaps: every gap must be > 0, got " + g);
-  }
+  const Eigen::Vector3d centre = icd::experiments::bounding_box_centre(mesh);
   std::vector<NamedTree> trees;
   for (const std::string& item : split(trees_arg, ',')) {
     const auto eq = item.find('=');
@@ -135,12 +138,7 @@ int run(int argc, char** argv) {
     bool centred = false;
     if (path.size() > 8 && path.substr(path.size() - 8) == ":centred")
       centred = true, path.resize(path.size() - 8);
-    NamedTree t{item.substr(0, eq), icd::collision::read_sph(path)};
-    if (centred) {
-      for (auto& s : t.tree.spheres) s.x += centre.x(), s.y += centre.y(), s.z += centre.z();
-      t.tree.rest_spheres = t.tree.spheres;
-    }
-    trees.push_back(std::move(t));
+    trees.push_back({item.substr(0, eq), icd::experiments::read_sph_for_mesh(path, mesh, centred)});
   }
   if (trees.empty()) throw std::invalid_argument("--trees: at least one tree is needed");
 

@@ -19,7 +19,6 @@
 #include <iostream>
 #include <string>
 
-#include "collision/sph_io.hpp"
 #include "experiments/common/command_line.hpp"
 #include "experiments/spheretree/tree_report.hpp"
 #include "mesh/io/surface_reader.hpp"
@@ -48,13 +47,8 @@ int run(int argc, char** argv) {
   if (const auto status = cli.parse(argc, argv)) return *status;
 
   const icd::SurfaceMesh mesh = icd::read_surface_mesh(mesh_path);
-  icd::collision::SphereTree tree = icd::collision::read_sph(tree_path.string());
-  if (centred) {
-    const Eigen::Vector3d centre =
-        0.5 * (mesh.V.colwise().minCoeff() + mesh.V.colwise().maxCoeff());
-    for (auto& s : tree.spheres) s.x += centre.x(), s.y += centre.y(), s.z += centre.z();
-    tree.rest_spheres = tree.spheres;
-  }
+  const icd::collision::SphereTree tree =
+      icd::experiments::read_sph_for_mesh(tree_path.string(), mesh, centred);
   std::printf(
       "# %s: %s (%d nodes, %d levels) on %s (%lld vertices, %lld triangles); %d probe "
       "orientations per sphere, coverage spacing %g, %d shell points per sphere\n",

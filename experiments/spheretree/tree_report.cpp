@@ -66,4 +66,19 @@ double to_normalized_units(const SurfaceMesh& mesh) {
   return 2000.0 / (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
 }
 
+Eigen::Vector3d bounding_box_centre(const SurfaceMesh& mesh) {
+  return 0.5 * (mesh.V.colwise().minCoeff() + mesh.V.colwise().maxCoeff()).transpose();
+}
+
+collision::SphereTree read_sph_for_mesh(const std::string& path, const SurfaceMesh& mesh,
+                                        bool centred) {
+  collision::SphereTree tree = collision::read_sph(path);
+  if (centred) {
+    const Eigen::Vector3d centre = bounding_box_centre(mesh);
+    for (auto& s : tree.spheres) s.x += centre.x(), s.y += centre.y(), s.z += centre.z();
+    tree.rest_spheres = tree.spheres;
+  }
+  return tree;
+}
+
 }  // namespace icd::experiments

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "collision/sph_io.hpp"
 #include "collision/sphere_tree.hpp"
 #include "mesh/io/types.hpp"
 #include "mesh/spheres/evaluation.hpp"
@@ -26,5 +27,14 @@ void print_dense_errors(const std::string& label, const SurfaceMesh& mesh,
 
 /// Factor from model units to the table's (longest bounding-box side 2000).
 double to_normalized_units(const SurfaceMesh& mesh);
+
+/// Centre of the axis-aligned bounding box of `mesh`'s vertices.
+Eigen::Vector3d bounding_box_centre(const SurfaceMesh& mesh);
+
+/// Reads a `.sph` tree into `mesh`'s coordinates: with `centred`, its
+/// coordinates have the mesh's bounding-box centre at the origin (as
+/// makeTreeMedial writes them) and are moved back. Throws what read_sph throws.
+collision::SphereTree read_sph_for_mesh(const std::string& path, const SurfaceMesh& mesh,
+                                        bool centred);
 
 }  // namespace icd::experiments
