@@ -1,5 +1,5 @@
 // sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
-//                   [--cover-spacing REL] [--joint 0|1] [--lloyd N] [--octree 0|1]
+//                   [--cover-spacing REL] [--joint 0|1] [--regroup 0|1] [--lloyd N] [--octree 0|1]
 //                   [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]
 //                   [--coverage-spacing UNITS] [--shell-samples N]  (evaluation)
 //                   [--reduction split|merge|both]
@@ -175,6 +175,7 @@ int run(int argc, char** argv) {
       .real("--medial-spacing", options.medial_spacing, "REL", "medial sample spacing")
       .real("--cover-spacing", options.cover_spacing, "REL", "coverage sample spacing")
       .boolean("--joint", options.joint_leaf_refinement, "joint leaf refinement")
+      .boolean("--regroup", options.regroup_parents, "choose the parents anew at the end")
       .integer("--lloyd", options.lloyd_iterations, "N", "Lloyd rounds of the reduction")
       .boolean("--octree", with_octree, "also the octree baseline")
       .real("--worst-share", options.worst_share, "F", "allocation: worst share")

@@ -530,7 +530,8 @@ constexpr int kRegroupRounds = 3;
 constexpr int kRegroupDirections = 256;
 
 /// Gives every node at most `branching` children, levels from the leaves
-/// up: the children of a level keep their spheres, their parents are chosen
+/// up: the children of a level keep their spheres; where a parent has too
+/// many children, or with `improve` on every level, their parents are chosen
 /// anew (regroup_children, with the radius each parent needs about its
 /// centre to cover a child's support points), and every node of the level
 /// above whose samples changed gets the union of its children's samples and
@@ -542,7 +543,7 @@ constexpr int kRegroupDirections = 256;
 /// keeps to it). Returns the number of parent changes.
 int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOracle*>& oracles,
                  const ReductionOptions& reduction, const ProtrusionPolishOptions* protrusion,
-                 int branching, CpuClock::time_point deadline,
+                 int branching, bool improve, CpuClock::time_point deadline,
                  std::vector<std::vector<Node>>& levels, std::vector<std::vector<int>>& parent_of) {
   const int workers = static_cast<int>(oracles.size());
   // Each node's support points (sample indices, one per direction) stand
@@ -614,7 +615,7 @@ int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOrac
     // Rounds of regrouping (against the parents' current centres) and refitting.
     std::vector<int> count(above.size(), 0);
     for (int p : parent_of[l]) count[static_cast<size_t>(p)] += 1;
-    const bool overfull = *std::max_element(count.begin(), count.end()) > branching;
+    const bool overfull = improve || *std::max_element(count.begin(), count.end()) > branching;
     // The children do not change over the rounds: their support points and
     // largest margins are taken once.
     std::vector<std::vector<Eigen::Vector3d>> support(overfull ? nodes.size() : 0);
@@ -953,10 +954,10 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     parent_of.back() = std::move(leaf_level.parent);
     end_step("worst split");
   }
-  if (regroup) {
-    out.num_regrouped = regroup_tree(dense, oracles, reduction,
-                                     options.protrusion_polish ? &options.protrusion : nullptr,
-                                     options.branching, deadline, levels, parent_of);
+  if (regroup || (options.regroup_parents && levels.size() > 2)) {
+    out.num_regrouped = regroup_tree(
+        dense, oracles, reduction, options.protrusion_polish ? &options.protrusion : nullptr,
+        options.branching, options.regroup_parents, deadline, levels, parent_of);
     end_step("regroup");
   }
 

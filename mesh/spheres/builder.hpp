@@ -132,6 +132,12 @@ struct SphereTreeOptions {
   /// the default is tuned for the per-sphere mean (experiments/spheretree/
   /// results/README.md, "This session (10)").
   bool joint_leaf_refinement = false;
+  /// After the leaves are final, choose every node's parent anew, levels
+  /// from the leaves up, to lower the sum of the parents' radii (as
+  /// build_branching's regrouping does, here with no parent over capacity):
+  /// meant for joint_leaf_refinement, whose leaves have left the patches
+  /// their parents were fitted to.
+  bool regroup_parents = false;
   /// Passes of lower_error_sum over the leaves after the exchanges, which
   /// lowers the mean leaf error bound: a leaf hands the cap of samples that
   /// sets its radius to neighbours that grow less than it shrinks, whose

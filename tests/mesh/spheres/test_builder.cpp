@@ -9,6 +9,7 @@
 #include <numeric>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -718,6 +719,49 @@ TEST(SphereTreeBuilder, BuildBranchingRegroupsToTheBranchingAndKeepsEveryGuarant
   EXPECT_EQ(threaded.tree.child_count, tree.child_count);
   o.build_branching = 2;  // below the branching
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
+}
+
+TEST(SphereTreeBuilder, RegroupParentsKeepsTheLeavesAndEveryGuarantee) {
+  // After the joint pass, regroup_parents chooses every node's parent anew:
+  // the leaf spheres must be exactly those of the same build without it (it
+  // moves whole leaves, never their samples), some leaf must have changed
+  // parent (the case exercises it), and the tree must keep its branching,
+  // coverage with margin with children dividing their parent's samples, and
+  // every level covering a dense random sampling (brute force); the inner
+  // level's radii, the objective, must sum to less. The icosphere with coarse
+  // medial samples under branching 8 (leaves of very different sizes): its
+  // joint pass moves leaves across parents.
+  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
+  SphereTreeOptions o = lossy_leaf_options();
+  o.joint_leaf_refinement = true;
+  const SphereTreeBuild plain = build_sphere_tree(sphere, o);
+  o.regroup_parents = true;
+  const SphereTreeBuild build = build_sphere_tree(sphere, o);
+  const auto& tree = build.tree;
+  EXPECT_NO_THROW(icd::collision::validate(tree));
+  ASSERT_EQ(tree.num_levels(), 3);
+  EXPECT_GT(build.num_regrouped, 0) << "the case must exercise the regrouping";
+  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
+  expect_nodes_cover_and_children_divide(build);
+  expect_every_level_covers(tree, sphere, 29);
+  // The same leaves (sphere and samples), in some order.
+  auto leaves = [](const SphereTreeBuild& b) {
+    std::vector<std::tuple<std::vector<int>, double, double, double, double>> out;
+    for (int i = b.tree.level_offset[2]; i < b.tree.level_offset[3]; ++i) {
+      const auto& s = b.tree.spheres[i];
+      out.emplace_back(b.node_samples[i], s.x, s.y, s.z, s.r);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(leaves(build), leaves(plain));
+  auto inner_radii = [](const SphereTreeBuild& b) {
+    double sum = 0;
+    for (int i = b.tree.level_offset[1]; i < b.tree.level_offset[2]; ++i)
+      sum += b.tree.spheres[i].r;
+    return sum;
+  };
+  EXPECT_LT(inner_radii(build), inner_radii(plain));
 }
 
 TEST(SphereTreeBuilder, RejectsBadOptionsAndMeshes) {
