@@ -50,6 +50,9 @@ void print_help(const PreprocessOptions& d) {
       "  --no-spheres               same as --spheres none\n"
       "  --sphere-depth D           sphere-tree levels below the root [%d]\n"
       "  --sphere-branching B       children per sphere [%d]\n"
+      "  --sphere-fit FIT           medial tree optimisation: light, full (the builder's "
+      "defaults),\n"
+      "                             shell (fewest false contacts near contact) [light]\n"
       "  --sphere-time-limit S      wall-clock seconds for the medial-axis optimisation [none];\n"
       "                             a limit that fires makes the output machine-load dependent\n"
       "  --assoc-nearest K          coarse nodes associated with each sphere, at least [%d]\n"
@@ -65,6 +68,7 @@ void print_help(const PreprocessOptions& d) {
 struct Cli {
   std::string input, output;
   PreprocessOptions options;
+  icd::mesh::SphereFit fit = icd::mesh::SphereFit::light;
   bool quiet = false;
 };
 
@@ -145,6 +149,13 @@ Cli parse(int argc, char** argv) {
       o.octree.levels = o.spheres.depth + 1;
     } else if (a == "--sphere-branching") {
       o.spheres.branching = to_int(a, value());
+    } else if (a == "--sphere-fit") {
+      const std::string& f = value();
+      try {
+        c.fit = icd::mesh::parse_sphere_fit(f, "--sphere-fit");
+      } catch (const icd::ParameterError& e) {
+        usage_error(e.what());
+      }
     } else if (a == "--sphere-time-limit") {
       o.spheres.time_limit = to_double(a, value());
     } else if (a == "--assoc-nearest") {
@@ -161,6 +172,7 @@ Cli parse(int argc, char** argv) {
       usage_error("more than one input file ('" + c.input + "', '" + a + "')");
     }
   }
+  icd::mesh::apply_sphere_fit(c.fit, o.spheres);  // after the loop: keeps --sphere-depth etc.
   if (c.input.empty()) usage_error("no input file");
   if (c.output.empty()) usage_error("no output folder (-o)");
   return c;
@@ -179,8 +191,11 @@ void print_summary(const Cli& c, const icd::mesh::PreprocessResult& r, double wr
               static_cast<int>(b.surface_nodes.size()));
   if (c.options.sphere_builder != icd::mesh::SphereBuilder::none) {
     std::printf(
-        "-- sphere tree (%s): %d spheres, %d levels, %zu node associations%s\n",
+        "-- sphere tree (%s%s): %d spheres, %d levels, %zu node associations%s\n",
         c.options.sphere_builder == icd::mesh::SphereBuilder::octree ? "octree" : "medial axis",
+        c.options.sphere_builder == icd::mesh::SphereBuilder::octree
+            ? ""
+            : (std::string(", fit ") + icd::mesh::to_string(c.fit)).c_str(),
         b.spheres.num_nodes(), r.sphere_levels, b.spheres.assoc_nodes.size(),
         r.sphere_time_limit_hit ? " (TIME LIMIT HIT: output may differ between runs)" : "");
   } else {

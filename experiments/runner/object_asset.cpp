@@ -170,6 +170,8 @@ ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::pat
   std::ostringstream args;
   args << " --coarse-tets " << pre.coarse_tets << " --sphere-depth " << pre.tree_depth
        << " --sphere-branching " << pre.tree_branching << (octree ? " --no-spheres" : "");
+  // (only when not the default, so that the cached light bundles stay valid)
+  if (!octree && pre.tree_fit != "light") args << " --sphere-fit " << pre.tree_fit;
   const std::string key = bytes.str() + args.str() + kPreprocessVersion;
   char hash[17];
   std::snprintf(hash, sizeof hash, "%016llx",

@@ -154,6 +154,7 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
     o.preprocess.tree_branching = p.integer("tree_branching", o.preprocess.tree_branching, 2, 64);
     o.preprocess.tree_builder =
         p.string("tree_builder", o.preprocess.tree_builder, {"medial", "octree"});
+    o.preprocess.tree_fit = p.string("tree_fit", o.preprocess.tree_fit, {"light", "full", "shell"});
     p.finish();
   }
   o.size = f.number("size", 0, 0, 1e4);

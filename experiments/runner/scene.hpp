@@ -44,6 +44,9 @@ struct PreprocessSpec {
   int tree_depth = 3;                   ///< sphere-tree levels below the root (paper: 3)
   int tree_branching = 8;               ///< sphere tree branching factor
   std::string tree_builder = "medial";  ///< "medial" (adaptive medial axis) or "octree"
+  /// Optimisation of a medial tree: "light", "full" or "shell"
+  /// (icd-preprocess --sphere-fit; icd::mesh::SphereFit).
+  std::string tree_fit = "light";
 };
 
 /// One object of the scene.

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <utility>
 
+#include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
 #include "mesh/pipeline/hausdorff.hpp"
 
@@ -45,6 +46,51 @@ class StageTimer {
 };
 
 }  // namespace
+
+SphereFit parse_sphere_fit(const std::string& name, const std::string& field) {
+  for (SphereFit fit : {SphereFit::light, SphereFit::full, SphereFit::shell})
+    if (name == to_string(fit)) return fit;
+  throw ParameterError(field + ": must be light, full or shell, got '" + name + "'");
+}
+
+const char* to_string(SphereFit fit) {
+  switch (fit) {
+    case SphereFit::light:
+      return "light";
+    case SphereFit::full:
+      return "full";
+    case SphereFit::shell:
+      return "shell";
+  }
+  return "?";
+}
+
+void apply_sphere_fit(SphereFit fit, SphereTreeOptions& spheres) {
+  SphereTreeOptions o;
+  o.depth = spheres.depth;
+  o.branching = spheres.branching;
+  o.max_spheres_per_level = spheres.max_spheres_per_level;
+  o.threads = spheres.threads;
+  o.time_limit = spheres.time_limit;
+  switch (fit) {
+    case SphereFit::light:
+      o.lloyd_iterations = 1;
+      o.refinement_iterations = 0;
+      o.medial_spacing = 1.0 / 80.0;
+      o.cover_spacing = 1.0 / 400.0;
+      break;
+    case SphereFit::full:
+      break;
+    case SphereFit::shell:
+      o.joint_leaf_refinement = true;
+      o.regroup_parents = true;
+      o.worst_share = 1;
+      o.leaf_worst_target = 0;
+      o.leaf_worst_factor = 0;
+      break;
+  }
+  spheres = std::move(o);
+}
 
 PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o,
                             const ProgressFn& progress, const std::string& name) {

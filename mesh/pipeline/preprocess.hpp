@@ -26,6 +26,31 @@ enum class SphereBuilder {
   none,         ///< no sphere tree in the bundle
 };
 
+/// How far the medial-axis sphere tree is optimised (icd-preprocess
+/// --sphere-fit, scene field preprocess.tree_fit). Measured trees:
+/// experiments/spheretree/results/README.md.
+enum class SphereFit {
+  /// Lighter than the builder's defaults (one Lloyd round, no adaptive
+  /// refinement, coarser coverage samples): the preprocessing's default.
+  light,
+  /// The builder's defaults: the trees of the issue-5 table (lowest error per
+  /// sphere; traversal cost close to the reference toolkit's tree).
+  full,
+  /// full with the joint leaf pass, worst-first allocation and the parents
+  /// regrouped: the fewest false leaf contacts near contact (dragon -22 %
+  /// against full) for a costlier traversal (+21 % sphere tests).
+  shell,
+};
+
+/// "light", "full" or "shell"; anything else throws ParameterError naming
+/// `field` and the choices.
+SphereFit parse_sphere_fit(const std::string& name, const std::string& field = "sphere fit");
+const char* to_string(SphereFit fit);
+
+/// Sets the fitting options of `spheres` for `fit`, keeping the tree's shape
+/// (depth, branching, per-level caps), its thread count and its time limit.
+void apply_sphere_fit(SphereFit fit, SphereTreeOptions& spheres);
+
 /// Options of every stage; the defaults are the tool's defaults.
 struct PreprocessOptions {
   RepairOptions repair;
@@ -43,10 +68,7 @@ struct PreprocessOptions {
   bool compute_hausdorff = true;  ///< dense vs coarse surface distance for the summary
   PreprocessOptions() {
     spheres.time_limit = 1e9;
-    spheres.lloyd_iterations = 1;
-    spheres.refinement_iterations = 0;
-    spheres.medial_spacing = 1.0 / 80.0;
-    spheres.cover_spacing = 1.0 / 400.0;
+    apply_sphere_fit(SphereFit::light, spheres);
     octree.levels = spheres.depth + 1;
   }
 };
