@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "collision/sph_io.hpp"
 #include "coupling/asset_bundle.hpp"
 #include "mesh/io/error.hpp"
 #include "mesh/io/surface_reader.hpp"
@@ -52,8 +53,9 @@ void print_help(const PreprocessOptions& d) {
       "  --sphere-branching B       children per sphere [%d]\n"
       "  --sphere-fit FIT           medial tree optimisation: light, full (the builder's "
       "defaults),\n"
-      "                             shell (fewest false contacts near contact) [light]\n"
-      "  --sphere-time-limit S      wall-clock seconds for the medial-axis optimisation [none];\n"
+      "                             shell (thinnest leaf shell) [light]\n"
+      "  --sph FILE                 also write the sphere tree (rest pose) as .sph to FILE\n"
+      "  --sphere-time-limit S      CPU seconds for the medial-axis optimisation [none];\n"
       "                             a limit that fires makes the output machine-load dependent\n"
       "  --assoc-nearest K          coarse nodes associated with each sphere, at least [%d]\n"
       "  --no-hausdorff             skip the Hausdorff distance of the summary\n"
@@ -69,6 +71,7 @@ struct Cli {
   std::string input, output;
   PreprocessOptions options;
   icd::mesh::SphereFit fit = icd::mesh::SphereFit::light;
+  std::string sph;  ///< --sph: the tree as .sph too (empty: no)
   bool quiet = false;
 };
 
@@ -156,6 +159,8 @@ Cli parse(int argc, char** argv) {
       } catch (const icd::ParameterError& e) {
         usage_error(e.what());
       }
+    } else if (a == "--sph") {
+      c.sph = value();
     } else if (a == "--sphere-time-limit") {
       o.spheres.time_limit = to_double(a, value());
     } else if (a == "--assoc-nearest") {
@@ -173,6 +178,8 @@ Cli parse(int argc, char** argv) {
     }
   }
   icd::mesh::apply_sphere_fit(c.fit, o.spheres);  // after the loop: keeps --sphere-depth etc.
+  if (!c.sph.empty() && o.sphere_builder == icd::mesh::SphereBuilder::none)
+    usage_error("--sph needs a sphere tree (not --spheres none)");
   if (c.input.empty()) usage_error("no input file");
   if (c.output.empty()) usage_error("no output folder (-o)");
   return c;
@@ -251,6 +258,16 @@ int main(int argc, char** argv) {
 
     const auto tw = Clock::now();
     icd::coupling::write_asset_bundle(cli.output, r.bundle);
+    if (!cli.sph.empty()) {  // under a temporary name until complete
+      const std::string part = cli.sph + ".part";
+      try {
+        icd::collision::write_sph(part, r.bundle.spheres);
+      } catch (...) {
+        std::filesystem::remove(part);
+        throw;
+      }
+      std::filesystem::rename(part, cli.sph);
+    }
     const double write_s = std::chrono::duration<double>(Clock::now() - tw).count();
     std::vector<double> load_ms, load_cpu_ms;
     for (int i = 0; i < 5; ++i) {

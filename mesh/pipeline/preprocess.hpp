@@ -27,18 +27,19 @@ enum class SphereBuilder {
 };
 
 /// How far the medial-axis sphere tree is optimised (icd-preprocess
-/// --sphere-fit, scene field preprocess.tree_fit). Measured trees:
-/// experiments/spheretree/results/README.md.
+/// --sphere-fit, scene field preprocess.tree_fit). Measured on the dragon
+/// (icd-preprocess defaults otherwise; experiments/spheretree/results/
+/// README.md, "This session (12)"): full reports 12 % fewer false leaf pairs
+/// near contact than light for 5 % fewer sphere tests, at about the same
+/// build time; shell 3 % fewer than full for 32 % more tests.
 enum class SphereFit {
-  /// Lighter than the builder's defaults (one Lloyd round, no adaptive
-  /// refinement, coarser coverage samples): the preprocessing's default.
+  /// One Lloyd round, no adaptive refinement, finer medial and coarser
+  /// coverage samples: the preprocessing's default.
   light,
-  /// The builder's defaults: the trees of the issue-5 table (lowest error per
-  /// sphere; traversal cost close to the reference toolkit's tree).
+  /// The builder's defaults: the trees of the issue-5 table.
   full,
   /// full with the joint leaf pass, worst-first allocation and the parents
-  /// regrouped: the fewest false leaf contacts near contact (dragon -22 %
-  /// against full) for a costlier traversal (+21 % sphere tests).
+  /// regrouped: the thinnest leaf shell, a thicker level 2.
   shell,
 };
 
@@ -58,10 +59,9 @@ struct PreprocessOptions {
   TetrahedralizeOptions tetrahedralize;
   coupling::RigidLinkOptions links;
   SphereBuilder sphere_builder = SphereBuilder::medial_axis;
-  /// Medial-axis builder options. Defaults here are lighter than the builder's
-  /// own (one Lloyd round, no adaptive refinement, coarser samples) to keep the
-  /// whole run within a minute, and without a wall-clock limit: a limit that
-  /// fires makes the output depend on machine load (not byte-reproducible).
+  /// Medial-axis builder options: SphereFit::light, and no time limit (a
+  /// limit of CPU seconds that fires makes the output depend on timing: not
+  /// byte-reproducible).
   SphereTreeOptions spheres;
   collision::OctreeTreeOptions octree;  ///< octree builder options (levels = depth + 1)
   collision::NodeAssociationOptions association;
