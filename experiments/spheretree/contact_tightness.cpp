@@ -22,6 +22,7 @@
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -29,16 +30,18 @@
 
 #include <Eigen/Geometry>
 
-#include "collision/aabb_tree.hpp"
 #include "collision/traversal.hpp"
 #include "experiments/common/command_line.hpp"
+#include "experiments/spheretree/approach.hpp"
 #include "experiments/spheretree/tree_report.hpp"
 #include "mesh/io/surface_reader.hpp"
 
 namespace {
 
-using icd::collision::Sphere;
 using icd::collision::SphereTree;
+using icd::experiments::ApproachPose;
+using icd::experiments::last_leaf_overlap;
+using icd::experiments::moved;
 
 struct NamedTree {
   std::string name;
@@ -53,49 +56,13 @@ std::vector<std::string> split(const std::string& s, char sep) {
   return out;
 }
 
-/// The rigid motion of the second copy: x -> R (x - c) + c + t u.
-struct Pose {
-  Eigen::Matrix3d R;
-  Eigen::Vector3d c, u;
-  Eigen::Vector3d apply(const Eigen::Vector3d& x, double t) const { return R * (x - c) + c + t * u; }
-};
-
-/// The largest t at which leaf i of `a` and leaf j of `b` moved by the pose
-/// overlap, over all leaf pairs (-inf when none ever does): past it no leaf
-/// pair of this tree overlaps, so (for a covering tree) the surfaces are apart.
-double last_leaf_overlap(const SphereTree& a, const SphereTree& b, const Pose& pose) {
-  const int la = a.num_levels() - 1, lb = b.num_levels() - 1;
-  double last = -std::numeric_limits<double>::infinity();
-  for (int j = b.level_offset[lb]; j < b.level_offset[lb + 1]; ++j) {
-    const Eigen::Vector3d q = pose.apply(b.spheres[j].center(), 0.0);
-    for (int i = a.level_offset[la]; i < a.level_offset[la + 1]; ++i) {
-      // |q + t u - p| <= ra + rb: t^2 + 2 t u.(q - p) + |q - p|^2 - R^2 <= 0.
-      const Eigen::Vector3d d = q - a.spheres[i].center();
-      const double R = a.spheres[i].r + b.spheres[j].r;
-      const double half_b = pose.u.dot(d), c = d.squaredNorm() - R * R;
-      const double disc = half_b * half_b - c;
-      if (disc >= 0) last = std::max(last, -half_b + std::sqrt(disc));
-    }
-  }
-  return last;
-}
-
-SphereTree moved(const SphereTree& tree, const Pose& pose, double t) {
-  SphereTree m = tree;
-  for (Sphere& s : m.spheres) {
-    const Eigen::Vector3d c = pose.apply(s.center(), t);
-    s.x = c.x(), s.y = c.y(), s.z = c.z();
-  }
-  return m;
-}
-
 struct Counts {
-  std::vector<int> false_poses;        // per gap: poses with a leaf pair
-  std::vector<double> false_leaves;    // per gap: summed leaf pairs
-  std::vector<double> upper_pairs;     // per gap: summed level L-1 pairs
-  std::vector<double> tests;           // per gap: summed sphere tests of the full traversal
-  int missed = 0;                      // crossing poses with no leaf pair
-  double crossing_leaves = 0;          // summed leaf pairs at the crossing poses
+  std::vector<int> false_poses;      // per gap: poses with a leaf pair
+  std::vector<double> false_leaves;  // per gap: summed leaf pairs
+  std::vector<double> upper_pairs;   // per gap: summed level L-1 pairs
+  std::vector<double> tests;         // per gap: summed sphere tests of the full traversal
+  int missed = 0;                    // crossing poses with no leaf pair
+  double crossing_leaves = 0;        // summed leaf pairs at the crossing poses
 };
 
 int run(int argc, char** argv) {
@@ -142,20 +109,8 @@ int run(int argc, char** argv) {
   }
   if (trees.empty()) throw std::invalid_argument("--trees: at least one tree is needed");
 
-  const icd::MatX3d& VA = mesh.V;
-  const icd::collision::AabbTree aabb_a(VA, mesh.F);
-  icd::MatX3d VB = VA;
-  icd::collision::AabbTree aabb_b(VB, mesh.F);
-  auto meshes_meet = [&](const Pose& pose, double t) {
-    for (Eigen::Index v = 0; v < VA.rows(); ++v)
-      VB.row(v) = pose.apply(VA.row(v).transpose(), t).transpose();
-    aabb_b.refit(VB, mesh.F);
-    return !icd::collision::intersecting_triangle_pairs(aabb_a, VA, mesh.F, aabb_b, VB, mesh.F)
-                .empty();
-  };
-
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal;
+  icd::experiments::SelfApproach surfaces(mesh.V, mesh.F);
+  icd::experiments::RandomApproachPoses random_poses(seed, centre);
   std::vector<Counts> counts(trees.size());
   for (auto& c : counts) {
     c.false_poses.assign(gaps.size(), 0);
@@ -166,31 +121,23 @@ int run(int argc, char** argv) {
   icd::collision::CollisionRequest full;  // no budget: every overlapping leaf pair
   int skipped = 0;
   for (int k = 0; k < poses; ++k) {
-    Pose pose;
-    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-    pose.R = q.normalized().toRotationMatrix();
-    pose.u = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
-    pose.c = centre;
+    const ApproachPose pose = random_poses.next();
     // From where no leaf pair of any tree overlaps, march in until the
     // surfaces cross, then bisect between the last apart and the first crossing.
-    double hi = -std::numeric_limits<double>::infinity();
-    for (const auto& t : trees) hi = std::max(hi, last_leaf_overlap(t.tree, t.tree, pose));
-    hi += 1.0 / to_2000;
-    if (meshes_meet(pose, hi)) {  // no tree covers this contact: cannot start from outside
+    double start = -std::numeric_limits<double>::infinity();
+    for (const auto& t : trees) start = std::max(start, last_leaf_overlap(t.tree, t.tree, pose));
+    start += 1.0 / to_2000;
+    const auto touching = icd::experiments::find_touching(
+        [&](double t) { return surfaces.meets(pose, t); }, start, step / to_2000, 1e-4 / to_2000);
+    if (!touching.found) {  // no tree covers this contact: cannot start from outside
       ++skipped;
       continue;
     }
-    double lo = hi;
-    while (!meshes_meet(pose, lo)) hi = lo, lo -= step / to_2000;
-    for (int it = 0; it < 40 && hi - lo > 1e-4 / to_2000; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (meshes_meet(pose, mid) ? lo : hi) = mid;
-    }
-    const double touch = hi;  // apart here, crossing 1e-4 units further in
+    const double touch = touching.apart, past = touching.crossing;  // 1e-4 units apart
     for (size_t ti = 0; ti < trees.size(); ++ti) {
       const SphereTree& a = trees[ti].tree;
       Counts& c = counts[ti];
-      const auto crossing = icd::collision::collide(a, moved(a, pose, lo), full);
+      const auto crossing = icd::collision::collide(a, moved(a, pose, past), full);
       c.missed += crossing.colliding.empty() ? 1 : 0;
       c.crossing_leaves += static_cast<double>(crossing.colliding.size());
       for (size_t g = 0; g < gaps.size(); ++g) {
