@@ -1,0 +1,101 @@
+// The icd-preprocess program's sphere-tree options: --sph writes the
+// bundle's tree as .sph (read back equal to the bundle's, covering every
+// vertex at every level; the octree builder, as a medial build of even a
+// small sphere takes over 10 s at the fits' sample spacings), and
+// --sphere-fit refuses an unknown fit before any work.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "collision/sph_io.hpp"
+#include "coupling/asset_bundle.hpp"
+#include "mesh/io/primitives.hpp"
+#include "mesh/io/surface_writer.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+#ifdef ICD_PREPROCESS
+struct ProgramRun {
+  int status = -1;
+  std::string output;
+};
+
+ProgramRun run_preprocess(const std::string& args, const fs::path& dir) {
+  const fs::path log = dir / "log.txt";
+  const std::string cmd = std::string(ICD_PREPROCESS) + " " + args + " > " + log.string() + " 2>&1";
+  const int raw = std::system(cmd.c_str());
+  ProgramRun r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.output = ss.str();
+  return r;
+}
+
+TEST(PreprocessCli, WritesTheBundlesTreeAsSph) {
+  const fs::path dir = fs::temp_directory_path() / "icd_test_preprocess_cli";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  icd::write_off(dir / "sphere.off", icd::make_icosphere(2));
+  const fs::path bundle = dir / "bundle", sph = dir / "tree.sph";
+  const ProgramRun run = run_preprocess(
+      (dir / "sphere.off").string() + " -o " + bundle.string() +
+          " --coarse-tets 200 --sphere-depth 2 --sphere-branching 4 --spheres octree --sph " +
+          sph.string() + " --no-hausdorff -q",
+      dir);
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_FALSE(fs::exists(sph.string() + ".part"));
+  const icd::coupling::AssetBundle b = icd::coupling::read_asset_bundle(bundle);
+  const icd::collision::SphereTree tree = icd::collision::read_sph(sph.string());
+  ASSERT_EQ(tree.num_nodes(), b.spheres.num_nodes());
+  ASSERT_EQ(tree.num_levels(), 3);
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    const auto &s = tree.spheres[i], &t = b.spheres.rest_spheres[i];
+    EXPECT_NEAR((s.center() - t.center()).norm(), 0.0, 1e-9) << "node " << i;
+    EXPECT_NEAR(s.r, t.r, 1e-9) << "node " << i;
+    EXPECT_EQ(tree.child_count[i], b.spheres.child_count[i]) << "node " << i;
+  }
+  for (int l = 0; l < tree.num_levels(); ++l) {
+    for (Eigen::Index v = 0; v < b.dense.V.rows(); ++v) {
+      bool covered = false;
+      for (int i = tree.level_offset[l]; i < tree.level_offset[l + 1] && !covered; ++i)
+        covered = (b.dense.V.row(v).transpose() - tree.spheres[i].center()).norm() <=
+                  tree.spheres[i].r + 1e-9;
+      EXPECT_TRUE(covered) << "vertex " << v << " at level " << l;
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(PreprocessCli, RefusesAnUnknownFitBeforeAnyWork) {
+  const fs::path dir = fs::temp_directory_path() / "icd_test_preprocess_cli_bad";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  icd::write_off(dir / "sphere.off", icd::make_icosphere(1));
+  const ProgramRun run = run_preprocess(
+      (dir / "sphere.off").string() + " -o " + (dir / "bundle").string() + " --sphere-fit tight",
+      dir);
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_NE(run.output.find("--sphere-fit: must be light, full or shell, got 'tight'"),
+            std::string::npos)
+      << run.output;
+  EXPECT_FALSE(fs::exists(dir / "bundle"));
+  const ProgramRun none =
+      run_preprocess((dir / "sphere.off").string() + " -o " + (dir / "bundle").string() +
+                         " --no-spheres --sph x.sph",
+                     dir);
+  EXPECT_EQ(none.status, 2) << none.output;
+  EXPECT_NE(none.output.find("--sph needs a sphere tree"), std::string::npos) << none.output;
+  fs::remove_all(dir);
+}
+#endif
+
+}  // namespace
