@@ -27,16 +27,18 @@ enum class SphereBuilder {
 };
 
 /// How far the medial-axis sphere tree is optimised (icd-preprocess
-/// --sphere-fit, scene field preprocess.tree_fit). Measured on the dragon
-/// (icd-preprocess defaults otherwise; experiments/spheretree/results/
-/// README.md, "This session (12)"): full reports 12 % fewer false leaf pairs
-/// near contact than light for 5 % fewer sphere tests, at about the same
-/// build time; shell 3 % fewer than full for 32 % more tests.
+/// --sphere-fit, scene field preprocess.tree_fit). Measured against light
+/// (icd-preprocess defaults otherwise, 400 approach poses of
+/// contact_tightness; experiments/spheretree/results/README.md, "This
+/// session (12)"), dragon / bunny: full -12 % / +10 % false leaf pairs near
+/// contact, -5 % / +28 % sphere tests; shell -15 % / +3 %, +26 % / +21 %.
+/// No fit is better on both models, so light stays the default.
 enum class SphereFit {
   /// One Lloyd round, no adaptive refinement, finer medial and coarser
   /// coverage samples: the preprocessing's default.
   light,
-  /// The builder's defaults: the trees of the issue-5 table.
+  /// The builder's defaults (the issue-5 table's trees there have caps of
+  /// 1/8/64/445 spheres per level; here every level may fill up).
   full,
   /// full with the joint leaf pass, worst-first allocation and the parents
   /// regrouped: the thinnest leaf shell, a thicker level 2.
