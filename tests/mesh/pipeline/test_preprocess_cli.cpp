@@ -4,40 +4,25 @@
 // small sphere takes over 10 s at the fits' sample spacings), and
 // --sphere-fit refuses an unknown fit before any work.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "collision/sph_io.hpp"
 #include "coupling/asset_bundle.hpp"
 #include "mesh/io/primitives.hpp"
 #include "mesh/io/surface_writer.hpp"
+#include "mesh/program_run.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
 #ifdef ICD_PREPROCESS
-struct ProgramRun {
-  int status = -1;
-  std::string output;
-};
+using icd::test::ProgramRun;
 
 ProgramRun run_preprocess(const std::string& args, const fs::path& dir) {
-  const fs::path log = dir / "log.txt";
-  const std::string cmd = std::string(ICD_PREPROCESS) + " " + args + " > " + log.string() + " 2>&1";
-  const int raw = std::system(cmd.c_str());
-  ProgramRun r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.output = ss.str();
-  return r;
+  return icd::test::run_program(ICD_PREPROCESS, args, dir);
 }
 
 TEST(PreprocessCli, WritesTheBundlesTreeAsSph) {

@@ -3,8 +3,6 @@
 // probe frame and the toolkit's against the closed-form distance to a cube,
 // and its refusals of bad input.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -19,6 +17,7 @@
 
 #include "mesh/io/primitives.hpp"
 #include "mesh/io/surface_writer.hpp"
+#include "mesh/program_run.hpp"
 #include "mesh/spheres/evaluation.hpp"
 
 namespace {
@@ -26,23 +25,10 @@ namespace {
 namespace fs = std::filesystem;
 
 #ifdef ICD_EVALUATE_SPH
-struct ProgramRun {
-  int status = -1;
-  std::string output;
-};
+using icd::test::ProgramRun;
 
 ProgramRun run_program(const std::string& args, const fs::path& dir) {
-  const fs::path log = dir / "log.txt";
-  const std::string cmd =
-      std::string(ICD_EVALUATE_SPH) + " " + args + " > " + log.string() + " 2>&1";
-  const int raw = std::system(cmd.c_str());
-  ProgramRun r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.output = ss.str();
-  return r;
+  return icd::test::run_program(ICD_EVALUATE_SPH, args, dir);
 }
 
 /// The table row (whitespace-separated fields) of `method` at `level`.
