@@ -68,6 +68,7 @@ Touching find_touching(const std::function<bool(double)>& meets, double start, d
 
 /// Exact surface contact of a mesh with a moved copy of itself (triangle
 /// pairs through bounding-box trees; the copy's boxes refitted per call).
+/// Keeps V and F by reference: they must outlive it.
 class SelfApproach {
  public:
   SelfApproach(const MatX3d& V, const MatX3i& F);

@@ -615,17 +615,18 @@ int regroup_tree(const ReductionProblem& dense, const std::vector<const MeshOrac
     // Rounds of regrouping (against the parents' current centres) and refitting.
     std::vector<int> count(above.size(), 0);
     for (int p : parent_of[l]) count[static_cast<size_t>(p)] += 1;
-    const bool overfull = improve || *std::max_element(count.begin(), count.end()) > branching;
+    // Parents are chosen anew where one has too many children, or always with `improve`.
+    const bool choose = improve || *std::max_element(count.begin(), count.end()) > branching;
     // The children do not change over the rounds: their support points and
     // largest margins are taken once.
-    std::vector<std::vector<Eigen::Vector3d>> support(overfull ? nodes.size() : 0);
+    std::vector<std::vector<Eigen::Vector3d>> support(choose ? nodes.size() : 0);
     std::vector<double> gap(support.size(), 0.0);
     parallel_for(support.size(), workers, [&](size_t i, int) {
       for (int s : nodes[i].sphere.members) gap[i] = std::max(gap[i], dense.gap[s]);
       support[i] = points_of(extreme[i]);
     });
-    for (int round = 0; round < (overfull ? kRegroupRounds : 1); ++round) {
-      if (overfull) {
+    for (int round = 0; round < (choose ? kRegroupRounds : 1); ++round) {
+      if (choose) {
         std::vector<std::vector<double>> reach(nodes.size(), std::vector<double>(above.size()));
         parallel_for(nodes.size(), workers, [&](size_t i, int) {
           for (size_t p = 0; p < above.size(); ++p) {
