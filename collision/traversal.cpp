@@ -13,13 +13,22 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Every child of the node split next may be tested (see WorkPair::allowed).
+constexpr uint32_t kAllChildren = ~uint32_t{0};
+
 // A pair being refined. `split_b`: the node to split next is b (the paper's
 // p.2); the flag flips at every generated pair, which is Fig. 7's swap.
+// `allowed`: bit j set when child j of the node split next may overlap (with
+// CollisionRequest::parent_filter: it overlaps the node the pair's other node
+// was split from); children past the 32nd are always allowed.
 struct WorkPair {
   int32_t a;
   int32_t b;
   int32_t split_b;
+  uint32_t allowed = kAllChildren;
 };
+
+inline bool is_allowed(uint32_t allowed, int32_t j) { return j >= 32 || ((allowed >> j) & 1u); }
 
 // Growable ring buffer (FIFO), storage kept between queries of a thread.
 class PairQueue {
@@ -50,6 +59,11 @@ class PairQueue {
   template <class F>
   void for_each(F&& f) const {
     for (std::size_t k = 0; k < m_size; ++k) f(m_buf[(m_head + k) & m_mask]);
+  }
+  /// Applies f to the last `count` pairs pushed.
+  template <class F>
+  void for_last(std::size_t count, F&& f) {
+    for (std::size_t k = m_size - count; k < m_size; ++k) f(m_buf[(m_head + k) & m_mask]);
   }
 
  private:
@@ -87,6 +101,10 @@ class PairStack {
   template <class F>
   void for_each(F&& f) const {
     for (std::size_t k = m_size; k-- > 0;) f(m_buf[k]);
+  }
+  template <class F>
+  void for_last(std::size_t count, F&& f) {
+    for (std::size_t k = m_size - count; k < m_size; ++k) f(m_buf[k]);
   }
 
  private:
@@ -209,6 +227,7 @@ struct Trees {
   const int32_t* la;
   const int32_t* lb;
   int cap;
+  bool parent_filter;
   bool expandable_a(int32_t n) const { return cca[n] > 0 && la[n] < cap; }
   bool expandable_b(int32_t n) const { return ccb[n] > 0 && lb[n] < cap; }
   bool overlaps(int32_t a, int32_t b) const { return overlap(sa[a], sb[b]); }
@@ -229,21 +248,92 @@ inline bool choose_split_b(const Trees& t, const WorkPair& p) {
   return p.split_b ? eb : !t.expandable_a(p.a) && eb;
 }
 
-// Tests the children [first, end) of p's split node against p's other node
-// one at a time, each under the budget: an overlapping pair that can be split
-// further goes to `queue(a, b)`, one that cannot is settled. `pending()` is
-// the current size of the work list (for the budget's list cap). Returns false
-// when the budget stopped it (the untested children are then reported).
+// One split: the children [first, end) of one node of `p` (b's when
+// `split_b`) against the other node, `other`. The pairs it queues split
+// `other` next when it is expandable (Fig. 7's swap).
+struct Split {
+  bool split_b;
+  int32_t first, end;
+  int32_t other;
+  bool other_expandable;
+  int32_t next_flag;
+  Split(const Trees& t, const WorkPair& p) {
+    split_b = choose_split_b(t, p);
+    first = split_b ? t.fcb[p.b] : t.fca[p.a];
+    end = first + (split_b ? t.ccb[p.b] : t.cca[p.a]);
+    other = split_b ? p.a : p.b;
+    other_expandable = split_b ? t.expandable_a(p.a) : t.expandable_b(p.b);
+    next_flag = split_b ? 0 : 1;
+  }
+  // Tests of the parent filter for this split: other's children (the first
+  // 32) against the split node; 0 when the filter is off or other will not be
+  // split.
+  int32_t filter_tests(const Trees& t) const {
+    if (!t.parent_filter || !other_expandable) return 0;
+    return std::min<int32_t>(split_b ? t.cca[other] : t.ccb[other], 32);
+  }
+};
+
+// The parent filter makes a mask only for a split that queues at least this
+// many pairs: for one pair the mask's tests cost about what they save.
+// Measured (contact_tightness, 400 approach poses of two dragons 1 unit short
+// of touching, three trees): 5-6 % fewer sphere tests than with a mask for
+// every split, 1-3 % more leaf pairs.
+constexpr std::size_t kMaskFromPairs = 2;
+
+// The parent filter's tests of one split: the other node's children (the
+// first 32; later ones are always allowed) against the split node. Bit j of
+// the mask: child j overlaps it.
+struct FilterTests {
+  Sphere split;
+  const Sphere* kids;  // the other node's first child
+  int32_t count;
+  FilterTests(const Trees& t, const Split& s, const WorkPair& p)
+      : split(s.split_b ? t.sb[p.b] : t.sa[p.a]),
+        kids(s.split_b ? t.sa + t.fca[s.other] : t.sb + t.fcb[s.other]),
+        count(s.filter_tests(t)) {}
+  uint32_t bit(int32_t j) const { return static_cast<uint32_t>(overlap(split, kids[j])) << j; }
+};
+
+thread_local std::vector<WorkPair> t_found;  // overlapping children of one split
+
+// Tests the allowed children of the split node against the other node one at
+// a time, each under the budget: an overlapping pair that can be split further
+// goes to `queue(WorkPair)`, one that cannot is settled; children the parent
+// filter rules out count as pruned. Then, with the filter, the other node's
+// children are tested against the split node (under the budget too) to make
+// the queued pairs' mask. `pending()` is the current size of the work list
+// (for the budget's reserve). Returns false when the budget stopped it (the
+// untested children are then reported; pairs found so far are queued with
+// every child allowed).
 template <class PendingSize, class Queue>
-bool test_children_one_by_one(const Trees& t, const WorkPair& p, bool split_b, int32_t first,
-                              int32_t end, Budget& budget, bool record_front, CollisionResult& res,
-                              PendingSize pending, Queue queue) {
+bool test_children_one_by_one(const Trees& t, const WorkPair& p, const Split& s, Budget& budget,
+                              bool record_front, CollisionResult& res, PendingSize pending,
+                              Queue queue) {
   StopReason reason = StopReason::Completed;
-  for (int32_t c = first; c < end; ++c) {
-    const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
-    if (!budget.allow(res.tests, pending(), reason)) {
-      for (int32_t r = c; r < end; ++r)
-        res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
+  std::vector<WorkPair>& found = t_found;
+  found.clear();
+  auto flush = [&](uint32_t mask) {
+    for (WorkPair& f : found) {
+      f.allowed = mask;
+      queue(f);
+    }
+  };
+  for (int32_t c = s.first; c < s.end; ++c) {
+    const int32_t a = s.split_b ? p.a : c, b = s.split_b ? c : p.b;
+    if (!is_allowed(p.allowed, c - s.first)) {  // misses the other side's parent
+      if (record_front) res.front.push_back({a, b});
+      continue;
+    }
+    if (!budget.allow(res.tests, pending() + found.size(), reason)) {
+      for (int32_t r = c; r < s.end; ++r) {
+        const NodePair rest = s.split_b ? NodePair{p.a, r} : NodePair{r, p.b};
+        if (is_allowed(p.allowed, r - s.first))
+          res.untested.push_back(rest);
+        else if (record_front)
+          res.front.push_back(rest);  // pruned by the filter: still part of the cut
+      }
+      flush(kAllChildren);
       res.interrupted = true;
       res.stop_reason = reason;
       return false;
@@ -254,10 +344,27 @@ bool test_children_one_by_one(const Trees& t, const WorkPair& p, bool split_b, i
       continue;
     }
     if (t.expandable_a(a) || t.expandable_b(b))
-      queue(a, b);
+      found.push_back({a, b, s.next_flag, kAllChildren});
     else
       settle(t, a, b, res);
   }
+  if (found.size() < kMaskFromPairs || s.filter_tests(t) == 0) {
+    flush(kAllChildren);
+    return true;
+  }
+  const FilterTests f(t, s, p);
+  uint32_t mask = 0;
+  for (int32_t j = 0; j < f.count; ++j) {
+    if (!budget.allow(res.tests, pending() + found.size(), reason)) {
+      flush(kAllChildren);  // stopped: the pairs are reported unrefined anyway
+      res.interrupted = true;
+      res.stop_reason = reason;
+      return false;
+    }
+    ++res.tests;
+    mask |= f.bit(j);
+  }
+  flush(mask);
   return true;
 }
 
@@ -298,25 +405,40 @@ void run_literal(const Trees& t, List& list, Budget& budget, bool record_front,
   list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
 }
 
-// Tests the children [first, end) of the split node against the other node
-// of `p` and queues the overlapping pairs (SplitB: the children are b's).
+// Tests the allowed children of the split node against the other node of `p`
+// and queues the overlapping pairs (SplitB: the children are b's), then, with
+// the parent filter, sets the queued pairs' mask. No budget event may fall
+// inside (see Budget::batch_ok). Returns the number of tests.
 template <bool SplitB, class List>
-inline void expand_batch(const Trees& t, const WorkPair& p, int32_t first, int32_t end, List& list,
-                         CollisionResult& res) {
+inline int64_t expand_batch(const Trees& t, const WorkPair& p, const Split& s, List& list,
+                            CollisionResult& res) {
   const Sphere o = SplitB ? t.sa[p.a] : t.sb[p.b];
   const Sphere* kids = SplitB ? t.sb : t.sa;
-  const bool other_expandable = SplitB ? t.expandable_a(p.a) : t.expandable_b(p.b);
-  const int32_t next_flag = SplitB ? 0 : 1;
-  for (int32_t c = first; c < end; ++c) {
-    const Sphere& s = kids[c];
-    const double dx = o.x - s.x, dy = o.y - s.y, dz = o.z - s.z, rr = o.r + s.r;
+  const std::size_t before = list.size();
+  int64_t tests = 0;
+  for (int32_t c = s.first; c < s.end; ++c) {
+    if (!is_allowed(p.allowed, c - s.first)) continue;
+    ++tests;
+    const Sphere& k = kids[c];
+    const double dx = o.x - k.x, dy = o.y - k.y, dz = o.z - k.z, rr = o.r + k.r;
     const bool ov = dx * dx + dy * dy + dz * dz <= rr * rr;
     const int32_t a = SplitB ? p.a : c, b = SplitB ? c : p.b;
-    if (other_expandable || (SplitB ? t.expandable_b(c) : t.expandable_a(c)))
-      list.push_if({a, b, next_flag}, ov);
+    if (s.other_expandable || (SplitB ? t.expandable_b(c) : t.expandable_a(c)))
+      list.push_if({a, b, s.next_flag, kAllChildren}, ov);
     else if (ov)
       settle(t, a, b, res);
   }
+  res.tests += tests;
+  const std::size_t queued = list.size() - before;
+  if (queued >= kMaskFromPairs && s.filter_tests(t) > 0) {
+    const FilterTests f(t, s, p);
+    uint32_t mask = 0;
+    for (int32_t j = 0; j < f.count; ++j) mask |= f.bit(j);
+    res.tests += f.count;
+    tests += f.count;
+    list.for_last(queued, [mask](WorkPair& w) { w.allowed = mask; });
+  }
+  return tests;
 }
 
 // Fast path: children are tested as they are generated; the list holds only
@@ -326,27 +448,22 @@ void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, Col
   bool stopped = false;
   while (!list.empty() && !stopped) {
     const WorkPair p = list.pop();
-    const bool split_b = choose_split_b(t, p);
-    const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a];
-    const int32_t end = first + (split_b ? t.ccb[p.b] : t.cca[p.a]);
-    const int32_t next_flag = split_b ? 0 : 1;
-    if (!record_front && budget.batch_ok(res.tests, end - first)) {
+    const Split s(t, p);
+    const int64_t most = (s.end - s.first) + s.filter_tests(t);
+    if (!record_front && budget.batch_ok(res.tests, most)) {
       // Batch: no budget event inside; children tested against the fixed
       // sphere with branch-free pushes of the overlapping ones.
-      list.ensure(static_cast<std::size_t>(end - first));
-      res.tests += end - first;
-      if (split_b)
-        expand_batch<true>(t, p, first, end, list, res);
+      list.ensure(static_cast<std::size_t>(s.end - s.first));
+      if (s.split_b)
+        expand_batch<true>(t, p, s, list, res);
       else
-        expand_batch<false>(t, p, first, end, list, res);
+        expand_batch<false>(t, p, s, list, res);
       res.peak_list_size = std::max(res.peak_list_size, list.size());
       continue;
     }
     stopped = !test_children_one_by_one(
-        t, p, split_b, first, end, budget, record_front, res, [&] { return list.size(); },
-        [&](int32_t a, int32_t b) {
-          list.push({a, b, next_flag});
-        });
+        t, p, s, budget, record_front, res, [&] { return list.size(); },
+        [&](const WorkPair& w) { list.push(w); });
     res.peak_list_size = std::max(res.peak_list_size, list.size());
   }
   res.untested.reserve(res.untested.size() + list.size());
@@ -371,9 +488,8 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
     std::pop_heap(heap.begin(), heap.end());
     const WorkPair p = heap.back().p;
     heap.pop_back();
-    const bool split_b = choose_split_b(t, p);
-    const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a];
-    const int32_t count = split_b ? t.ccb[p.b] : t.cca[p.a];
+    const Split s(t, p);
+    const int32_t count = s.end - s.first;
     if (heap.size() + static_cast<std::size_t>(count) > cap) {
       // Full: give up the lower-priority half (reported unrefined), keep the rest.
       std::sort(heap.begin(), heap.end());
@@ -383,11 +499,10 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
       heap.erase(heap.begin(), heap.begin() + std::min(drop, heap.size()));
       std::make_heap(heap.begin(), heap.end());
     }
-    const int32_t next_flag = split_b ? 0 : 1;
     stopped = !test_children_one_by_one(
-        t, p, split_b, first, first + count, budget, record_front, res, [&] { return heap.size(); },
-        [&](int32_t a, int32_t b) {
-          heap.push_back({priority_of(key, t.sa[a], t.sb[b]), {a, b, next_flag}});
+        t, p, s, budget, record_front, res, [&] { return heap.size(); },
+        [&](const WorkPair& w) {
+          heap.push_back({priority_of(key, t.sa[w.a], t.sb[w.b]), w});
           std::push_heap(heap.begin(), heap.end());
         });
     res.peak_list_size = std::max(res.peak_list_size, heap.size());
@@ -437,9 +552,12 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
   res.tests = 0;
   res.peak_list_size = 0;
 
-  const Trees t{a.spheres.data(),     b.spheres.data(),     a.first_child.data(),
-                a.child_count.data(), b.first_child.data(), b.child_count.data(),
-                a.level.data(),       b.level.data(),       request.depth_cap};
+  const bool literal = !request.test_on_push && request.mode != TraversalMode::Priority;
+  const Trees t{a.spheres.data(),     b.spheres.data(),
+                a.first_child.data(), a.child_count.data(),
+                b.first_child.data(), b.child_count.data(),
+                a.level.data(),       b.level.data(),
+                request.depth_cap,    request.parent_filter && !literal};
   // Seeds: the root pair (Fig. 7: p.1 = root of a, p.2 = root of b, split p.2
   // first), or the previous front, splitting the shallower node first.
   std::vector<WorkPair>& seeds = t_seeds;
@@ -450,13 +568,12 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
       if (p.a < 0 || p.a >= a.num_nodes() || p.b < 0 || p.b >= b.num_nodes())
         throw ParameterError("collide: start_front pair (" + std::to_string(p.a) + ", " +
                              std::to_string(p.b) + ") out of range");
-      seeds.push_back({p.a, p.b, a.level[p.a] >= b.level[p.b] ? 1 : 0});
+      seeds.push_back({p.a, p.b, a.level[p.a] >= b.level[p.b] ? 1 : 0, kAllChildren});
     }
   } else {
-    seeds.push_back({0, 0, 1});
+    seeds.push_back({0, 0, 1, kAllChildren});
   }
   Budget budget(request, start);
-  const bool literal = !request.test_on_push && request.mode != TraversalMode::Priority;
   StopReason reason = StopReason::Completed;
   std::size_t seeded = 0;
   auto seed_into = [&](auto&& push) {

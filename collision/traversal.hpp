@@ -55,6 +55,17 @@ struct CollisionRequest {
   /// pairs enter the list. false = the paper's literal Fig. 7 (pairs tested
   /// when popped). Priority mode always tests on push.
   bool test_on_push = true;
+  /// Parent filter (not in the paper; fast path and Priority mode): when a
+  /// node is split, the children of the pair's other node are also tested,
+  /// once, against it, and later only those that overlap it are tested
+  /// against its children. Conservative for surface contacts as the plain
+  /// traversal is (a point where the surfaces touch lies in every ancestor
+  /// of the two leaves covering it, so a child on its path overlaps the
+  /// other side's node at every step); it prunes leaf pairs whose spheres
+  /// overlap away from both parents, so it reports a subset of the plain
+  /// traversal's pairs. Fewer pairs and, on wrapped trees, fewer tests
+  /// (tests include the filter's own).
+  bool parent_filter = false;
   /// Sphere tests between two clock reads (>= 1); the paper reads it at every test (1).
   int clock_check_interval = 16;
   ClockSource clock = ClockSource::SteadyClock;

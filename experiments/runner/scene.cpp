@@ -228,6 +228,7 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.max_list_size = static_cast<std::size_t>(f.integer("max_list_size", 1 << 14, 8, 1 << 28));
   c.depth_cap = f.integer("depth_cap", -1, -1, 64);
   c.temporal_coherence = f.boolean("temporal_coherence", false);
+  c.parent_filter = f.boolean("parent_filter", false);
   c.layered = f.boolean("layered", true);
   c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", true);
   c.midpoint = f.boolean("midpoint", true);

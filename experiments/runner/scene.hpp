@@ -92,6 +92,10 @@ struct CollisionSpec {
   std::size_t max_list_size = 1 << 14;  ///< priority mode cap
   int depth_cap = -1;                   ///< -1 = none
   bool temporal_coherence = false;
+  /// collision::CollisionRequest::parent_filter (not with fifo_literal). Pays
+  /// only on wrapped trees (layered false): on layered trees it prunes nothing
+  /// and its own tests are extra.
+  bool parent_filter = false;
   /// After each update, grow parents to enclose their children (a layered
   /// tree): the penalty force then grows continuously from first contact.
   /// false keeps the paper's wrapped tree, where a leaf pair can appear

@@ -186,6 +186,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     if (!cs.literal) {
       req.mode = cs.mode;
       req.clock_check_interval = cs.clock_check_interval;
+      req.parent_filter = cs.parent_filter;
     }
     req.max_list_size = cs.max_list_size;
     if (cs.depth_cap >= 0) req.depth_cap = cs.depth_cap;

@@ -72,6 +72,7 @@ int run(int argc, char** argv) {
   int poses = 100;
   unsigned seed = 1;
   double step = 0.5;
+  int parent_filter = 0;
   icd::experiments::CommandLine cli(
       "contact_tightness",
       "  False contacts of sphere trees on two copies of a mesh approaching each other.");
@@ -89,7 +90,9 @@ int run(int argc, char** argv) {
                 }
                 if (gaps.empty()) throw std::invalid_argument("needs at least one gap");
               })
-      .real("--step", step, "UNITS", "marching step towards the touching pose (normalized units)");
+      .real("--step", step, "UNITS", "marching step towards the touching pose (normalized units)")
+      .integer("--parent-filter", parent_filter, "0|1",
+               "traverse with CollisionRequest::parent_filter", 0, 1);
   if (const auto status = cli.parse(argc, argv)) return *status;
   if (!(step > 0)) throw std::invalid_argument("--step must be > 0");
 
@@ -119,6 +122,7 @@ int run(int argc, char** argv) {
     c.tests.assign(gaps.size(), 0.0);
   }
   icd::collision::CollisionRequest full;  // no budget: every overlapping leaf pair
+  full.parent_filter = parent_filter != 0;
   int skipped = 0;
   for (int k = 0; k < poses; ++k) {
     const ApproachPose pose = random_poses.next();
@@ -148,6 +152,7 @@ int run(int argc, char** argv) {
         c.tests[g] += static_cast<double>(leaves.tests);
         icd::collision::CollisionRequest capped;
         capped.depth_cap = a.num_levels() - 2;
+        capped.parent_filter = full.parent_filter;
         const auto upper = icd::collision::collide(a, b, capped);
         c.upper_pairs[g] += static_cast<double>(upper.untested.size() + upper.colliding.size());
       }

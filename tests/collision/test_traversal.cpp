@@ -47,20 +47,51 @@ std::vector<CollisionRequest> all_modes() {
   return v;
 }
 
+// The fast modes with CollisionRequest::parent_filter.
+std::vector<CollisionRequest> filtered_modes() {
+  std::vector<CollisionRequest> v;
+  for (const CollisionRequest& r : all_modes())
+    if (r.test_on_push || r.mode == TraversalMode::Priority) {
+      v.push_back(r);
+      v.back().parent_filter = true;
+    }
+  return v;
+}
+
+std::string describe(const CollisionRequest& r) {
+  return "mode " + std::to_string(int(r.mode)) + " fast " + std::to_string(r.test_on_push) +
+         " filter " + std::to_string(r.parent_filter) + " priority " +
+         std::to_string(int(r.priority));
+}
+
 TEST(Traversal, FullTraversalOfLayeredTreesEqualsBruteForceLeafPairs) {
   const Scene s = torus_and_sphere(4, true);
   const auto expected = brute_force_leaf_overlaps(s.a, s.b);
   ASSERT_GT(expected.size(), 10u);
-  for (const CollisionRequest& r : all_modes()) {
+  // The parent filter prunes nothing here: in a layered tree a child lies in
+  // its parent, so a child overlapping the other side overlaps its parent too.
+  auto modes = all_modes();
+  for (const CollisionRequest& r : filtered_modes()) modes.push_back(r);
+  for (const CollisionRequest& r : modes) {
     const CollisionResult res = collide(s.a, s.b, r);
     EXPECT_FALSE(res.interrupted);
     EXPECT_EQ(res.stop_reason, StopReason::Completed);
     EXPECT_TRUE(res.untested.empty());
-    EXPECT_EQ(as_set(res.colliding), expected)
-        << "mode " << int(r.mode) << " fast " << r.test_on_push;
+    EXPECT_EQ(as_set(res.colliding), expected) << describe(r);
     EXPECT_EQ(res.colliding.size(), expected.size());  // no duplicates
     EXPECT_EQ(res.completed_level, 3);
   }
+}
+
+// Every ancestor-or-self of leaf i overlaps every ancestor-or-self of leaf j:
+// then any traversal that prunes on overlaps of ancestors keeps (i, j).
+bool all_ancestor_pairs_overlap(const SphereTree& a, const SphereTree& b,
+                                const std::vector<int32_t>& pa, const std::vector<int32_t>& pb,
+                                int i, int j) {
+  for (int x = i; x >= 0; x = pa[x])
+    for (int y = j; y >= 0; y = pb[y])
+      if (!overlap(a.spheres[x], b.spheres[y])) return false;
+  return true;
 }
 
 TEST(Traversal, WrappedTreesAllModesAgreeAndSitBetweenOracles) {
@@ -74,12 +105,81 @@ TEST(Traversal, WrappedTreesAllModesAgreeAndSitBetweenOracles) {
     EXPECT_EQ(as_set(collide(s.a, s.b, r).colliding), ref_set);
   // Reported leaf pairs overlap; leaf pairs whose every ancestor combination overlaps are reported.
   for (const auto& p : ref_set) EXPECT_TRUE(upper.count(p));
-  for (const auto& [i, j] : upper) {
-    bool all = true;
-    for (int x = i; x >= 0 && all; x = pa[x])
-      for (int y = j; y >= 0 && all; y = pb[y]) all = overlap(s.a.spheres[x], s.b.spheres[y]);
-    if (all) {
+  for (const auto& [i, j] : upper)
+    if (all_ancestor_pairs_overlap(s.a, s.b, pa, pb, i, j)) {
       EXPECT_TRUE(ref_set.count({i, j}));
+    }
+}
+
+// The parent filter's rule for one leaf pair, walked along its path in the
+// pair tree (Fig. 7: b split first, then the sides alternate, a leaf's side
+// skipped): every pair on the path overlaps, and when a split of one side
+// queues two or more pairs (overlapping children of it that it may take,
+// with the other node or one of them still to split), the child taken at the
+// next split of the other side must also overlap the node just split.
+bool filter_rule_reports(const SphereTree& a, const SphereTree& b, const std::vector<int32_t>& pa,
+                         const std::vector<int32_t>& pb, int i, int j) {
+  auto chain = [](const std::vector<int32_t>& parent, int leaf) {
+    std::vector<int> c;
+    for (int n = leaf; n >= 0; n = parent[n]) c.insert(c.begin(), n);
+    return c;
+  };
+  const std::vector<int> ca = chain(pa, i), cb = chain(pb, j);
+  std::size_t ka = 0, kb = 0;
+  bool flag_b = true;
+  std::vector<char> allowed;  // empty: every child of the node split next
+  while (true) {
+    if (!overlap(a.spheres[ca[ka]], b.spheres[cb[kb]])) return false;
+    const bool ea = ka + 1 < ca.size(), eb = kb + 1 < cb.size();
+    if (!ea && !eb) return true;
+    const bool split_b = flag_b ? eb : (!ea && eb);
+    const SphereTree& ts = split_b ? b : a;  // the split side
+    const SphereTree& to = split_b ? a : b;
+    const int x = split_b ? cb[kb] : ca[ka], y = split_b ? ca[ka] : cb[kb];
+    const int taken = split_b ? cb[kb + 1] : ca[ka + 1];
+    if (!allowed.empty() && !allowed[taken - ts.first_child[x]]) return false;
+    const bool y_splits = !to.is_leaf(y);
+    int queued = 0;
+    for (int k = 0; k < ts.child_count[x]; ++k) {
+      const int c = ts.first_child[x] + k;
+      const bool may = allowed.empty() || allowed[k];
+      queued += may && overlap(ts.spheres[c], to.spheres[y]) && (y_splits || !ts.is_leaf(c));
+    }
+    allowed.clear();
+    if (y_splits && queued >= 2)
+      for (int k = 0; k < to.child_count[y]; ++k)
+        allowed.push_back(overlap(to.spheres[to.first_child[y] + k], ts.spheres[x]));
+    (split_b ? kb : ka) += 1;
+    flag_b = !split_b;
+  }
+}
+
+TEST(Traversal, ParentFilterReportsExactlyItsRuleAndPrunesOnWrappedTrees) {
+  // The octree's cell spheres nest, so the filter would prune nothing there:
+  // inner spheres shrunk make children stick out of their parents, as in a
+  // wrapped tree (the rule needs no covering).
+  for (int levels : {4, 5}) {
+    Scene s = torus_and_sphere(levels, false);
+    for (SphereTree* t : {&s.a, &s.b})
+      for (int i = 0; i < t->num_nodes(); ++i)
+        if (!t->is_leaf(i)) t->spheres[i].r *= 0.8;
+    const auto pa = parents(s.a), pb = parents(s.b);
+    std::set<std::pair<int, int>> expected;
+    for (const auto& [i, j] : brute_force_leaf_overlaps(s.a, s.b))
+      if (filter_rule_reports(s.a, s.b, pa, pb, i, j)) expected.insert({i, j});
+    const CollisionResult plain = collide(s.a, s.b, CollisionRequest{});
+    const auto plain_set = as_set(plain.colliding);
+    // The rule has teeth here: it drops leaf pairs the plain traversal reports.
+    ASSERT_LT(expected.size(), plain_set.size());
+    ASSERT_GT(expected.size(), 10u);
+    for (const auto& p : expected) EXPECT_TRUE(plain_set.count(p));
+    for (const CollisionRequest& r : filtered_modes()) {
+      const CollisionResult res = collide(s.a, s.b, r);
+      EXPECT_FALSE(res.interrupted);
+      EXPECT_TRUE(res.untested.empty());
+      EXPECT_EQ(as_set(res.colliding), expected) << describe(r);
+      EXPECT_EQ(res.colliding.size(), expected.size()) << describe(r);  // no duplicates
+      EXPECT_LT(res.tests, plain.tests) << describe(r);                 // filter tests included
     }
   }
 }
@@ -103,9 +203,12 @@ void expect_cut_covers(const SphereTree& a, const SphereTree& b,
 
 TEST(Traversal, InterruptedAtAnyTestBudgetIsConservativeOnThePairTree) {
   const Scene s = torus_and_sphere(4, false);
-  const CollisionResult full = collide(s.a, s.b, CollisionRequest{});
-  const auto full_set = as_set(full.colliding);
-  for (CollisionRequest r : all_modes()) {
+  auto modes = all_modes();
+  for (const CollisionRequest& r : filtered_modes()) modes.push_back(r);
+  for (CollisionRequest r : modes) {
+    // The full traversal of the same request (the filter's set is smaller).
+    const CollisionResult full = collide(s.a, s.b, r);
+    const auto full_set = as_set(full.colliding);
     for (int64_t budget = 0; budget <= full.tests + 10; budget += 1 + budget / 3) {
       r.budget_tests = budget;
       const CollisionResult res = collide(s.a, s.b, r);
@@ -124,9 +227,11 @@ TEST(Traversal, InterruptedByTheClockIsConservativeOnThePairTree) {
   // of the full traversal (the stop point varies from run to run; the
   // property may not).
   const Scene s = torus_and_sphere(4, false);
-  const auto full_set = as_set(collide(s.a, s.b, CollisionRequest{}).colliding);
   int interrupted = 0;
-  for (CollisionRequest r : all_modes()) {
+  auto modes = all_modes();
+  for (const CollisionRequest& r : filtered_modes()) modes.push_back(r);
+  for (CollisionRequest r : modes) {
+    const auto full_set = as_set(collide(s.a, s.b, r).colliding);
     for (ClockSource clock : {ClockSource::SteadyClock, ClockSource::CycleCounter}) {
       for (double budget : {1e-7, 1e-6, 3e-6, 1e-5, 3e-5, 1e-4}) {
         r.budget_seconds = budget;
@@ -196,34 +301,49 @@ TEST(Traversal, DepthCapStopsAtTheLevel) {
 }
 
 TEST(Traversal, TemporalCoherenceFrontIsConservative) {
-  for (bool make_layered : {true, false}) {
-    Scene s = torus_and_sphere(4, make_layered);
-    CollisionRequest r;
-    r.record_front = true;
-    CollisionResult prev = collide(s.a, s.b, r);
-    // Move b a little each frame; starting from the previous front must find
-    // what a query from the roots finds (exactly so for layered trees; for
-    // wrapped trees it may keep pairs whose ancestors separated).
-    for (int frame = 1; frame <= 5; ++frame) {
-      for (Sphere& sp : s.b.spheres) {
-        sp.x += 0.03;
-        sp.y -= 0.01;
+  for (bool make_layered : {true, false})
+    for (bool filter : {false, true}) {
+      Scene s = torus_and_sphere(4, make_layered);
+      CollisionRequest r;
+      r.record_front = true;
+      r.parent_filter = filter;
+      CollisionRequest from_roots_request;
+      from_roots_request.parent_filter = filter;
+      CollisionResult prev = collide(s.a, s.b, r);
+      // Move b a little each frame; starting from the previous front must find
+      // what a query from the roots finds (exactly so for layered trees; for
+      // wrapped trees it may keep pairs whose ancestors separated).
+      for (int frame = 1; frame <= 5; ++frame) {
+        for (Sphere& sp : s.b.spheres) {
+          sp.x += 0.03;
+          sp.y -= 0.01;
+        }
+        const auto from_roots = as_set(collide(s.a, s.b, from_roots_request).colliding);
+        CollisionRequest rf = r;
+        rf.start_front = &prev.front;
+        const CollisionResult from_front = collide(s.a, s.b, rf);
+        const auto got = as_set(from_front.colliding);
+        if (make_layered) {
+          EXPECT_EQ(got, from_roots) << "frame " << frame;
+        } else if (filter) {
+          // From the front the filter has no parents above it, and which splits
+          // make a mask depends on the pairs beside: the sets need not nest, but
+          // every leaf pair all of whose ancestor pairs overlap is kept.
+          const auto pa = parents(s.a), pb = parents(s.b);
+          const auto upper = brute_force_leaf_overlaps(s.a, s.b);
+          for (const auto& [i, j] : upper)
+            if (all_ancestor_pairs_overlap(s.a, s.b, pa, pb, i, j)) {
+              EXPECT_TRUE(got.count({i, j})) << "frame " << frame;
+            }
+          for (const auto& p : got) EXPECT_TRUE(upper.count(p)) << "frame " << frame;
+        } else {
+          for (const auto& p : from_roots) EXPECT_TRUE(got.count(p)) << "frame " << frame;
+          const auto upper = brute_force_leaf_overlaps(s.a, s.b);
+          for (const auto& p : got) EXPECT_TRUE(upper.count(p)) << "frame " << frame;
+        }
+        prev = from_front;
       }
-      const auto from_roots = as_set(collide(s.a, s.b, CollisionRequest{}).colliding);
-      CollisionRequest rf = r;
-      rf.start_front = &prev.front;
-      const CollisionResult from_front = collide(s.a, s.b, rf);
-      const auto got = as_set(from_front.colliding);
-      if (make_layered) {
-        EXPECT_EQ(got, from_roots) << "frame " << frame;
-      } else {
-        for (const auto& p : from_roots) EXPECT_TRUE(got.count(p)) << "frame " << frame;
-        const auto upper = brute_force_leaf_overlaps(s.a, s.b);
-        for (const auto& p : got) EXPECT_TRUE(upper.count(p)) << "frame " << frame;
-      }
-      prev = from_front;
     }
-  }
 }
 
 TEST(Traversal, TemporalCoherenceRefinesInterruptedQueriesOverFrames) {

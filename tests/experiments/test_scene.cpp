@@ -36,6 +36,13 @@ TEST(Scene, ParsesDefaultsAndFields) {
   EXPECT_EQ(s.collision.budget_tests, 100);
   EXPECT_EQ(s.collision.mode, collision::TraversalMode::Priority);
   EXPECT_TRUE(std::isinf(s.collision.budget_seconds));  // a test budget alone
+  EXPECT_FALSE(s.collision.parent_filter);
+  EXPECT_TRUE(s.collision.layered);
+  const Scene f = parse(with_objects(
+      R"({"name": "a", "primitive": {"type": "sphere", "radius": 0.2}})",
+      R"("collision": {"parent_filter": true, "layered": false})"));
+  EXPECT_TRUE(f.collision.parent_filter);
+  EXPECT_FALSE(f.collision.layered);
 }
 
 // Every bad field gets an InputError naming the file and the field.

@@ -14,6 +14,7 @@
 
 #include <Eigen/Geometry>
 
+#include "collision/contact_oracle.hpp"
 #include "collision/sphere_tree.hpp"
 #include "mesh/io/error.hpp"
 #include "mesh/io/primitives.hpp"
@@ -762,6 +763,39 @@ TEST(SphereTreeBuilder, RegroupParentsKeepsTheLeavesAndEveryGuarantee) {
     return sum;
   };
   EXPECT_LT(inner_radii(build), inner_radii(plain));
+}
+
+TEST(SphereTreeBuilder, ParentFilterFindsEveryContactOfInterlockedWrappedTrees) {
+  // The query's parent filter (CollisionRequest::parent_filter) is
+  // conservative because every node covers its subtree's surface patch, which
+  // the builder guarantees; its trees are wrapped (children stick out of their
+  // parents), so the filter prunes pairs here. Two copies of the torus' tree,
+  // the second turned 90 degrees about x and moved through the first's tube.
+  const Case torus = cases()[2];
+  SphereTreeOptions o = small_options();
+  o.depth = 3;  // the filter's first test that can fail: a leaf against a level-1 node
+  const icd::collision::SphereTree ta = build_sphere_tree(torus.mesh, o).tree;
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Vector3d shift(1.9, 0.1, 0.05);
+  icd::SurfaceMesh b = torus.mesh;
+  b.V = (b.V * R.transpose()).eval();
+  b.V.rowwise() += shift.transpose();
+  icd::collision::SphereTree tb = ta;
+  for (auto& sp : tb.spheres) {
+    const Eigen::Vector3d c = R * sp.center() + shift;
+    sp.x = c.x(), sp.y = c.y(), sp.z = c.z();
+  }
+  tb.rest_spheres = tb.spheres;
+  const auto points = icd::collision::testing::contact_points(torus.mesh.V, torus.mesh.F, b.V, b.F);
+  // Every contact point under a reported pair, every mode, with and without
+  // the filter, at every test budget.
+  icd::collision::testing::check_all_budgets(ta, tb, points);
+  icd::collision::CollisionRequest filtered;
+  filtered.parent_filter = true;
+  const auto plain_result = icd::collision::collide(ta, tb, icd::collision::CollisionRequest{});
+  const auto filtered_result = icd::collision::collide(ta, tb, filtered);
+  EXPECT_LT(filtered_result.colliding.size(), plain_result.colliding.size());
 }
 
 TEST(SphereTreeBuilder, RejectsBadOptionsAndMeshes) {
