@@ -1,6 +1,7 @@
 #include "collision/traversal.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -13,22 +14,30 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Every child of the node split next may be tested (see WorkPair::allowed).
-constexpr uint32_t kAllChildren = ~uint32_t{0};
-
-// A pair being refined. `split_b`: the node to split next is b (the paper's
-// p.2); the flag flips at every generated pair, which is Fig. 7's swap.
-// `allowed`: bit j set when child j of the node split next may overlap (with
+// A pair being refined. `split`: the node to split next is b (the paper's
+// p.2) when 1; the flag flips at every generated pair, which is Fig. 7's swap.
+// `mask`: bit j set when child j of the node split next may overlap (with
 // CollisionRequest::parent_filter: it overlaps the node the pair's other node
-// was split from); children past the 32nd are always allowed.
+// was split from); children past the 31st are always allowed.
 struct WorkPair {
   int32_t a;
   int32_t b;
-  int32_t split_b;
-  uint32_t allowed = kAllChildren;
+  int32_t split;
+  uint32_t mask;
+  static constexpr uint32_t kAll = ~uint32_t{0};
+  bool split_b() const { return split != 0; }
+  uint32_t allowed() const { return mask; }
+  void set_allowed(uint32_t m) { mask = m; }
 };
+constexpr int32_t kMaskedChildren = 31;  // children a mask can rule out
 
-inline bool is_allowed(uint32_t allowed, int32_t j) { return j >= 32 || ((allowed >> j) & 1u); }
+inline WorkPair work_pair(int32_t a, int32_t b, bool split_b, uint32_t allowed = WorkPair::kAll) {
+  return {a, b, split_b ? 1 : 0, allowed};
+}
+
+inline bool is_allowed(uint32_t allowed, int32_t j) {
+  return j >= kMaskedChildren || ((allowed >> j) & 1u);
+}
 
 // Growable ring buffer (FIFO), storage kept between queries of a thread.
 class PairQueue {
@@ -117,7 +126,7 @@ class PairStack {
 double output_seconds_per_pair() {
   static const double cost = [] {
     constexpr std::size_t n = 1 << 16;
-    std::vector<WorkPair> src(n, WorkPair{1, 2, 0});
+    std::vector<WorkPair> src(n, work_pair(1, 2, false));
     std::vector<NodePair> dst;
     dst.reserve(n);
     double best = 1.0;
@@ -245,7 +254,7 @@ inline void settle(const Trees& t, int32_t a, int32_t b, CollisionResult& res) {
 // `split_b` and b is expandable, otherwise a (the swap for a leaf).
 inline bool choose_split_b(const Trees& t, const WorkPair& p) {
   const bool eb = t.expandable_b(p.b);
-  return p.split_b ? eb : !t.expandable_a(p.a) && eb;
+  return p.split_b() ? eb : !t.expandable_a(p.a) && eb;
 }
 
 // One split: the children [first, end) of one node of `p` (b's when
@@ -256,21 +265,21 @@ struct Split {
   int32_t first, end;
   int32_t other;
   bool other_expandable;
-  int32_t next_flag;
+  bool next_split_b;
   Split(const Trees& t, const WorkPair& p) {
     split_b = choose_split_b(t, p);
     first = split_b ? t.fcb[p.b] : t.fca[p.a];
     end = first + (split_b ? t.ccb[p.b] : t.cca[p.a]);
     other = split_b ? p.a : p.b;
     other_expandable = split_b ? t.expandable_a(p.a) : t.expandable_b(p.b);
-    next_flag = split_b ? 0 : 1;
+    next_split_b = !split_b;
   }
   // Tests of the parent filter for this split: other's children (the first
-  // 32) against the split node; 0 when the filter is off or other will not be
+  // 31) against the split node; 0 when the filter is off or other will not be
   // split.
   int32_t filter_tests(const Trees& t) const {
     if (!t.parent_filter || !other_expandable) return 0;
-    return std::min<int32_t>(split_b ? t.cca[other] : t.ccb[other], 32);
+    return std::min<int32_t>(split_b ? t.cca[other] : t.ccb[other], kMaskedChildren);
   }
 };
 
@@ -282,7 +291,7 @@ struct Split {
 constexpr std::size_t kMaskFromPairs = 2;
 
 // The parent filter's tests of one split: the other node's children (the
-// first 32; later ones are always allowed) against the split node. Bit j of
+// first 31; later ones are always allowed) against the split node. Bit j of
 // the mask: child j overlaps it.
 struct FilterTests {
   Sphere split;
@@ -295,68 +304,73 @@ struct FilterTests {
   uint32_t bit(int32_t j) const { return static_cast<uint32_t>(overlap(split, kids[j])) << j; }
 };
 
-thread_local std::vector<WorkPair> t_found;  // overlapping children of one split
-
 // Tests the allowed children of the split node against the other node one at
 // a time, each under the budget: an overlapping pair that can be split further
 // goes to `queue(WorkPair)`, one that cannot is settled; children the parent
-// filter rules out count as pruned. Then, with the filter, the other node's
-// children are tested against the split node (under the budget too) to make
-// the queued pairs' mask. `pending()` is the current size of the work list
-// (for the budget's reserve). Returns false when the budget stopped it (the
-// untested children are then reported; pairs found so far are queued with
-// every child allowed).
+// filter rules out count as pruned. When the filter may make a mask, the
+// overlapping pairs among the first 64 children are held back (as bits) until
+// the other node's children have been tested against the split node (under
+// the budget too). `pending()` is the current size of the work list (for the
+// budget's reserve). Returns false when the budget stopped it (the untested
+// children are then reported; pairs held back are queued with every child
+// allowed).
 template <class PendingSize, class Queue>
 bool test_children_one_by_one(const Trees& t, const WorkPair& p, const Split& s, Budget& budget,
                               bool record_front, CollisionResult& res, PendingSize pending,
                               Queue queue) {
   StopReason reason = StopReason::Completed;
-  std::vector<WorkPair>& found = t_found;
-  found.clear();
+  const bool may_mask = s.filter_tests(t) > 0;
+  uint64_t held = 0;  // bit k: child first + k overlaps and waits for the mask
+  std::size_t num_held = 0, num_queued = 0;  // queued: held or not
+  auto pair_of = [&](int32_t c) { return s.split_b ? NodePair{p.a, c} : NodePair{c, p.b}; };
   auto flush = [&](uint32_t mask) {
-    for (WorkPair& f : found) {
-      f.allowed = mask;
-      queue(f);
+    for (uint64_t bits = held; bits != 0; bits &= bits - 1) {
+      const NodePair q = pair_of(s.first + std::countr_zero(bits));
+      queue(work_pair(q.a, q.b, s.next_split_b, mask));
     }
   };
   for (int32_t c = s.first; c < s.end; ++c) {
-    const int32_t a = s.split_b ? p.a : c, b = s.split_b ? c : p.b;
-    if (!is_allowed(p.allowed, c - s.first)) {  // misses the other side's parent
-      if (record_front) res.front.push_back({a, b});
+    const NodePair q = pair_of(c);
+    if (!is_allowed(p.allowed(), c - s.first)) {  // misses the other side's parent
+      if (record_front) res.front.push_back(q);
       continue;
     }
-    if (!budget.allow(res.tests, pending() + found.size(), reason)) {
+    if (!budget.allow(res.tests, pending() + num_held, reason)) {
       for (int32_t r = c; r < s.end; ++r) {
-        const NodePair rest = s.split_b ? NodePair{p.a, r} : NodePair{r, p.b};
-        if (is_allowed(p.allowed, r - s.first))
-          res.untested.push_back(rest);
+        if (is_allowed(p.allowed(), r - s.first))
+          res.untested.push_back(pair_of(r));
         else if (record_front)
-          res.front.push_back(rest);  // pruned by the filter: still part of the cut
+          res.front.push_back(pair_of(r));  // pruned by the filter: still part of the cut
       }
-      flush(kAllChildren);
+      flush(WorkPair::kAll);
       res.interrupted = true;
       res.stop_reason = reason;
       return false;
     }
     ++res.tests;
-    if (!t.overlaps(a, b)) {
-      if (record_front) res.front.push_back({a, b});
+    if (!t.overlaps(q.a, q.b)) {
+      if (record_front) res.front.push_back(q);
       continue;
     }
-    if (t.expandable_a(a) || t.expandable_b(b))
-      found.push_back({a, b, s.next_flag, kAllChildren});
-    else
-      settle(t, a, b, res);
+    if (!t.expandable_a(q.a) && !t.expandable_b(q.b)) {
+      settle(t, q.a, q.b, res);
+    } else if (may_mask && c - s.first < 64) {
+      held |= uint64_t{1} << (c - s.first);
+      ++num_held, ++num_queued;
+    } else {
+      queue(work_pair(q.a, q.b, s.next_split_b));
+      ++num_queued;
+    }
   }
-  if (found.size() < kMaskFromPairs || s.filter_tests(t) == 0) {
-    flush(kAllChildren);
+  if (!may_mask || num_queued < kMaskFromPairs) {
+    flush(WorkPair::kAll);
     return true;
   }
   const FilterTests f(t, s, p);
   uint32_t mask = 0;
   for (int32_t j = 0; j < f.count; ++j) {
-    if (!budget.allow(res.tests, pending() + found.size(), reason)) {
-      flush(kAllChildren);  // stopped: the pairs are reported unrefined anyway
+    if (!budget.allow(res.tests, pending() + num_held, reason)) {
+      flush(WorkPair::kAll);  // stopped: the pairs are reported unrefined anyway
       res.interrupted = true;
       res.stop_reason = reason;
       return false;
@@ -390,14 +404,16 @@ void run_literal(const Trees& t, List& list, Budget& budget, bool record_front,
       settle(t, p.a, p.b, res);
       continue;
     }
-    const bool split2_is_b = p.split_b != 0;
+    const bool split2_is_b = p.split_b();
     const bool split2_expandable = split2_is_b ? eb : ea;
     if (!split2_expandable) {  // p.2 is a leaf, p.1 is not: push the swapped pair
-      list.push({p.a, p.b, !p.split_b});
+      list.push(work_pair(p.a, p.b, !p.split_b()));
     } else if (split2_is_b) {
-      for (int32_t c = t.fcb[p.b], e = c + t.ccb[p.b]; c < e; ++c) list.push({p.a, c, 0});
+      for (int32_t c = t.fcb[p.b], e = c + t.ccb[p.b]; c < e; ++c)
+        list.push(work_pair(p.a, c, false));
     } else {
-      for (int32_t c = t.fca[p.a], e = c + t.cca[p.a]; c < e; ++c) list.push({c, p.b, 1});
+      for (int32_t c = t.fca[p.a], e = c + t.cca[p.a]; c < e; ++c)
+        list.push(work_pair(c, p.b, true));
     }
     res.peak_list_size = std::max(res.peak_list_size, list.size());
   }
@@ -407,57 +423,67 @@ void run_literal(const Trees& t, List& list, Budget& budget, bool record_front,
 
 // Tests the allowed children of the split node against the other node of `p`
 // and queues the overlapping pairs (SplitB: the children are b's), then, with
-// the parent filter, sets the queued pairs' mask. No budget event may fall
-// inside (see Budget::batch_ok). Returns the number of tests.
-template <bool SplitB, class List>
-inline int64_t expand_batch(const Trees& t, const WorkPair& p, const Split& s, List& list,
-                            CollisionResult& res) {
+// the parent filter (Filter), sets the queued pairs' mask. No budget event may
+// fall inside (see Budget::batch_ok). Without the filter this is the plain
+// loop: every child tested, nothing more.
+template <bool SplitB, bool Filter, class List>
+inline void expand_batch(const Trees& t, const WorkPair& p, const Split& s, List& list,
+                         CollisionResult& res) {
   const Sphere o = SplitB ? t.sa[p.a] : t.sb[p.b];
   const Sphere* kids = SplitB ? t.sb : t.sa;
-  const std::size_t before = list.size();
-  int64_t tests = 0;
-  for (int32_t c = s.first; c < s.end; ++c) {
-    if (!is_allowed(p.allowed, c - s.first)) continue;
-    ++tests;
+  auto test = [&](int32_t c) {
+    ++res.tests;
     const Sphere& k = kids[c];
     const double dx = o.x - k.x, dy = o.y - k.y, dz = o.z - k.z, rr = o.r + k.r;
     const bool ov = dx * dx + dy * dy + dz * dz <= rr * rr;
     const int32_t a = SplitB ? p.a : c, b = SplitB ? c : p.b;
     if (s.other_expandable || (SplitB ? t.expandable_b(c) : t.expandable_a(c)))
-      list.push_if({a, b, s.next_flag, kAllChildren}, ov);
+      list.push_if(work_pair(a, b, s.next_split_b), ov);
     else if (ov)
       settle(t, a, b, res);
+  };
+  if constexpr (!Filter) {
+    for (int32_t c = s.first; c < s.end; ++c) test(c);
+  } else {
+    const std::size_t before = list.size();
+    const int32_t n = s.end - s.first;
+    if (n <= 64) {
+      // Only the allowed children, by their bits: no branch per ruled-out child.
+      uint64_t todo = n == 64 ? ~uint64_t{0} : (uint64_t{1} << n) - 1;
+      todo &= p.allowed() | ~((uint64_t{1} << kMaskedChildren) - 1);
+      for (; todo != 0; todo &= todo - 1) test(s.first + std::countr_zero(todo));
+    } else {
+      for (int32_t c = s.first; c < s.end; ++c)
+        if (is_allowed(p.allowed(), c - s.first)) test(c);
+    }
+    const std::size_t queued = list.size() - before;
+    if (queued >= kMaskFromPairs && s.filter_tests(t) > 0) {
+      const FilterTests f(t, s, p);
+      uint32_t mask = 0;
+      for (int32_t j = 0; j < f.count; ++j) mask |= f.bit(j);
+      res.tests += f.count;
+      list.for_last(queued, [mask](WorkPair& w) { w.set_allowed(mask); });
+    }
   }
-  res.tests += tests;
-  const std::size_t queued = list.size() - before;
-  if (queued >= kMaskFromPairs && s.filter_tests(t) > 0) {
-    const FilterTests f(t, s, p);
-    uint32_t mask = 0;
-    for (int32_t j = 0; j < f.count; ++j) mask |= f.bit(j);
-    res.tests += f.count;
-    tests += f.count;
-    list.for_last(queued, [mask](WorkPair& w) { w.allowed = mask; });
-  }
-  return tests;
 }
 
 // Fast path: children are tested as they are generated; the list holds only
 // overlapping pairs that still need splitting.
-template <class List>
+template <bool Filter, class List>
 void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, CollisionResult& res) {
   bool stopped = false;
   while (!list.empty() && !stopped) {
     const WorkPair p = list.pop();
     const Split s(t, p);
-    const int64_t most = (s.end - s.first) + s.filter_tests(t);
+    const int64_t most = (s.end - s.first) + (Filter ? s.filter_tests(t) : 0);
     if (!record_front && budget.batch_ok(res.tests, most)) {
       // Batch: no budget event inside; children tested against the fixed
       // sphere with branch-free pushes of the overlapping ones.
       list.ensure(static_cast<std::size_t>(s.end - s.first));
       if (s.split_b)
-        expand_batch<true>(t, p, s, list, res);
+        expand_batch<true, Filter>(t, p, s, list, res);
       else
-        expand_batch<false>(t, p, s, list, res);
+        expand_batch<false, Filter>(t, p, s, list, res);
       res.peak_list_size = std::max(res.peak_list_size, list.size());
       continue;
     }
@@ -484,12 +510,17 @@ inline double priority_of(PriorityKey key, const Sphere& p, const Sphere& q) {
 void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, PriorityKey key,
                   Budget& budget, bool record_front, CollisionResult& res) {
   bool stopped = false;
+  auto push = [&](const WorkPair& w) {
+    heap.push_back({priority_of(key, t.sa[w.a], t.sb[w.b]), w});
+    std::push_heap(heap.begin(), heap.end());
+  };
   while (!heap.empty() && !stopped) {
     std::pop_heap(heap.begin(), heap.end());
     const WorkPair p = heap.back().p;
     heap.pop_back();
-    const Split s(t, p);
-    const int32_t count = s.end - s.first;
+    const bool split_b = choose_split_b(t, p);
+    const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a];
+    const int32_t count = split_b ? t.ccb[p.b] : t.cca[p.a];
     if (heap.size() + static_cast<std::size_t>(count) > cap) {
       // Full: give up the lower-priority half (reported unrefined), keep the rest.
       std::sort(heap.begin(), heap.end());
@@ -499,12 +530,32 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
       heap.erase(heap.begin(), heap.begin() + std::min(drop, heap.size()));
       std::make_heap(heap.begin(), heap.end());
     }
-    stopped = !test_children_one_by_one(
-        t, p, s, budget, record_front, res, [&] { return heap.size(); },
-        [&](const WorkPair& w) {
-          heap.push_back({priority_of(key, t.sa[w.a], t.sb[w.b]), w});
-          std::push_heap(heap.begin(), heap.end());
-        });
+    if (t.parent_filter) {
+      stopped = !test_children_one_by_one(
+          t, p, Split(t, p), budget, record_front, res, [&] { return heap.size(); }, push);
+    } else {
+      // The plain loop (measured: the general one costs up to 2x here).
+      StopReason reason = StopReason::Completed;
+      for (int32_t c = first; c < first + count; ++c) {
+        const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
+        if (!budget.allow(res.tests, heap.size(), reason)) {
+          for (int32_t r = c; r < first + count; ++r)
+            res.untested.push_back(split_b ? NodePair{p.a, r} : NodePair{r, p.b});
+          res.interrupted = true;
+          res.stop_reason = reason;
+          stopped = true;
+          break;
+        }
+        ++res.tests;
+        if (!t.overlaps(a, b)) {
+          if (record_front) res.front.push_back({a, b});
+        } else if (t.expandable_a(a) || t.expandable_b(b)) {
+          push(work_pair(a, b, !split_b));
+        } else {
+          settle(t, a, b, res);
+        }
+      }
+    }
     res.peak_list_size = std::max(res.peak_list_size, heap.size());
   }
   res.untested.reserve(res.untested.size() + heap.size());
@@ -568,10 +619,10 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
       if (p.a < 0 || p.a >= a.num_nodes() || p.b < 0 || p.b >= b.num_nodes())
         throw ParameterError("collide: start_front pair (" + std::to_string(p.a) + ", " +
                              std::to_string(p.b) + ") out of range");
-      seeds.push_back({p.a, p.b, a.level[p.a] >= b.level[p.b] ? 1 : 0, kAllChildren});
+      seeds.push_back(work_pair(p.a, p.b, a.level[p.a] >= b.level[p.b]));
     }
   } else {
-    seeds.push_back({0, 0, 1, kAllChildren});
+    seeds.push_back(work_pair(0, 0, true));
   }
   Budget budget(request, start);
   StopReason reason = StopReason::Completed;
@@ -617,7 +668,10 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
         for (const WorkPair& s : seeds) list.push(s);
         run_literal(t, list, budget, request.record_front, res);
       } else if (seed_into([&](const WorkPair& s) { list.push(s); })) {
-        run_fast(t, list, budget, request.record_front, res);
+        if (t.parent_filter)
+          run_fast<true>(t, list, budget, request.record_front, res);
+        else
+          run_fast<false>(t, list, budget, request.record_front, res);
       } else {
         list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
       }

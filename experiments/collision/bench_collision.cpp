@@ -93,6 +93,7 @@ void BM_FullTraversal(benchmark::State& state) {
   for (auto _ : state) collide(d->a.tree, d->b.tree, r, res);
   state.counters["tests"] = double(res.tests);
   state.counters["leaf_pairs"] = double(res.colliding.size());
+  state.counters["peak"] = double(res.peak_list_size);
   state.SetItemsProcessed(state.iterations() * res.tests);  // items = sphere tests
 }
 // 0: literal Fig. 7, 1: fast FIFO, 2: fast DFS, 3: priority
