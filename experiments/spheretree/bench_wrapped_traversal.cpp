@@ -9,7 +9,8 @@
 // surfaces first touch, i.e. the hardest case for a sphere tree (every leaf
 // pair reported is a false contact). One iteration runs the 32 queries.
 // Counters: sphere tests and leaf pairs per query. Compare filter=1 against
-// filter=0 of the same tree and mode, within one run.
+// filter=0 of the same tree and mode, within one run. BM_NearContactTestBudget:
+// the same queries interrupted by a budget of sphere tests.
 // Run: build/experiments/spheretree/bench_wrapped_traversal [--benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
@@ -104,6 +105,37 @@ void BM_NearContact(benchmark::State& state) {
 BENCHMARK(BM_NearContact)
     ->ArgsProduct({{0, 1}, {0, 1}, {0, 1, 2}, {0, 1}})
     ->ArgNames({"model", "tree", "mode", "filter"})
+    ->Unit(benchmark::kMicrosecond);
+
+// The same queries under a budget of sphere tests (fast FIFO): what an
+// interrupted query answers. Args: model, tree, budget (tests), filter.
+// Counters per query: reported pairs (colliding + untested; fewer is
+// tighter), completed level (deeper is tighter), interrupted share.
+void BM_NearContactTestBudget(benchmark::State& state) {
+  const Workload* w =
+      workload(state, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  if (!w) return;
+  icd::collision::CollisionRequest r;
+  r.budget_tests = state.range(2);
+  r.parent_filter = state.range(3) != 0;
+  icd::collision::CollisionResult res;
+  int64_t reported = 0, level = 0, interrupted = 0;
+  for (auto _ : state) {
+    for (const SphereTree& b : w->b) {
+      icd::collision::collide(w->a, b, r, res);
+      reported += static_cast<int64_t>(res.colliding.size() + res.untested.size());
+      level += res.completed_level;
+      interrupted += res.interrupted ? 1 : 0;
+    }
+  }
+  const double queries = static_cast<double>(state.iterations()) * kPoses;
+  state.counters["reported"] = static_cast<double>(reported) / queries;
+  state.counters["level"] = static_cast<double>(level) / queries;
+  state.counters["interrupted"] = static_cast<double>(interrupted) / queries;
+}
+BENCHMARK(BM_NearContactTestBudget)
+    ->ArgsProduct({{0, 1}, {0, 1}, {100, 200}, {0, 1}})
+    ->ArgNames({"model", "tree", "budget", "filter"})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
