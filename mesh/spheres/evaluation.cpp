@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -18,6 +20,22 @@ namespace icd::mesh {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Seed of a sphere's random draws from its geometry (the bits of x, y, z, r
+// mixed with splitmix64's finalizer), so that the estimates do not depend on
+// the order of the spheres in the tree.
+unsigned geometry_seed(const collision::Sphere& s, uint64_t salt) {
+  uint64_t h = salt;
+  for (double v : {s.x, s.y, s.z, s.r}) {
+    uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    h ^= bits + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+    h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+    h ^= h >> 31;
+  }
+  return static_cast<unsigned>(h ^ (h >> 32));
+}
 
 /// Spheres of one level bucketed in a uniform grid; very large spheres are
 /// kept in a separate list tested for every query.
@@ -176,11 +194,11 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     }
     return err;
   };
-  // Random orientations of the 42 probes, per sphere and fixed by its index.
+  // Random orientations of the 42 probes, per sphere and fixed by its geometry.
   const MatX3d unturned42 = probe_directions(1);
-  auto rotated_error = [&](int node, const collision::Sphere& s) {
+  auto rotated_error = [&](const collision::Sphere& s) {
     if (options.probe_rotations == 0) return 0.0;
-    std::mt19937 rng(static_cast<unsigned>(node) * 2246822519u + 977u);
+    std::mt19937 rng(geometry_seed(s, 977u));
     std::normal_distribution<double> normal(0.0, 1.0);
     double sum = 0;
     for (int k = 0; k < options.probe_rotations; ++k) {
@@ -220,7 +238,7 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
     for (int i = begin; i < end; ++i) {
       const auto& s = spheres[static_cast<size_t>(i)];
       const double e42 = sphere_error(s, probes42), e162 = sphere_error(s, probes162);
-      const double e42r = rotated_error(i, s);
+      const double e42r = rotated_error(s);
       m.worst_error_42_rotated = std::max(m.worst_error_42_rotated, e42r);
       m.mean_error_42_rotated += e42r / m.num_spheres;
       m.worst_error_42 = std::max(m.worst_error_42, e42);
@@ -300,7 +318,7 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
       if (depth >= s.r) continue;
       const double r3 = s.r * s.r * s.r, d3 = depth * depth * depth;
       const double part = 4.0 / 3.0 * M_PI * (r3 - d3) / options.shell_samples;
-      std::mt19937 rng(static_cast<unsigned>(begin + i) * 2654435761u + 12345u);
+      std::mt19937 rng(geometry_seed(s, 12345u));
       std::uniform_real_distribution<double> uniform(0.0, 1.0);
       std::normal_distribution<double> normal(0.0, 1.0);
       for (int k = 0; k < options.shell_samples; ++k) {

@@ -20,6 +20,8 @@ struct EvaluationOptions {
   /// sub-triangle's area. Make it much finer than the build's samples.
   double coverage_spacing = 1.0;
   /// Points per sphere of the shell-volume estimate (LevelMetrics::shell_thickness;
+  /// drawn with a seed from the sphere's centre and radius, so the estimate does
+  /// not depend on the order of the spheres;
   /// 0 skips it; >= 0).
   int shell_samples = 256;
   /// Orientation of the probe directions (orthogonal): the probes of a
@@ -44,7 +46,7 @@ struct LevelMetrics {
   double worst_error_162 = 0, mean_error_162 = 0;
   /// The 42-probe error of each sphere averaged over
   /// EvaluationOptions::probe_rotations uniformly random orientations of the
-  /// probes (one set per sphere, fixed seeds); worst and mean over the level.
+  /// probes (one set per sphere, seeded by its centre and radius, so independent of the sphere order); worst and mean over the level.
   /// A tree fitted against one fixed set of probe directions (as the
   /// reference toolkit fits its spheres against its own 42 points) looks
   /// better on those directions than on any other 42; these numbers belong

@@ -162,6 +162,30 @@ TEST(Evaluation, ShellThicknessIsTheUnionVolumeOutsideOverTheArea) {
   EXPECT_THROW(evaluate_sphere_tree(cube, root_over({ball}), options), icd::ParameterError);
 }
 
+TEST(Evaluation, RandomEstimatesDoNotDependOnTheSphereOrder) {
+  // The shell and the rotated-probe errors draw random points per sphere;
+  // the same spheres listed in another order must give the same estimates.
+  const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
+  EvaluationOptions options;
+  options.coverage_spacing = 50.0;
+  options.shell_samples = 64;
+  options.probe_rotations = 4;
+  std::vector<icd::collision::Sphere> leaves;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), ur(0.3, 0.9);
+  for (int i = 0; i < 12; ++i) leaves.push_back({u(rng), u(rng), u(rng), ur(rng)});
+  const auto forward = evaluate_sphere_tree(cube, root_over(leaves), options);
+  std::reverse(leaves.begin(), leaves.end());
+  const auto backward = evaluate_sphere_tree(cube, root_over(leaves), options);
+  ASSERT_GT(forward[1].shell_thickness, 0.0);
+  ASSERT_GT(forward[1].mean_error_42_rotated, 0.0);
+  EXPECT_NEAR(backward[1].shell_thickness, forward[1].shell_thickness,
+              1e-12 * forward[1].shell_thickness);
+  EXPECT_NEAR(backward[1].mean_error_42_rotated, forward[1].mean_error_42_rotated,
+              1e-12 * forward[1].mean_error_42_rotated);
+  EXPECT_EQ(backward[1].worst_error_42_rotated, forward[1].worst_error_42_rotated);
+}
+
 TEST(Evaluation, RejectsBadOptionsAndTrees) {
   const auto cube = icd::make_box_surface({-1, -1, -1}, {1, 1, 1});
   EvaluationOptions bad;
