@@ -16,6 +16,7 @@
 #include "mesh/spheres/parallel.hpp"
 #include "mesh/spheres/point_grid.hpp"
 #include "mesh/spheres/regroup.hpp"
+#include "mesh/spheres/sort_indices.hpp"
 #include "mesh/spheres/sum_exchange.hpp"
 
 namespace icd::mesh {
@@ -128,7 +129,7 @@ std::vector<std::vector<int>> children_members(const std::vector<std::vector<Nod
     auto& u = unions[static_cast<size_t>(parent_of[l][i])];
     u.insert(u.end(), m.begin(), m.end());
   }
-  for (auto& u : unions) std::sort(u.begin(), u.end());
+  for (auto& u : unions) sort_indices(u);
   return unions;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "mesh/io/error.hpp"
+#include "mesh/spheres/sort_indices.hpp"
 
 namespace icd::mesh {
 
@@ -37,8 +38,7 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
     for (int j : order) {
       FittedSphere& sp = spheres[static_cast<size_t>(j)];
       // Samples received earlier in this pass were appended: restore the order.
-      if (!std::is_sorted(sp.members.begin(), sp.members.end()))
-        std::sort(sp.members.begin(), sp.members.end());
+      sort_indices(sp.members);
       if (sp.members.size() <= 1) continue;
       // Members farthest first, popped lazily from a heap (most never leave).
       std::vector<std::pair<double, int>> heap;
@@ -75,8 +75,7 @@ int shrink_by_exchange(const ReductionProblem& problem, std::vector<FittedSphere
       moved_round += static_cast<int>(leaving.size());
     }
     for (auto& other : spheres) {
-      if (!std::is_sorted(other.members.begin(), other.members.end()))
-        std::sort(other.members.begin(), other.members.end());
+      sort_indices(other.members);
     }
     moved_total += moved_round;
     if (moved_round == 0) break;
@@ -144,7 +143,7 @@ int relieve_worst(const ReductionProblem& problem, std::vector<FittedSphere>& sp
       auto& members = spheres[static_cast<size_t>(j)].members;
       members.clear();
       for (const auto& [r, neg] : heaps[static_cast<size_t>(j)]) members.push_back(-neg);
-      std::sort(members.begin(), members.end());
+      sort_indices(members);
     }
   }
   return moves;

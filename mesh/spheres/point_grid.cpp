@@ -6,6 +6,7 @@
 #include <string>
 
 #include "mesh/io/error.hpp"
+#include "mesh/spheres/sort_indices.hpp"
 
 namespace icd::mesh {
 
@@ -86,7 +87,7 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
   // Increasing order: a sort for small results, a scan of flags over all
   // points for large ones (same output, linear time).
   if (out.size() * 16 < m_points.size()) {
-    std::sort(out.begin(), out.end());
+    sort_indices(out);
     return out;
   }
   std::vector<char> hit(m_points.size(), 0);

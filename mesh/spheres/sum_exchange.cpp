@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "mesh/io/error.hpp"
+#include "mesh/spheres/sort_indices.hpp"
 
 namespace icd::mesh {
 
@@ -79,7 +80,7 @@ int lower_error_sum(const ReductionProblem& problem, std::vector<FittedSphere>& 
         spheres[static_cast<size_t>(receiver_of[i])].members.push_back(cap[i]);
       for (const auto& [b, r] : planned) {
         FittedSphere& B = spheres[static_cast<size_t>(b)];
-        std::sort(B.members.begin(), B.members.end());
+        sort_indices(B.members);
         B.radius = r;
         B.error = r - B.depth;
       }
