@@ -48,6 +48,8 @@ PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_ce
   std::vector<int> fill(m_start.begin(), m_start.end() - 1);
   for (size_t i = 0; i < n; ++i)
     m_index[static_cast<size_t>(fill[cell[i]]++)] = static_cast<int>(i);
+  m_by_cell.resize(n);
+  for (size_t t = 0; t < n; ++t) m_by_cell[t] = m_points[static_cast<size_t>(m_index[t])];
 }
 
 size_t PointGrid::linear(int i, int j, int k) const {
@@ -79,8 +81,8 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
       // Cells (i, j, lo.z .. hi.z) are contiguous in the CSR arrays.
       const int begin = m_start[linear(i, j, lo.z())], end = m_start[linear(i, j, hi.z()) + 1];
       for (int t = begin; t < end; ++t) {
-        const int idx = m_index[static_cast<size_t>(t)];
-        if ((m_points[static_cast<size_t>(idx)] - center).squaredNorm() <= r2) out.push_back(idx);
+        if ((m_by_cell[static_cast<size_t>(t)] - center).squaredNorm() <= r2)
+          out.push_back(m_index[static_cast<size_t>(t)]);
       }
     }
   }

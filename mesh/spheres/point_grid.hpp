@@ -39,6 +39,7 @@ class PointGrid {
   int m_dims[3] = {0, 0, 0};                           // cells per axis
   std::vector<int> m_start;  // points of cell c: m_index[m_start[c] .. m_start[c + 1])
   std::vector<int> m_index;
+  std::vector<Eigen::Vector3d> m_by_cell;  // m_points[m_index[t]] at t: scans read in order
 };
 
 }  // namespace icd::mesh
