@@ -531,8 +531,41 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
       std::make_heap(heap.begin(), heap.end());
     }
     if (t.parent_filter) {
-      stopped = !test_children_one_by_one(
-          t, p, Split(t, p), budget, record_front, res, [&] { return heap.size(); }, push);
+      const Split s(t, p);
+      if (!record_front && count <= 64 && budget.batch_ok(res.tests, count + s.filter_tests(t))) {
+        // Batch (no budget event inside), as expand_batch: the allowed
+        // children by their bits, the pairs held until the mask is known.
+        uint64_t todo = count == 64 ? ~uint64_t{0} : (uint64_t{1} << count) - 1;
+        todo &= p.allowed() | ~((uint64_t{1} << kMaskedChildren) - 1);
+        uint64_t held = 0;
+        int num_held = 0;
+        for (; todo != 0; todo &= todo - 1) {
+          const int32_t k = std::countr_zero(todo), c = first + k;
+          const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
+          ++res.tests;
+          if (!t.overlaps(a, b)) continue;
+          if (t.expandable_a(a) || t.expandable_b(b)) {
+            held |= uint64_t{1} << k;
+            ++num_held;
+          } else {
+            settle(t, a, b, res);
+          }
+        }
+        uint32_t mask = WorkPair::kAll;
+        if (static_cast<std::size_t>(num_held) >= kMaskFromPairs && s.filter_tests(t) > 0) {
+          const FilterTests f(t, s, p);
+          mask = 0;
+          for (int32_t j = 0; j < f.count; ++j) mask |= f.bit(j);
+          res.tests += f.count;
+        }
+        for (; held != 0; held &= held - 1) {
+          const int32_t c = first + std::countr_zero(held);
+          push(work_pair(split_b ? p.a : c, split_b ? c : p.b, !split_b, mask));
+        }
+      } else {
+        stopped = !test_children_one_by_one(
+            t, p, s, budget, record_front, res, [&] { return heap.size(); }, push);
+      }
     } else {
       // The plain loop (measured: the general one costs up to 2x here).
       StopReason reason = StopReason::Completed;
