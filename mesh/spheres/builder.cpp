@@ -136,8 +136,8 @@ std::vector<std::vector<int>> children_members(const std::vector<std::vector<Nod
 /// True when the children of every inner node divide its coverage samples:
 /// each sample of a node is a member of exactly one of its children, and the
 /// children hold no other sample (the invariant the later steps rely on).
-bool children_divide_samples(const std::vector<std::vector<Node>>& levels,
-                             const std::vector<std::vector<int>>& parent_of) {
+[[maybe_unused]] bool children_divide_samples(const std::vector<std::vector<Node>>& levels,
+                                              const std::vector<std::vector<int>>& parent_of) {
   for (size_t l = 1; l < levels.size(); ++l) {
     const std::vector<std::vector<int>> unions = children_members(levels, parent_of, l);
     for (size_t p = 0; p < unions.size(); ++p) {
