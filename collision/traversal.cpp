@@ -14,29 +14,34 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A pair being refined. `split`: the node to split next is b (the paper's
-// p.2) when 1; the flag flips at every generated pair, which is Fig. 7's swap.
-// `mask`: bit j set when child j of the node split next may overlap (with
+// Every child of the node split next may be tested (see WorkPair::allowed).
+constexpr uint32_t kAllChildren = ~uint32_t{0};
+constexpr int32_t kMaskedChildren = 31;  // children a mask can rule out
+
+// A pair being refined. `split_b`: the node to split next is b (the paper's
+// p.2); the flag flips at every generated pair, which is Fig. 7's swap.
+// `allowed`: bit j set when child j of the node split next may overlap (with
 // CollisionRequest::parent_filter: it overlaps the node the pair's other node
 // was split from); children past the 31st are always allowed.
 struct WorkPair {
   int32_t a;
   int32_t b;
-  int32_t split;
-  uint32_t mask;
-  static constexpr uint32_t kAll = ~uint32_t{0};
-  bool split_b() const { return split != 0; }
-  uint32_t allowed() const { return mask; }
-  void set_allowed(uint32_t m) { mask = m; }
+  int32_t split_b;
+  uint32_t allowed;
 };
-constexpr int32_t kMaskedChildren = 31;  // children a mask can rule out
 
-inline WorkPair work_pair(int32_t a, int32_t b, bool split_b, uint32_t allowed = WorkPair::kAll) {
+inline WorkPair work_pair(int32_t a, int32_t b, bool split_b, uint32_t allowed = kAllChildren) {
   return {a, b, split_b ? 1 : 0, allowed};
 }
 
 inline bool is_allowed(uint32_t allowed, int32_t j) {
   return j >= kMaskedChildren || ((allowed >> j) & 1u);
+}
+
+// The allowed ones of the first n <= 64 children, as bits.
+inline uint64_t allowed_children(uint32_t allowed, int32_t n) {
+  const uint64_t all = n == 64 ? ~uint64_t{0} : (uint64_t{1} << n) - 1;
+  return all & (allowed | ~((uint64_t{1} << kMaskedChildren) - 1));
 }
 
 // Growable ring buffer (FIFO), storage kept between queries of a thread.
@@ -254,7 +259,7 @@ inline void settle(const Trees& t, int32_t a, int32_t b, CollisionResult& res) {
 // `split_b` and b is expandable, otherwise a (the swap for a leaf).
 inline bool choose_split_b(const Trees& t, const WorkPair& p) {
   const bool eb = t.expandable_b(p.b);
-  return p.split_b() ? eb : !t.expandable_a(p.a) && eb;
+  return p.split_b ? eb : !t.expandable_a(p.a) && eb;
 }
 
 // One split: the children [first, end) of one node of `p` (b's when
@@ -302,6 +307,13 @@ struct FilterTests {
         kids(s.split_b ? t.sa + t.fca[s.other] : t.sb + t.fcb[s.other]),
         count(s.filter_tests(t)) {}
   uint32_t bit(int32_t j) const { return static_cast<uint32_t>(overlap(split, kids[j])) << j; }
+  // The whole mask, its tests counted (no budget event may fall inside).
+  uint32_t mask(CollisionResult& res) const {
+    uint32_t m = 0;
+    for (int32_t j = 0; j < count; ++j) m |= bit(j);
+    res.tests += count;
+    return m;
+  }
 };
 
 // Tests the allowed children of the split node against the other node one at
@@ -331,18 +343,18 @@ bool test_children_one_by_one(const Trees& t, const WorkPair& p, const Split& s,
   };
   for (int32_t c = s.first; c < s.end; ++c) {
     const NodePair q = pair_of(c);
-    if (!is_allowed(p.allowed(), c - s.first)) {  // misses the other side's parent
+    if (!is_allowed(p.allowed, c - s.first)) {  // misses the other side's parent
       if (record_front) res.front.push_back(q);
       continue;
     }
     if (!budget.allow(res.tests, pending() + num_held, reason)) {
       for (int32_t r = c; r < s.end; ++r) {
-        if (is_allowed(p.allowed(), r - s.first))
+        if (is_allowed(p.allowed, r - s.first))
           res.untested.push_back(pair_of(r));
         else if (record_front)
           res.front.push_back(pair_of(r));  // pruned by the filter: still part of the cut
       }
-      flush(WorkPair::kAll);
+      flush(kAllChildren);
       res.interrupted = true;
       res.stop_reason = reason;
       return false;
@@ -363,14 +375,14 @@ bool test_children_one_by_one(const Trees& t, const WorkPair& p, const Split& s,
     }
   }
   if (!may_mask || num_queued < kMaskFromPairs) {
-    flush(WorkPair::kAll);
+    flush(kAllChildren);
     return true;
   }
   const FilterTests f(t, s, p);
   uint32_t mask = 0;
   for (int32_t j = 0; j < f.count; ++j) {
     if (!budget.allow(res.tests, pending() + num_held, reason)) {
-      flush(WorkPair::kAll);  // stopped: the pairs are reported unrefined anyway
+      flush(kAllChildren);  // stopped: the pairs are reported unrefined anyway
       res.interrupted = true;
       res.stop_reason = reason;
       return false;
@@ -404,10 +416,10 @@ void run_literal(const Trees& t, List& list, Budget& budget, bool record_front,
       settle(t, p.a, p.b, res);
       continue;
     }
-    const bool split2_is_b = p.split_b();
+    const bool split2_is_b = p.split_b != 0;
     const bool split2_expandable = split2_is_b ? eb : ea;
     if (!split2_expandable) {  // p.2 is a leaf, p.1 is not: push the swapped pair
-      list.push(work_pair(p.a, p.b, !p.split_b()));
+      list.push(work_pair(p.a, p.b, !p.split_b));
     } else if (split2_is_b) {
       for (int32_t c = t.fcb[p.b], e = c + t.ccb[p.b]; c < e; ++c)
         list.push(work_pair(p.a, c, false));
@@ -449,20 +461,16 @@ inline void expand_batch(const Trees& t, const WorkPair& p, const Split& s, List
     const int32_t n = s.end - s.first;
     if (n <= 64) {
       // Only the allowed children, by their bits: no branch per ruled-out child.
-      uint64_t todo = n == 64 ? ~uint64_t{0} : (uint64_t{1} << n) - 1;
-      todo &= p.allowed() | ~((uint64_t{1} << kMaskedChildren) - 1);
-      for (; todo != 0; todo &= todo - 1) test(s.first + std::countr_zero(todo));
+      for (uint64_t todo = allowed_children(p.allowed, n); todo != 0; todo &= todo - 1)
+        test(s.first + std::countr_zero(todo));
     } else {
       for (int32_t c = s.first; c < s.end; ++c)
-        if (is_allowed(p.allowed(), c - s.first)) test(c);
+        if (is_allowed(p.allowed, c - s.first)) test(c);
     }
     const std::size_t queued = list.size() - before;
     if (queued >= kMaskFromPairs && s.filter_tests(t) > 0) {
-      const FilterTests f(t, s, p);
-      uint32_t mask = 0;
-      for (int32_t j = 0; j < f.count; ++j) mask |= f.bit(j);
-      res.tests += f.count;
-      list.for_last(queued, [mask](WorkPair& w) { w.set_allowed(mask); });
+      const uint32_t mask = FilterTests(t, s, p).mask(res);
+      list.for_last(queued, [mask](WorkPair& w) { w.allowed = mask; });
     }
   }
 }
@@ -535,11 +543,9 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
       if (!record_front && count <= 64 && budget.batch_ok(res.tests, count + s.filter_tests(t))) {
         // Batch (no budget event inside), as expand_batch: the allowed
         // children by their bits, the pairs held until the mask is known.
-        uint64_t todo = count == 64 ? ~uint64_t{0} : (uint64_t{1} << count) - 1;
-        todo &= p.allowed() | ~((uint64_t{1} << kMaskedChildren) - 1);
         uint64_t held = 0;
         int num_held = 0;
-        for (; todo != 0; todo &= todo - 1) {
+        for (uint64_t todo = allowed_children(p.allowed, count); todo != 0; todo &= todo - 1) {
           const int32_t k = std::countr_zero(todo), c = first + k;
           const int32_t a = split_b ? p.a : c, b = split_b ? c : p.b;
           ++res.tests;
@@ -551,13 +557,10 @@ void run_priority(const Trees& t, std::vector<HeapItem>& heap, std::size_t cap, 
             settle(t, a, b, res);
           }
         }
-        uint32_t mask = WorkPair::kAll;
-        if (static_cast<std::size_t>(num_held) >= kMaskFromPairs && s.filter_tests(t) > 0) {
-          const FilterTests f(t, s, p);
-          mask = 0;
-          for (int32_t j = 0; j < f.count; ++j) mask |= f.bit(j);
-          res.tests += f.count;
-        }
+        const uint32_t mask =
+            static_cast<std::size_t>(num_held) >= kMaskFromPairs && s.filter_tests(t) > 0
+                ? FilterTests(t, s, p).mask(res)
+                : kAllChildren;
         for (; held != 0; held &= held - 1) {
           const int32_t c = first + std::countr_zero(held);
           push(work_pair(split_b ? p.a : c, split_b ? c : p.b, !split_b, mask));
