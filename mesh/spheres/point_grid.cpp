@@ -16,11 +16,10 @@ PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_ce
                          std::to_string(cell_size));
   }
   const auto n = static_cast<size_t>(P.rows());
-  m_points.resize(n);
-  for (size_t i = 0; i < n; ++i) m_points[i] = P.row(static_cast<Eigen::Index>(i));
   if (n == 0) return;
-  Eigen::Vector3d lo = m_points.front(), hi = m_points.front();
-  for (const auto& p : m_points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  auto point = [&](size_t i) -> Eigen::Vector3d { return P.row(static_cast<Eigen::Index>(i)); };
+  Eigen::Vector3d lo = point(0), hi = point(0);
+  for (size_t i = 1; i < n; ++i) lo = lo.cwiseMin(point(i)), hi = hi.cwiseMax(point(i));
   // The cell size only affects speed (queries are exact): coarsen it so that
   // the dense cell array stays within a few cells per point.
   const double max_cells = std::max(4.0 * static_cast<double>(n), double{1 << 20});
@@ -39,7 +38,7 @@ PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_ce
   std::vector<size_t> cell(n);
   m_start.assign(num_cells + 1, 0);
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3i c = cell_of(m_points[i]);
+    const Eigen::Vector3i c = cell_of(point(i));
     cell[i] = linear(c.x(), c.y(), c.z());
     m_start[cell[i] + 1] += 1;
   }
@@ -49,7 +48,7 @@ PointGrid::PointGrid(const Eigen::Ref<const MatX3d>& P, double cell_size) : m_ce
   for (size_t i = 0; i < n; ++i)
     m_index[static_cast<size_t>(fill[cell[i]]++)] = static_cast<int>(i);
   m_by_cell.resize(n);
-  for (size_t t = 0; t < n; ++t) m_by_cell[t] = m_points[static_cast<size_t>(m_index[t])];
+  for (size_t t = 0; t < n; ++t) m_by_cell[t] = point(static_cast<size_t>(m_index[t]));
 }
 
 size_t PointGrid::linear(int i, int j, int k) const {
@@ -67,9 +66,9 @@ Eigen::Vector3i PointGrid::cell_of(const Eigen::Vector3d& p) const {
   return c;
 }
 
-std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double radius) const {
-  std::vector<int> out;
-  if (m_points.empty() || !(radius >= 0)) return out;
+template <class F>
+void PointGrid::scan_ball(const Eigen::Vector3d& center, double radius, F&& f) const {
+  if (m_by_cell.empty() || !(radius >= 0)) return;
   const Eigen::Vector3i lo =
       cell_of(center - Eigen::Vector3d::Constant(radius)).cwiseMax(Eigen::Vector3i::Zero());
   const Eigen::Vector3i hi =
@@ -82,17 +81,22 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
       const int begin = m_start[linear(i, j, lo.z())], end = m_start[linear(i, j, hi.z()) + 1];
       for (int t = begin; t < end; ++t) {
         if ((m_by_cell[static_cast<size_t>(t)] - center).squaredNorm() <= r2)
-          out.push_back(m_index[static_cast<size_t>(t)]);
+          f(static_cast<size_t>(t));
       }
     }
   }
+}
+
+std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double radius) const {
+  std::vector<int> out;
+  scan_ball(center, radius, [&](size_t t) { out.push_back(m_index[t]); });
   // Increasing order: a sort for small results, a scan of flags over all
   // points for large ones (same output, linear time).
-  if (out.size() * 16 < m_points.size()) {
+  if (out.size() * 16 < m_by_cell.size()) {
     sort_indices(out);
     return out;
   }
-  std::vector<char> hit(m_points.size(), 0);
+  std::vector<char> hit(m_by_cell.size(), 0);
   for (int idx : out) hit[static_cast<size_t>(idx)] = 1;
   size_t k = 0;
   for (size_t i = 0; i < hit.size(); ++i) {
@@ -102,7 +106,7 @@ std::vector<int> PointGrid::query_ball(const Eigen::Vector3d& center, double rad
 }
 
 int PointGrid::nearest(const Eigen::Vector3d& q) const {
-  if (m_points.empty()) return -1;
+  if (m_by_cell.empty()) return -1;
   // Distance from q to the grid's box, plus its diagonal: a ball of that
   // radius holds every point.
   double outside = 0;
@@ -115,16 +119,14 @@ int PointGrid::nearest(const Eigen::Vector3d& q) const {
   const double max_radius = std::sqrt(outside) + m_cell * extent.norm();
   double radius = std::max(m_cell, std::sqrt(outside) + m_cell);
   while (true) {
-    const std::vector<int> near = query_ball(q, radius);
-    if (!near.empty()) {
-      int best = near.front();
-      double best_d = std::numeric_limits<double>::infinity();
-      for (int idx : near) {
-        const double d = (m_points[static_cast<size_t>(idx)] - q).squaredNorm();
-        if (d < best_d) best_d = d, best = idx;
-      }
-      return best;
-    }
+    // The nearest point in the ball; of equally near ones, the lowest index.
+    int best = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    scan_ball(q, radius, [&](size_t t) {
+      const double d = (m_by_cell[t] - q).squaredNorm();
+      if (d < best_d || (d == best_d && m_index[t] < best)) best_d = d, best = m_index[t];
+    });
+    if (best >= 0) return best;
     if (radius > max_radius) break;
     radius *= 2;
   }

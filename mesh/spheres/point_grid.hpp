@@ -26,20 +26,24 @@ class PointGrid {
   int nearest(const Eigen::Vector3d& q) const;
 
   /// Number of points.
-  int size() const { return static_cast<int>(m_points.size()); }
+  int size() const { return static_cast<int>(m_by_cell.size()); }
 
  private:
   size_t linear(int i, int j, int k) const;
+  /// Calls f(t) for every cell-order position t whose point lies in the ball.
+  template <class F>
+  void scan_ball(const Eigen::Vector3d& center, double radius, F&& f) const;
   /// Cell of p, each coordinate clamped to [-1, dims].
   Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const;
 
   double m_cell;
-  std::vector<Eigen::Vector3d> m_points;
   Eigen::Vector3d m_origin = Eigen::Vector3d::Zero();  // lowest corner of cell (0, 0, 0)
   int m_dims[3] = {0, 0, 0};                           // cells per axis
-  std::vector<int> m_start;  // points of cell c: m_index[m_start[c] .. m_start[c + 1])
-  std::vector<int> m_index;
-  std::vector<Eigen::Vector3d> m_by_cell;  // m_points[m_index[t]] at t: scans read in order
+  // Points of cell c: positions m_start[c] .. m_start[c + 1] - 1 of the two
+  // arrays below, which hold them in cell order, so that scans read in order.
+  std::vector<int> m_start;
+  std::vector<int> m_index;                // the point's row in P
+  std::vector<Eigen::Vector3d> m_by_cell;  // the point
 };
 
 }  // namespace icd::mesh

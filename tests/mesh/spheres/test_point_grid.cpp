@@ -36,6 +36,17 @@ TEST(PointGrid, BallAndNearestMatchBruteForce) {
   }
 }
 
+TEST(PointGrid, NearestOfEquallyNearPointsIsTheLowestIndex) {
+  // Point 0 lies in a cell the query scans after point 2's; 1 and 3 repeat them.
+  icd::MatX3d P(4, 3);
+  P << 1, 0, 0, 0, 5, 0, -1, 0, 0, 1, 0, 0;
+  for (const double cell : {0.25, 1.0, 10.0}) {
+    const PointGrid grid(P, cell);
+    EXPECT_EQ(grid.nearest(Eigen::Vector3d::Zero()), 0) << "cell " << cell;
+    EXPECT_EQ(grid.nearest(Eigen::Vector3d(-0.1, 0, 0)), 2) << "cell " << cell;
+  }
+}
+
 TEST(PointGrid, EmptyAndInvalid) {
   const PointGrid empty(icd::MatX3d(0, 3), 1.0);
   EXPECT_TRUE(empty.query_ball(Eigen::Vector3d::Zero(), 5.0).empty());
