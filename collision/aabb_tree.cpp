@@ -1,11 +1,11 @@
-#include "collision/aabb_tree.hpp"
+#include <icd/collision/aabb_tree.hpp>
 
 #include <algorithm>
 #include <numeric>
 #include <string>
 
-#include "collision/triangle_intersection.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/collision/triangle_intersection.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 namespace {

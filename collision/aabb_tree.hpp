@@ -4,7 +4,7 @@
 #include <utility>
 #include <vector>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::collision {
 

@@ -1,11 +1,11 @@
-#include "collision/broad_phase.hpp"
+#include <icd/collision/broad_phase.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 

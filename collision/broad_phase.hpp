@@ -4,7 +4,7 @@
 #include <utility>
 #include <vector>
 
-#include "collision/sphere_tree.hpp"
+#include <icd/collision/sphere_tree.hpp>
 
 namespace icd::collision {
 

@@ -1,4 +1,4 @@
-#include "collision/coverage.hpp"
+#include <icd/collision/coverage.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 

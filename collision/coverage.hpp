@@ -1,7 +1,7 @@
 #pragma once
 /// How well a (deformed) sphere tree covers a (deformed) dense surface.
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::collision {
 

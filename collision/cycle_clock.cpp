@@ -1,4 +1,4 @@
-#include "collision/cycle_clock.hpp"
+#include <icd/collision/cycle_clock.hpp>
 
 #include <chrono>
 

@@ -1,4 +1,4 @@
-#include "collision/exact_predicates.hpp"
+#include <icd/collision/exact_predicates.hpp>
 
 #include <cmath>
 #include <limits>

@@ -1,12 +1,12 @@
-#include "collision/node_association.hpp"
+#include <icd/collision/node_association.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/triangle_geometry.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/triangle_geometry.hpp>
 
 namespace icd::collision {
 namespace {

@@ -3,8 +3,8 @@
 /// (paper 4.4): fills SphereTree::assoc_offset / assoc_nodes / assoc_rest_dist.
 #include <vector>
 
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::collision {
 

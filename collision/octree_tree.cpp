@@ -1,11 +1,11 @@
-#include "collision/octree_tree.hpp"
+#include <icd/collision/octree_tree.hpp>
 
 #include <array>
 #include <cassert>
 #include <cmath>
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 namespace {

@@ -2,8 +2,8 @@
 /// The Hubbard-style octree sphere tree, the simple baseline of issue 5: the
 /// bounding cube of the surface is subdivided recursively (branching 8); every
 /// occupied cell gets one sphere enclosing the part of the surface inside it.
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::collision {
 

@@ -1,4 +1,4 @@
-#include "collision/sph_io.hpp"
+#include <icd/collision/sph_io.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 namespace {

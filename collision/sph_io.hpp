@@ -6,7 +6,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "collision/sphere_tree.hpp"
+#include <icd/collision/sphere_tree.hpp>
 
 namespace icd::collision {
 

@@ -1,9 +1,9 @@
-#include "collision/sphere_tree.hpp"
+#include <icd/collision/sphere_tree.hpp>
 
 #include <cmath>
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 namespace {

@@ -1,11 +1,11 @@
-#include "collision/sphere_update.hpp"
+#include <icd/collision/sphere_update.hpp>
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 
@@ -81,6 +81,16 @@ void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_res
       if (!std::isfinite(s.x + s.y + s.z + s.r))
         throw NumericalError("update_spheres: sphere " + std::to_string(i) +
                              " is not finite after the update (non-finite coarse node positions?)");
+    }
+  }
+}
+
+void enclose_children(SphereTree& t) {
+  for (int i = t.num_nodes() - 1; i >= 0; --i) {
+    Sphere& s = t.spheres[i];
+    for (int c = t.first_child[i]; c >= 0 && c < t.first_child[i] + t.child_count[i]; ++c) {
+      const Sphere& k = t.spheres[c];
+      s.r = std::max(s.r, (k.center() - s.center()).norm() + k.r);
     }
   }
 }

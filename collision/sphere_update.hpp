@@ -1,8 +1,8 @@
 #pragma once
 /// Per-frame update of a sphere tree from the coarse nodes (paper 4.4, after
 /// James & Pai's BD-trees). Cost: O(sum_i |V_i|), independent of the dense mesh.
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::collision {
 
@@ -35,5 +35,12 @@ struct SphereUpdateOptions {
 void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_rest,
                     const Eigen::Ref<const MatX3d>& coarse_positions,
                     const SphereUpdateOptions& options = {});
+
+/// Grows every parent sphere, bottom-up, until it encloses its children's
+/// spheres (turns a wrapped tree into a layered one, Guibas et al.): sphere
+/// overlaps then never appear suddenly below a pruned pair, so a penalty
+/// force computed from them is continuous in the positions. Only radii grow;
+/// centres and leaves are unchanged.
+void enclose_children(SphereTree& tree);
 
 }  // namespace icd::collision

@@ -1,4 +1,4 @@
-#include "collision/traversal.hpp"
+#include <icd/collision/traversal.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <string>
 
-#include "collision/cycle_clock.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/collision/cycle_clock.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 namespace {
@@ -608,19 +608,12 @@ thread_local std::vector<WorkPair> t_seeds;
 CollisionRequest CollisionRequest::paper_reference(double budget_seconds) {
   CollisionRequest r;
   r.budget_seconds = budget_seconds;
-  r.mode = TraversalMode::BreadthFirstFifo;
-  r.test_on_push = false;
+  r.mode = TraversalMode::BreadthFirstLiteral;
   r.clock_check_interval = 1;
   return r;
 }
 
-void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request,
-             CollisionResult& res) {
-  if (std::isfinite(request.budget_seconds)) {  // one-time calibrations, outside the budget
-    if (t_finish_cost == 0.0) t_finish_cost = output_seconds_per_pair();
-    if (request.clock == ClockSource::CycleCounter) cycle_counter_hz();
-  }
-  const Clock::time_point start = Clock::now();
+void validate(const CollisionRequest& request) {
   if (!(request.budget_seconds > 0.0))
     throw ParameterError("CollisionRequest::budget_seconds must be > 0 (infinity for none)");
   if (request.budget_tests < -1)
@@ -630,6 +623,16 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
   if (request.depth_cap < 0) throw ParameterError("CollisionRequest::depth_cap must be >= 0");
   if (request.mode == TraversalMode::Priority && request.max_list_size < 8)
     throw ParameterError("CollisionRequest::max_list_size must be >= 8");
+}
+
+void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request,
+             CollisionResult& res) {
+  if (std::isfinite(request.budget_seconds)) {  // one-time calibrations, outside the budget
+    if (t_finish_cost == 0.0) t_finish_cost = output_seconds_per_pair();
+    if (request.clock == ClockSource::CycleCounter) cycle_counter_hz();
+  }
+  const Clock::time_point start = Clock::now();
+  validate(request);
   if (a.num_nodes() == 0 || b.num_nodes() == 0) throw ParameterError("collide: empty sphere tree");
   res.colliding.clear();
   res.untested.clear();
@@ -639,7 +642,7 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
   res.tests = 0;
   res.peak_list_size = 0;
 
-  const bool literal = !request.test_on_push && request.mode != TraversalMode::Priority;
+  const bool literal = is_literal(request.mode);
   const Trees t{a.spheres.data(),     b.spheres.data(),
                 a.first_child.data(), a.child_count.data(),
                 b.first_child.data(), b.child_count.data(),
@@ -712,7 +715,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
         list.for_each([&](const WorkPair& p) { res.untested.push_back({p.a, p.b}); });
       }
     };
-    if (request.mode == TraversalMode::BreadthFirstFifo)
+    if (request.mode == TraversalMode::BreadthFirstFifo ||
+        request.mode == TraversalMode::BreadthFirstLiteral)
       go(t_queue);
     else
       go(t_stack);

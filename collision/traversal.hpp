@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "collision/sphere_tree.hpp"
+#include <icd/collision/sphere_tree.hpp>
 
 namespace icd::collision {
 
@@ -18,10 +18,27 @@ struct NodePair {
 
 /// Order in which sphere pairs are refined.
 enum class TraversalMode {
-  BreadthFirstFifo,  ///< paper Fig. 7: FIFO PAIRLIST, level by level, pair order swapped
-  DepthFirst,        ///< paper Fig. 4: LIFO (recursive order), optionally depth-capped
-  Priority,          ///< best-first (see PriorityKey) with a capped list
+  /// Paper Fig. 7, fast path: FIFO PAIRLIST, level by level, pair order
+  /// swapped; child pairs are tested as they are generated, so only
+  /// overlapping pairs enter the list.
+  BreadthFirstFifo,
+  /// Paper Fig. 7 as printed: pairs are tested when popped (the list holds
+  /// untested pairs); use with clock_check_interval 1 for the paper's clock
+  /// read at every test (CollisionRequest::paper_reference).
+  BreadthFirstLiteral,
+  /// Paper Fig. 4: LIFO (recursive order), optionally depth-capped; child
+  /// pairs tested as they are generated.
+  DepthFirst,
+  /// Paper Fig. 4 as printed: LIFO, pairs tested when popped.
+  DepthFirstLiteral,
+  /// Best-first (see PriorityKey) with a capped list; tests on push.
+  Priority,
 };
+
+/// True for the modes that test pairs when they are popped (as printed in the paper).
+constexpr bool is_literal(TraversalMode m) {
+  return m == TraversalMode::BreadthFirstLiteral || m == TraversalMode::DepthFirstLiteral;
+}
 
 /// What the Priority mode refines first.
 enum class PriorityKey {
@@ -51,11 +68,7 @@ struct CollisionRequest {
   /// Budget in sphere-sphere tests (>= 0); -1 = no limit. Deterministic, for tests.
   int64_t budget_tests = -1;
   TraversalMode mode = TraversalMode::BreadthFirstFifo;
-  /// Fast path: test child pairs as they are generated, so only overlapping
-  /// pairs enter the list. false = the paper's literal Fig. 7 (pairs tested
-  /// when popped). Priority mode always tests on push.
-  bool test_on_push = true;
-  /// Parent filter (not in the paper; fast path and Priority mode): when a
+  /// Parent filter (not in the paper; ignored by the literal modes): when a
   /// node is split, the children of the pair's other node are also tested,
   /// once, against it, and later only those that overlap it are tested
   /// against its children. Conservative for surface contacts as the plain
@@ -88,6 +101,11 @@ struct CollisionRequest {
   /// The paper's reference configuration: Fig. 7 literally, clock at every test.
   static CollisionRequest paper_reference(double budget_seconds);
 };
+
+/// Throws ParameterError naming the field when `request` is invalid:
+/// budget_seconds <= 0 (infinity for none), budget_tests < -1,
+/// clock_check_interval < 1, depth_cap < 0, Priority with max_list_size < 8.
+void validate(const CollisionRequest& request);
 
 /// What the query found. A point where the two (covered) surfaces touch lies
 /// in both spheres of some pair of `colliding` or `untested`.
@@ -122,7 +140,7 @@ struct CollisionResult {
 /// budget, so the call returns close to the deadline (reuse `result` between
 /// queries so that its vectors do not reallocate). The first timed query of a
 /// process calibrates its clocks (~20 ms) before its budget starts.
-/// Throws ParameterError for an invalid request (bad budget, interval, cap,
+/// Throws ParameterError for an invalid request (see validate(); also a
 /// start_front index out of range). Trees are assumed valid (see validate()).
 void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request,
              CollisionResult& result);

@@ -1,10 +1,10 @@
-#include "collision/triangle_intersection.hpp"
+#include <icd/collision/triangle_intersection.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
-#include "collision/exact_predicates.hpp"
+#include <icd/collision/exact_predicates.hpp>
 
 namespace icd::collision {
 namespace {

@@ -1,4 +1,4 @@
-#include "coupling/asset_bundle.hpp"
+#include <icd/coupling/asset_bundle.hpp>
 
 #include <algorithm>
 #include <array>
@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "mesh/io/atomic_write.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/io/vtk_writer.hpp"
-#include "mesh/io/vtu_reader.hpp"
+#include <icd/mesh/io/atomic_write.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/io/vtk_writer.hpp>
+#include <icd/mesh/io/vtu_reader.hpp>
 
 namespace icd::coupling {
 

@@ -42,9 +42,9 @@
 
 #include <Eigen/Core>
 
-#include "collision/sphere_tree.hpp"
-#include "coupling/rigid_links.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/coupling/rigid_links.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::coupling {
 

@@ -1,4 +1,4 @@
-#include "coupling/barycentric_embedding.hpp"
+#include <icd/coupling/barycentric_embedding.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -7,7 +7,7 @@
 
 #include <Eigen/Dense>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::coupling {
 namespace {

@@ -7,7 +7,7 @@
 /// coordinate is largest, i.e. a linear extrapolation of that tet's motion.
 #include <Eigen/SparseCore>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::coupling {
 

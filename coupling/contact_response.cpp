@@ -1,4 +1,4 @@
-#include "coupling/contact_response.hpp"
+#include <icd/coupling/contact_response.hpp>
 
 #include <cmath>
 #include <limits>
@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::coupling {
 namespace {

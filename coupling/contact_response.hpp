@@ -13,9 +13,9 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
-#include "collision/sphere_tree.hpp"
-#include "collision/traversal.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/collision/traversal.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::coupling {
 

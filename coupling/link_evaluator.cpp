@@ -1,4 +1,4 @@
-#include "coupling/link_evaluator.hpp"
+#include <icd/coupling/link_evaluator.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -7,7 +7,7 @@
 #include <limits>
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::coupling {
 namespace {

@@ -37,8 +37,8 @@
 
 #include <Eigen/Core>
 
-#include "coupling/rigid_links.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/coupling/rigid_links.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::coupling {
 

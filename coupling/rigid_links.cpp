@@ -1,4 +1,4 @@
-#include "coupling/rigid_links.hpp"
+#include <icd/coupling/rigid_links.hpp>
 
 #include <Eigen/Geometry>
 
@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "coupling/link_evaluator.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/coupling/link_evaluator.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::coupling {
 namespace {

@@ -17,7 +17,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::coupling {
 

@@ -1,9 +1,9 @@
-#include "fem/backward_euler.hpp"
+#include <icd/fem/backward_euler.hpp>
 
 #include <cmath>
 
-#include "fem/newton_system.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/fem/newton_system.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 

@@ -1,8 +1,8 @@
 #pragma once
 /// Backward Euler with Newton iterations solved by CHOLMOD: the implicit
 /// reference integrator and the fallback for stiff materials.
-#include "fem/cholmod_solver.hpp"
-#include "fem/integrators.hpp"
+#include <icd/fem/cholmod_solver.hpp>
+#include <icd/fem/integrators.hpp>
 
 namespace icd::fem {
 

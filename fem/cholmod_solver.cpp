@@ -1,11 +1,11 @@
-#include "fem/cholmod_solver.hpp"
+#include <icd/fem/cholmod_solver.hpp>
 
 #include <cholmod.h>
 #include <dlfcn.h>
 
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
-#include "fem/material.hpp"
+#include <icd/fem/material.hpp>
 
 namespace icd::fem {
 

@@ -1,4 +1,4 @@
-#include "fem/forces.hpp"
+#include <icd/fem/forces.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -7,12 +7,12 @@
 #include <string>
 #include <type_traits>
 
-#include "fem/constitutive.hpp"
-#include "fem/element_kernels.hpp"
-#include "fem/lane_kernels.hpp"
-#include "fem/lane_loops.hpp"
-#include "fem/polar.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/fem/constitutive.hpp>
+#include <icd/fem/element_kernels.hpp>
+#include <icd/fem/lane_kernels.hpp>
+#include <icd/fem/lane_loops.hpp>
+#include <icd/fem/polar.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

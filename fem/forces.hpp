@@ -8,9 +8,9 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 
-#include "fem/material.hpp"
-#include "fem/stiffness_pattern.hpp"
-#include "fem/tet_mesh_data.hpp"
+#include <icd/fem/material.hpp>
+#include <icd/fem/stiffness_pattern.hpp>
+#include <icd/fem/tet_mesh_data.hpp>
 
 namespace icd::fem {
 namespace lanes {

@@ -1,11 +1,11 @@
-#include "fem/integrators.hpp"
+#include <icd/fem/integrators.hpp>
 
 #include <bit>
 #include <cassert>
 #include <cstdint>
 #include <utility>
 
-#include "fem/lane_loops.hpp"
+#include <icd/fem/lane_loops.hpp>
 
 namespace icd::fem {
 

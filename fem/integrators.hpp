@@ -1,7 +1,7 @@
 #pragma once
 /// Time integrators of a Model: RK4 (the paper's), symplectic Euler (one force
 /// evaluation per step) and backward Euler (see backward_euler.hpp).
-#include "fem/model.hpp"
+#include <icd/fem/model.hpp>
 
 namespace icd::fem {
 

@@ -5,8 +5,8 @@
 /// scalar kernels (element_kernels.hpp), so results are bitwise identical.
 /// Always inlined: lane_loops.cpp compiles the loops that call them for two
 /// instruction sets.
-#include "fem/element_kernels.hpp"
-#include "fem/material.hpp"
+#include <icd/fem/element_kernels.hpp>
+#include <icd/fem/material.hpp>
 
 namespace icd::fem::lanes {
 

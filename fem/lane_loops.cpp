@@ -1,4 +1,4 @@
-#include "fem/lane_loops.hpp"
+#include <icd/fem/lane_loops.hpp>
 
 #include <algorithm>
 #include <cstring>

@@ -4,7 +4,7 @@
 /// per instruction) and for AVX2 (4 doubles), chosen at run time from what the
 /// CPU supports. Both run the same operations in the same order (no FMA
 /// contraction), so their results are bitwise identical.
-#include "fem/lane_kernels.hpp"
+#include <icd/fem/lane_kernels.hpp>
 
 namespace icd::fem::lanes {
 

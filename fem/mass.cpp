@@ -1,10 +1,10 @@
-#include "fem/mass.hpp"
+#include <icd/fem/mass.hpp>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
-#include "fem/tet_mesh_data.hpp"
+#include <icd/fem/tet_mesh_data.hpp>
 
 namespace icd::fem {
 

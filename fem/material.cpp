@@ -1,9 +1,9 @@
-#include "fem/material.hpp"
+#include <icd/fem/material.hpp>
 
 #include <cmath>
 #include <sstream>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 

@@ -1,11 +1,11 @@
-#include "fem/model.hpp"
+#include <icd/fem/model.hpp>
 
 #include <cassert>
 #include <cmath>
 #include <string>
 
-#include "fem/mass.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/fem/mass.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 

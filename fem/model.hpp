@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 
-#include "fem/forces.hpp"
-#include "fem/strain_rate_damping.hpp"
+#include <icd/fem/forces.hpp>
+#include <icd/fem/strain_rate_damping.hpp>
 
 namespace icd::fem {
 

@@ -1,6 +1,6 @@
-#include "fem/newton_system.hpp"
+#include <icd/fem/newton_system.hpp>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 

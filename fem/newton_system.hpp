@@ -7,8 +7,8 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
-#include "fem/cholmod_solver.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/fem/cholmod_solver.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::fem {
 

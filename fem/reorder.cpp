@@ -1,10 +1,10 @@
-#include "fem/reorder.hpp"
+#include <icd/fem/reorder.hpp>
 
 #include <algorithm>
 #include <numeric>
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

@@ -6,7 +6,7 @@
 /// hit nearby cache lines.
 #include <vector>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::fem {
 

@@ -1,4 +1,4 @@
-#include "fem/simulator.hpp"
+#include <icd/fem/simulator.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -6,7 +6,7 @@
 #include <limits>
 #include <sstream>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 

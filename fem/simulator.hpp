@@ -4,9 +4,9 @@
 /// and bounded retries.
 #include <string>
 
-#include "fem/backward_euler.hpp"
-#include "fem/integrators.hpp"
-#include "fem/stable_step.hpp"
+#include <icd/fem/backward_euler.hpp>
+#include <icd/fem/integrators.hpp>
+#include <icd/fem/stable_step.hpp>
 
 namespace icd::fem {
 

@@ -1,4 +1,4 @@
-#include "fem/stable_step.hpp"
+#include <icd/fem/stable_step.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

@@ -3,7 +3,7 @@
 /// eigenfrequency of the *current* state (it grows under compression).
 #include <Eigen/Core>
 
-#include "fem/integrators.hpp"
+#include <icd/fem/integrators.hpp>
 
 namespace icd::fem {
 

@@ -1,9 +1,9 @@
 #pragma once
 /// Static equilibrium by Newton's method with CHOLMOD: reference deformations
 /// f_int(x) + f_ext + M g = 0 on the free nodes.
-#include "fem/backward_euler.hpp"
-#include "fem/cholmod_solver.hpp"
-#include "fem/model.hpp"
+#include <icd/fem/backward_euler.hpp>
+#include <icd/fem/cholmod_solver.hpp>
+#include <icd/fem/model.hpp>
 
 namespace icd::fem {
 

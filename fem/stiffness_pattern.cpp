@@ -1,4 +1,4 @@
-#include "fem/stiffness_pattern.hpp"
+#include <icd/fem/stiffness_pattern.hpp>
 
 #include <algorithm>
 #include <cassert>

@@ -1,10 +1,10 @@
-#include "fem/strain_rate_damping.hpp"
+#include <icd/fem/strain_rate_damping.hpp>
 
 #include <cmath>
 #include <string>
 
-#include "fem/element_kernels.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/fem/element_kernels.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

@@ -5,8 +5,8 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
-#include "fem/stiffness_pattern.hpp"
-#include "fem/tet_mesh_data.hpp"
+#include <icd/fem/stiffness_pattern.hpp>
+#include <icd/fem/tet_mesh_data.hpp>
 
 namespace icd::fem {
 

@@ -1,11 +1,11 @@
-#include "fem/tet_mesh_data.hpp"
+#include <icd/fem/tet_mesh_data.hpp>
 
 #include <cmath>
 #include <sstream>
 
 #include <Eigen/LU>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 

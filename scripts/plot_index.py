@@ -144,15 +144,15 @@ def main():
     md.append("## Other engineers' experiments, reused\n")
     if os.path.exists(os.path.join(d, "fem/fem_error_vs_time.csv")):
         md.append("FEM error against run time (cantilever vs Timoshenko and a fine static reference), from "
-                  "`experiments/fem/fem_error_vs_time`: [CSV](fem/fem_error_vs_time.csv)\n")
+                  "`experiments/studies/fem/fem_error_vs_time`: [CSV](fem/fem_error_vs_time.csv)\n")
         md.append(image(d, "fem/fem_error_vs_time.png", "FEM error vs time"))
     if os.path.exists(os.path.join(d, "collision/accuracy.txt")):
         md.append("Collision accuracy/coverage experiment of the collision module: "
                   "[collision/accuracy.txt](collision/accuracy.txt); measured discussion in "
-                  "`experiments/collision/RESULTS.md`.\n")
+                  "`experiments/studies/collision/RESULTS.md`.\n")
 
     md.append("## Scenes\n")
-    md.append("The bunny/dragon runs use `experiments/paper/scenes/*.json`: the shipped `experiments/scenes/*.json` "
+    md.append("The bunny/dragon runs use `experiments/studies/paper/scenes/*.json`: the shipped `experiments/scenes/*.json` "
               "with the stable Neo-Hookean material (inversion-safe) and otherwise the shipped parameters.\n")
     md.append("## Where and why our numbers differ from the paper's\n")
     md.append(

@@ -44,7 +44,7 @@ bin="$build/bin"
 # (rk4 health check) about 4 frames after contact; everything else is identical.
 # Even so the bunny-dragon run fails ~3 frames after contact, so Table 1 is
 # measured 1 frame after first contact.
-scenes="$root/experiments/paper/scenes"
+scenes="$root/experiments/studies/paper/scenes"
 start=$(date +%s)
 status=()
 run_step() {  # name, command...: runs, records ok/failed (a failed step does not stop the others)
@@ -99,15 +99,15 @@ run_step plot_fig9_scaled "$py" "$root/scripts/plot_fig9.py" "$out/fig9_scaled" 
 run_step plot_error_vs_time "$py" "$root/scripts/plot_error_vs_time.py" "$out"
 
 # Other engineers' experiments, reused rather than duplicated.
-fem_prog=$(find "$build/experiments/fem" -maxdepth 1 -name fem_error_vs_time -type f 2>/dev/null | head -1)
+fem_prog=$(find "$build/bin" -maxdepth 1 -name fem_error_vs_time -type f 2>/dev/null | head -1)
 if [ -n "$fem_prog" ]; then
   mkdir -p "$out/fem"
   q=(); [ "$quick" = 1 ] && q=(--quick)
   run_step fem_error_vs_time "$fem_prog" "${q[@]}" "$out/fem/fem_error_vs_time.csv"
-  run_step plot_fem "$py" "$root/experiments/fem/plot_fem_error_vs_time.py" "$out/fem/fem_error_vs_time.csv" \
+  run_step plot_fem "$py" "$root/experiments/studies/fem/plot_fem_error_vs_time.py" "$out/fem/fem_error_vs_time.csv" \
     "$out/fem/fem_error_vs_time.png"
 fi
-col_prog=$(find "$build/experiments/collision" -maxdepth 1 -name icd_collision_accuracy -type f 2>/dev/null | head -1)
+col_prog=$(find "$build/bin" -maxdepth 1 -name icd_collision_accuracy -type f 2>/dev/null | head -1)
 if [ -n "$col_prog" ] && [ "$quick" = 0 ]; then
   mkdir -p "$out/collision"
   run_step collision_accuracy sh -c "'$col_prog' > '$out/collision/accuracy.txt'"

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::runner {
 

@@ -5,9 +5,9 @@
 /// bundle (preprocessing a raw mesh into the cache on first use).
 #include <filesystem>
 
-#include "coupling/asset_bundle.hpp"
+#include <icd/coupling/asset_bundle.hpp>
 #include "experiments/runner/scene.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::runner {
 
@@ -15,11 +15,6 @@ namespace icd::runner {
 /// structure the asset bundles hold (dense surface, coarse mesh, reduced
 /// coordinates Q, rigid links, sphere tree with its node association).
 using ObjectAsset = coupling::AssetBundle;
-
-/// Builds a primitive object: a dense icosphere (or box surface) over a
-/// structured coarse tet mesh (for a sphere: the cells of a grid inside the
-/// ball), octree sphere tree `depth` levels below the root, links and association.
-ObjectAsset make_primitive_asset(const PrimitiveSpec& spec, int depth);
 
 /// Loads the asset of an object spec: generated primitive, bundle folder, or
 /// raw mesh preprocessed into `cache_dir` by the icd-preprocess tool found in

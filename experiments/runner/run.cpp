@@ -8,30 +8,30 @@
 #include <sstream>
 #include <thread>
 
-#include "mesh/io/atomic_write.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/vtk_writer.hpp"
+#include "experiments/runner/object_asset.hpp"
+#include <icd/mesh/io/atomic_write.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/io/vtk_writer.hpp>
 
 namespace icd::runner {
 namespace {
 
-void write_frame_vtu(World& world, int frame, const std::filesystem::path& dir,
+void write_frame_vtu(World& world, const Scene& scene, int frame, const std::filesystem::path& dir,
                      std::vector<std::vector<PvdEntry>>& series) {
-  const Scene& scene = world.scene();
-  const double t = frame / scene.frame_rate;
+  const double t = frame / scene.world.frame_rate;
   auto& objects = world.objects();
   size_t s = 0;
   char suffix[32];
   std::snprintf(suffix, sizeof suffix, "_%06d.vtu", frame);
-  for (RuntimeObject& o : objects) {
+  for (coupling::RuntimeObject& o : objects) {
     TetMesh coarse = o.asset.coarse;
     coarse.V = o.positions;
-    const std::string cname = o.spec.name + "_coarse" + suffix;
+    const std::string cname = o.setup.name + "_coarse" + suffix;
     write_vtu_tet_mesh(dir / cname, coarse);
     series[s++].push_back({t, cname});
     if (o.plan.dense_update && scene.output.dense) {
       SurfaceMesh dense{o.dense, o.asset.dense.F};
-      const std::string dname = o.spec.name + "_dense" + suffix;
+      const std::string dname = o.setup.name + "_dense" + suffix;
       write_vtu_surface_mesh(dir / dname, dense);
       series[s].push_back({t, dname});
     }
@@ -43,7 +43,7 @@ void write_frame_vtu(World& world, int frame, const std::filesystem::path& dir,
       const auto [i, j] = world.plan().pairs[p];
       for (int side = 0; side < 2; ++side) {
         const std::string name =
-            objects[side ? j : i].spec.name + "_contact_spheres_pair" + std::to_string(p) + suffix;
+            objects[side ? j : i].setup.name + "_contact_spheres_pair" + std::to_string(p) + suffix;
         write_contact_spheres(world, p, side, dir / name);
         series[s].push_back({t, name});
         ++s;
@@ -59,6 +59,37 @@ std::string format_duration(double s) {
 }
 
 }  // namespace
+
+std::vector<coupling::ObjectSetup> object_setups(const Scene& scene) {
+  return {scene.objects.begin(), scene.objects.end()};  // (each ObjectSpec is an ObjectSetup)
+}
+
+coupling::StagePlan scene_plan(const Scene& scene) {
+  return coupling::make_plan(object_setups(scene), world_settings(scene));
+}
+
+std::vector<std::string> describe_plan(const Scene& scene) {
+  const std::vector<coupling::ObjectSetup> setups = object_setups(scene);
+  const coupling::WorldSettings settings = world_settings(scene);
+  std::vector<std::string> lines = coupling::make_plan(setups, settings).describe(setups, settings);
+  lines.push_back(std::string("output: ") + (scene.output.csv ? "frames.csv" : "no csv") +
+                  (scene.output.vtu_every > 0 ? ", VTU/PVD series" : ""));
+  return lines;
+}
+
+World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
+                 const std::filesystem::path& tool_dir) {
+  std::vector<coupling::WorldObject> objects;
+  objects.reserve(scene.objects.size());
+  for (const ObjectSpec& spec : scene.objects) {
+    coupling::WorldObject o;
+    o.setup = spec;
+    o.asset = load_object_asset(spec, cache_dir, tool_dir);
+    place_object(o.asset, spec);
+    objects.push_back(std::move(o));
+  }
+  return World(std::move(objects), world_settings(scene));
+}
 
 void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path) {
   const auto [i, j] = world.plan().pairs[pair];
@@ -108,7 +139,7 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   if (opt.out_dir.empty()) throw ParameterError("run_scene: an output folder is required");
   Scene scene = scene_in;
   if (opt.frames >= 0) scene.frames = opt.frames;
-  if (opt.target_fps >= 0) scene.target_fps = opt.target_fps;
+  if (opt.target_fps >= 0) scene.world.target_fps = opt.target_fps;
   std::filesystem::create_directories(opt.out_dir);
   // Remove a previous run's results first: nothing stale that looks complete.
   std::filesystem::remove(opt.out_dir / "frames.csv");
@@ -117,7 +148,7 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   std::filesystem::remove_all(vtu_dir);
   std::filesystem::remove_all(vtu_tmp);
 
-  World world(scene, opt.cache_dir, opt.tool_dir);
+  World world = make_world(scene, opt.cache_dir, opt.tool_dir);
   const bool tty = opt.progress && isatty(fileno(stderr));
   std::vector<FrameMetrics> frames;
   frames.reserve(scene.frames);
@@ -131,7 +162,7 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   // detection gets what is left of each frame (World::step); an early frame
   // waits for its deadline, so the rate is held, not exceeded.
   const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(scene.target_fps > 0 ? 1.0 / scene.target_fps : 0.0));
+      std::chrono::duration<double>(scene.world.target_fps > 0 ? 1.0 / scene.world.target_fps : 0.0));
   auto deadline = start;
   int missed = 0;
   for (int f = 0; f < scene.frames; ++f) {
@@ -139,10 +170,10 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
     FrameMetrics m = world.step();
     if (scene.output.vtu_every > 0 && (f % scene.output.vtu_every == 0 || f + 1 == scene.frames)) {
       const auto t0 = std::chrono::steady_clock::now();
-      write_frame_vtu(world, f, vtu_tmp, series);
+      write_frame_vtu(world, scene, f, vtu_tmp, series);
       m.times.output = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
-    if (scene.target_fps > 0) {
+    if (scene.world.target_fps > 0) {
       if (std::chrono::steady_clock::now() > deadline) {
         ++missed;
         deadline = std::chrono::steady_clock::now();  // late: the next frame starts now
@@ -197,13 +228,13 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
     }
   }
 
-  if (opt.log && scene.target_fps > 0) {
+  if (opt.log && scene.world.target_fps > 0) {
     const double el =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(
         opt.log,
         "real-time mode: target %.1f fps, held %.1f fps, %d of %d frames over their deadline\n",
-        scene.target_fps, scene.frames / el, missed, scene.frames);
+        scene.world.target_fps, scene.frames / el, missed, scene.frames);
   }
   if (scene.output.csv) write_file_atomically(opt.out_dir / "frames.csv", metrics_csv(frames));
   if (scene.output.vtu_every > 0) {

@@ -5,9 +5,32 @@
 #include <filesystem>
 #include <vector>
 
-#include "experiments/runner/world.hpp"
+#include <string>
+
+#include <icd/coupling/world.hpp>
+
+#include "experiments/runner/scene.hpp"
 
 namespace icd::runner {
+
+using coupling::FrameMetrics;
+using coupling::RuntimeObject;
+using coupling::World;
+
+/// The objects' setups of a scene, in scene order.
+std::vector<coupling::ObjectSetup> object_setups(const Scene& scene);
+
+/// The stages the scene needs (coupling::make_plan of its objects and settings).
+coupling::StagePlan scene_plan(const Scene& scene);
+
+/// The scene's stages and what it outputs, one line each (icd-run --dry-run).
+std::vector<std::string> describe_plan(const Scene& scene);
+
+/// Loads every object of the scene (load_object_asset: primitive, bundle, or
+/// raw mesh preprocessed into `cache_dir` by the icd-preprocess tool in
+/// `tool_dir`), places it, and builds the World with world_settings(scene).
+World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
+                 const std::filesystem::path& tool_dir);
 
 /// Options of run_scene().
 struct RunOptions {

@@ -4,8 +4,8 @@
 #include <limits>
 #include <set>
 
-#include "icd/config.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/config.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::runner {
 namespace {
@@ -108,18 +108,18 @@ class Fields {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 fem::Material parse_material(Fields& f) {
-  fem::Material m;
-  const std::string model =
-      f.string("model", "stvk", {"linear", "corotational", "stvk", "stable_neo_hookean"});
+  fem::Material m;  // fields left out keep fem::Material's defaults
+  const std::string model = f.string("model", fem::to_string(m.model),
+                                     {"linear", "corotational", "stvk", "stable_neo_hookean"});
   m.model = model == "linear"         ? fem::MaterialModel::Linear
             : model == "corotational" ? fem::MaterialModel::Corotational
             : model == "stvk"         ? fem::MaterialModel::StVK
                                       : fem::MaterialModel::StableNeoHookean;
-  m.young = f.number("young", 1e5, 0, 1e12, true);
-  m.poisson = f.number("poisson", 0.3, -1, 0.5, true);
+  m.young = f.number("young", m.young, 0, 1e12, true);
+  m.poisson = f.number("poisson", m.poisson, -1, 0.5, true);
   if (m.poisson >= 0.5 || m.poisson <= -1)
     f.fail(f.path("poisson"), "must be in (-1, 0.5), got " + Fields::fmt(m.poisson));
-  m.density = f.number("density", 1000, 0, 1e6, true);
+  m.density = f.number("density", m.density, 0, 1e6, true);
   return m;
 }
 
@@ -206,9 +206,11 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
 
 CollisionSpec parse_collision(const Json& j, const std::string& source) {
   Fields f(j, "collision", source);
-  CollisionSpec c;
-  c.budget_seconds = f.number("budget_seconds", c.budget_seconds, 0, 1e3, true);
-  if (f.boolean("unlimited", false)) c.budget_seconds = kInf;
+  CollisionSpec c;  // fields left out keep CollisionSpec's defaults
+  collision::CollisionRequest& q = c.query;
+  const bool has_seconds = f.get("budget_seconds") != nullptr;
+  q.budget_seconds = f.number("budget_seconds", q.budget_seconds, 0, 1e3, true);
+  if (f.boolean("unlimited", false)) q.budget_seconds = kInf;
   const double tests = f.number("budget_tests", -1, -1, 1e15);
   if (tests != -1 && (tests < 0 || tests != std::floor(tests)))
     f.fail("collision.budget_tests", "must be a positive integer or -1");
@@ -216,35 +218,48 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
     f.fail("collision.budget_tests",
            "0 allows no sphere test, so every query would answer with the root pair (whole "
            "objects assumed colliding); give a positive count, or -1 for no limit");
-  c.budget_tests = static_cast<int64_t>(tests);
-  if (c.budget_tests >= 0 && f.get("budget_seconds") == nullptr) c.budget_seconds = kInf;
+  q.budget_tests = static_cast<int64_t>(tests);
+  if (q.budget_tests >= 0 && !has_seconds) q.budget_seconds = kInf;
   const std::string mode =
       f.string("mode", "fifo", {"fifo", "fifo_literal", "depth_first", "priority"});
-  c.mode = mode == "depth_first" ? collision::TraversalMode::DepthFirst
-           : mode == "priority"  ? collision::TraversalMode::Priority
-                                 : collision::TraversalMode::BreadthFirstFifo;
-  c.literal = mode == "fifo_literal";
-  c.clock_check_interval = f.integer("clock_check_interval", c.clock_check_interval, 1, 1 << 20);
-  c.max_list_size = static_cast<std::size_t>(f.integer("max_list_size", 1 << 14, 8, 1 << 28));
-  c.depth_cap = f.integer("depth_cap", -1, -1, 64);
-  c.temporal_coherence = f.boolean("temporal_coherence", false);
-  c.parent_filter = f.boolean("parent_filter", false);
-  c.layered = f.boolean("layered", true);
-  c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", true);
-  c.midpoint = f.boolean("midpoint", true);
-  c.passive = f.boolean("passive", true);
-  const std::string upd = f.string("sphere_update", "paper", {"paper", "conservative"});
+  q.mode = mode == "depth_first"    ? collision::TraversalMode::DepthFirst
+           : mode == "priority"     ? collision::TraversalMode::Priority
+           : mode == "fifo_literal" ? collision::TraversalMode::BreadthFirstLiteral
+                                    : collision::TraversalMode::BreadthFirstFifo;
+  // The paper reads the clock at every test (Fig. 7).
+  const int interval = collision::is_literal(q.mode) ? 1 : q.clock_check_interval;
+  q.clock_check_interval = f.integer("clock_check_interval", interval, 1, 1 << 20);
+  q.max_list_size =
+      static_cast<std::size_t>(f.integer("max_list_size", static_cast<int>(q.max_list_size), 8, 1 << 28));
+  const int cap = f.integer("depth_cap", -1, -1, 64);
+  if (cap >= 0) q.depth_cap = cap;
+  c.temporal_coherence = f.boolean("temporal_coherence", c.temporal_coherence);
+  q.parent_filter = f.boolean("parent_filter", q.parent_filter);
+  if (q.parent_filter && collision::is_literal(q.mode))
+    f.fail("collision.parent_filter",
+           "the literal Fig. 7 mode (\"fifo_literal\") tests pairs when popped and has no parent "
+           "filter; use \"fifo\"");
+  c.layered = f.boolean("layered", c.layered);
+  c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", c.single_cycle_when_apart);
+  c.midpoint = f.boolean("midpoint", c.midpoint);
+  c.passive = f.boolean("passive", c.passive);
+  const bool paper_update = c.update.mode == collision::SphereUpdateMode::PaperRatio;
+  const std::string upd =
+      f.string("sphere_update", paper_update ? "paper" : "conservative", {"paper", "conservative"});
   c.update.mode = upd == "paper" ? collision::SphereUpdateMode::PaperRatio
                                  : collision::SphereUpdateMode::DisplacementBound;
-  c.update.margin = f.number("sphere_margin", 0, 0, 1e3);
-  c.contact.stiffness = f.number("stiffness", 1e3, 0, 1e12, true);
+  c.update.margin = f.number("sphere_margin", c.update.margin, 0, 1e3);
+  c.contact.stiffness = f.number("stiffness", c.contact.stiffness, 0, 1e12, true);
+  static_assert(coupling::ContactOptions{}.distribution ==
+                coupling::ContactDistribution::PartitionOfUnity);  // the field's default below
   const std::string dist = f.string("distribution", "partition_of_unity",
                                     {"mass_weighted", "partition_of_unity", "paper_average"});
   c.contact.distribution = dist == "paper_average" ? coupling::ContactDistribution::PaperAverage
                            : dist == "partition_of_unity"
                                ? coupling::ContactDistribution::PartitionOfUnity
                                : coupling::ContactDistribution::MassWeighted;
-  c.contact.use_untested = f.boolean("use_untested", true);
+  c.contact.use_untested = f.boolean("use_untested", c.contact.use_untested);
+  static_assert(CollisionSpec{}.on_interrupt == InterruptedResponse::Previous);
   c.on_interrupt = f.string("on_interrupt", "previous", {"untested", "previous"}) == "untested"
                        ? InterruptedResponse::Untested
                        : InterruptedResponse::Previous;
@@ -262,9 +277,9 @@ Scene parse_scene(const Json& json, const std::string& source,
   s.base_dir = base_dir;
   s.name = f.string("name", "scene");
   s.frames = f.integer("frames", s.frames, 1, 100000000);
-  s.frame_rate = f.number("frame_rate", s.frame_rate, 0, 1e5, true);
-  s.gravity = f.vec3("gravity", s.gravity, 1e4);
-  s.target_fps = f.number("target_fps", 0, 0, 1e5);
+  s.world.frame_rate = f.number("frame_rate", s.world.frame_rate, 0, 1e5, true);
+  s.world.gravity = f.vec3("gravity", s.world.gravity, 1e4);
+  s.world.target_fps = f.number("target_fps", s.world.target_fps, 0, 1e5);
   const Json* objects = f.get("objects");
   if (!objects || !objects->is_array() || objects->as_array().empty())
     f.fail("objects", "must be a non-empty array of objects");
@@ -276,14 +291,14 @@ Scene parse_scene(const Json& json, const std::string& source,
     if (!names.insert(s.objects[i].name).second)
       f.fail("objects[" + std::to_string(i) + "].name",
              "duplicate object name \"" + s.objects[i].name + "\"");
-  if (const Json* c = f.get("collision")) s.collision = parse_collision(*c, source);
+  if (const Json* c = f.get("collision")) s.world.collision = parse_collision(*c, source);
   if (const Json* o = f.get("output")) {
     Fields out(*o, "output", source);
     s.output.csv = out.boolean("csv", true);
     s.output.vtu_every = out.integer("vtu_every", 0, 0, 1000000);
     s.output.dense = out.boolean("dense", true);
     s.output.spheres = out.boolean("spheres", true);
-    s.output.exact_reference = out.boolean("exact_reference", false);
+    s.world.exact_reference = out.boolean("exact_reference", false);
     out.finish();
   }
   f.finish();
@@ -295,6 +310,12 @@ Scene parse_scene(const Json& json, const std::string& source,
         *p = std::filesystem::exists(local) ? local : std::filesystem::path(ICD_SOURCE_DIR) / *p;
       }
   return s;
+}
+
+coupling::WorldSettings world_settings(const Scene& scene) {
+  coupling::WorldSettings w = scene.world;
+  w.dense_meshes = scene.output.vtu_every > 0 && scene.output.dense;
+  return w;
 }
 
 Scene load_scene(const std::filesystem::path& path) {

@@ -1,4 +1,4 @@
-#include "mesh/io/atomic_write.hpp"
+#include <icd/mesh/io/atomic_write.hpp>
 
 #include <cerrno>
 #include <cstdio>
@@ -6,7 +6,7 @@
 #include <string>
 #include <system_error>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd {
 

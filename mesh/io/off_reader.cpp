@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "mesh/io/detail/input_error.hpp"
-#include "mesh/io/detail/surface_builder.hpp"
-#include "mesh/io/detail/text_scan.hpp"
-#include "mesh/io/surface_reader.hpp"
+#include <icd/mesh/io/detail/input_error.hpp>
+#include <icd/mesh/io/detail/surface_builder.hpp>
+#include <icd/mesh/io/detail/text_scan.hpp>
+#include <icd/mesh/io/surface_reader.hpp>
 
 namespace icd {
 namespace {

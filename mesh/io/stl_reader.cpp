@@ -8,10 +8,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mesh/io/detail/input_error.hpp"
-#include "mesh/io/detail/surface_builder.hpp"
-#include "mesh/io/detail/text_scan.hpp"
-#include "mesh/io/surface_reader.hpp"
+#include <icd/mesh/io/detail/input_error.hpp>
+#include <icd/mesh/io/detail/surface_builder.hpp>
+#include <icd/mesh/io/detail/text_scan.hpp>
+#include <icd/mesh/io/surface_reader.hpp>
 
 namespace icd {
 namespace {

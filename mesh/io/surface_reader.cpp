@@ -1,11 +1,11 @@
-#include "mesh/io/surface_reader.hpp"
+#include <icd/mesh/io/surface_reader.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <string>
 
-#include "mesh/io/detail/file_bytes.hpp"
-#include "mesh/io/detail/input_error.hpp"
+#include <icd/mesh/io/detail/file_bytes.hpp>
+#include <icd/mesh/io/detail/input_error.hpp>
 
 namespace icd {
 

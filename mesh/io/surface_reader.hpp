@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <string_view>
 
-#include "mesh/io/read_report.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/mesh/io/read_report.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd {
 

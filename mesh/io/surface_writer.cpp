@@ -1,13 +1,13 @@
-#include "mesh/io/surface_writer.hpp"
+#include <icd/mesh/io/surface_writer.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <string>
 
-#include "mesh/io/atomic_write.hpp"
-#include "mesh/io/detail/number_format.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/io/atomic_write.hpp>
+#include <icd/mesh/io/detail/number_format.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd {
 namespace {

@@ -3,7 +3,7 @@
 /// shortest form that reads back to the identical double).
 #include <filesystem>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd {
 

@@ -4,7 +4,7 @@
 
 #include <Eigen/Core>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd {
 

@@ -1,14 +1,14 @@
-#include "mesh/io/vtk_writer.hpp"
+#include <icd/mesh/io/vtk_writer.hpp>
 
 #include <cmath>
 #include <cstdint>
 #include <set>
 #include <string>
 
-#include "mesh/io/atomic_write.hpp"
-#include "mesh/io/detail/number_format.hpp"
-#include "mesh/io/detail/xml_text.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/io/atomic_write.hpp>
+#include <icd/mesh/io/detail/number_format.hpp>
+#include <icd/mesh/io/detail/xml_text.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd {
 namespace {

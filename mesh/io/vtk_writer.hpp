@@ -11,8 +11,8 @@
 #include <filesystem>
 #include <span>
 
-#include "mesh/io/types.hpp"
-#include "mesh/io/vtk_types.hpp"
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/io/vtk_types.hpp>
 
 namespace icd {
 

@@ -1,4 +1,4 @@
-#include "mesh/io/vtu_reader.hpp"
+#include <icd/mesh/io/vtu_reader.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,11 +7,11 @@
 #include <string_view>
 #include <utility>
 
-#include "mesh/io/detail/file_bytes.hpp"
-#include "mesh/io/detail/input_error.hpp"
-#include "mesh/io/detail/text_scan.hpp"
-#include "mesh/io/detail/xml_scanner.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/mesh/io/detail/file_bytes.hpp>
+#include <icd/mesh/io/detail/input_error.hpp>
+#include <icd/mesh/io/detail/text_scan.hpp>
+#include <icd/mesh/io/detail/xml_scanner.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd {
 namespace {

@@ -8,8 +8,8 @@
 #include <string_view>
 #include <vector>
 
-#include "mesh/io/types.hpp"
-#include "mesh/io/vtk_types.hpp"
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/io/vtk_types.hpp>
 
 namespace icd {
 

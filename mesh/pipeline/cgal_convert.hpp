@@ -8,7 +8,7 @@
 #include <cassert>
 #include <vector>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh::detail {
 

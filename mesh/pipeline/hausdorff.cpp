@@ -1,4 +1,4 @@
-#include "mesh/pipeline/hausdorff.hpp"
+#include <icd/mesh/pipeline/hausdorff.hpp>
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -8,8 +8,8 @@
 #include <cmath>
 #include <vector>
 
-#include "mesh/io/error.hpp"
-#include "mesh/pipeline/cgal_convert.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/pipeline/cgal_convert.hpp>
 
 namespace icd::mesh {
 namespace {

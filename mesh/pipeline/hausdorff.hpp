@@ -1,6 +1,6 @@
 #pragma once
 /// Distance between two surfaces, for the preprocessing summary.
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh {
 

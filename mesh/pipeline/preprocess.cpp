@@ -1,13 +1,13 @@
-#include "mesh/pipeline/preprocess.hpp"
+#include <icd/mesh/pipeline/preprocess.hpp>
 
 #include <chrono>
 #include <ctime>
 #include <sstream>
 #include <utility>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/pipeline/hausdorff.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/pipeline/hausdorff.hpp>
 
 namespace icd::mesh {
 namespace {

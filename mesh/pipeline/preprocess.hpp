@@ -7,15 +7,15 @@
 #include <string>
 #include <vector>
 
-#include "collision/node_association.hpp"
-#include "collision/octree_tree.hpp"
-#include "coupling/asset_bundle.hpp"
-#include "coupling/rigid_links.hpp"
-#include "mesh/io/types.hpp"
-#include "mesh/pipeline/repair.hpp"
-#include "mesh/pipeline/simplify.hpp"
-#include "mesh/pipeline/tetrahedralize.hpp"
-#include "mesh/spheres/builder.hpp"
+#include <icd/collision/node_association.hpp>
+#include <icd/collision/octree_tree.hpp>
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/coupling/rigid_links.hpp>
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/pipeline/repair.hpp>
+#include <icd/mesh/pipeline/simplify.hpp>
+#include <icd/mesh/pipeline/tetrahedralize.hpp>
+#include <icd/mesh/spheres/builder.hpp>
 
 namespace icd::mesh {
 

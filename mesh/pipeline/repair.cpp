@@ -3,7 +3,7 @@
 #define CGAL_EIGEN3_ENABLED
 #endif
 
-#include "mesh/pipeline/repair.hpp"
+#include <icd/mesh/pipeline/repair.hpp>
 
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
@@ -27,8 +27,8 @@
 #include <sstream>
 #include <vector>
 
-#include "mesh/io/error.hpp"
-#include "mesh/pipeline/cgal_convert.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/pipeline/cgal_convert.hpp>
 
 namespace icd::mesh {
 namespace PMP = CGAL::Polygon_mesh_processing;

@@ -4,7 +4,7 @@
 /// or refuse it with an InputError that says where it fails.
 #include <string>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh {
 

@@ -3,7 +3,7 @@
 #define CGAL_EIGEN3_ENABLED
 #endif
 
-#include "mesh/pipeline/simplify.hpp"
+#include <icd/mesh/pipeline/simplify.hpp>
 
 // GCC 12 reports a false -Wmaybe-uninitialized inside CGAL's Garland-Heckbert
 // quadric code (an Eigen 4x4 matrix copied in an optional); not our code.
@@ -17,8 +17,8 @@
 #include <cmath>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/pipeline/cgal_convert.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/pipeline/cgal_convert.hpp>
 
 namespace icd::mesh {
 namespace SMS = CGAL::Surface_mesh_simplification;

@@ -1,7 +1,7 @@
 #pragma once
 /// Stage 2 of the preprocessing pipeline (issue 4, paper section 5): quadric
 /// error metric simplification (Garland-Heckbert, CGAL Surface_mesh_simplification).
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh {
 

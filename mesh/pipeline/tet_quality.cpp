@@ -1,4 +1,4 @@
-#include "mesh/pipeline/tet_quality.hpp"
+#include <icd/mesh/pipeline/tet_quality.hpp>
 
 #include <Eigen/Dense>
 

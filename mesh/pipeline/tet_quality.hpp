@@ -3,7 +3,7 @@
 /// Plain Eigen: no CGAL.
 #include <string>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh {
 

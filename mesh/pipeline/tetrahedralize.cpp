@@ -1,4 +1,4 @@
-#include "mesh/pipeline/tetrahedralize.hpp"
+#include <icd/mesh/pipeline/tetrahedralize.hpp>
 
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
@@ -19,9 +19,9 @@
 #include <utility>
 #include <vector>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/pipeline/cgal_convert.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/pipeline/cgal_convert.hpp>
 
 namespace icd::mesh {
 namespace {

@@ -3,8 +3,8 @@
 /// mesh of a closed surface, with CGAL's 3D mesh generator (Mesh_3, polyhedral
 /// domain), Delaunay refinement with quality bounds, then sliver perturbation
 /// and exudation. Its boundary nodes are the reduced coordinates Q (paper 3.1).
-#include "mesh/io/types.hpp"
-#include "mesh/pipeline/tet_quality.hpp"
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/pipeline/tet_quality.hpp>
 
 namespace icd::mesh {
 

@@ -1,4 +1,4 @@
-#include "mesh/spheres/allocation.hpp"
+#include <icd/mesh/spheres/allocation.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::mesh {
 namespace {

@@ -1,4 +1,4 @@
-#include "mesh/spheres/builder.hpp"
+#include <icd/mesh/spheres/builder.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -9,15 +9,15 @@
 #include <queue>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/allocation.hpp"
-#include "mesh/spheres/medial_axis.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/parallel.hpp"
-#include "mesh/spheres/point_grid.hpp"
-#include "mesh/spheres/regroup.hpp"
-#include "mesh/spheres/sort_indices.hpp"
-#include "mesh/spheres/sum_exchange.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/allocation.hpp>
+#include <icd/mesh/spheres/medial_axis.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/parallel.hpp>
+#include <icd/mesh/spheres/point_grid.hpp>
+#include <icd/mesh/spheres/regroup.hpp>
+#include <icd/mesh/spheres/sort_indices.hpp>
+#include <icd/mesh/spheres/sum_exchange.hpp>
 
 namespace icd::mesh {
 namespace {

@@ -5,14 +5,14 @@
 #include <utility>
 #include <vector>
 
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/types.hpp"
-#include "mesh/spheres/exchange.hpp"
-#include "mesh/spheres/merge_burst.hpp"
-#include "mesh/spheres/protrusion.hpp"
-#include "mesh/spheres/reduction.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
-#include "mesh/spheres/worst_split.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/spheres/exchange.hpp>
+#include <icd/mesh/spheres/merge_burst.hpp>
+#include <icd/mesh/spheres/protrusion.hpp>
+#include <icd/mesh/spheres/reduction.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
+#include <icd/mesh/spheres/worst_split.hpp>
 
 namespace icd::mesh {
 

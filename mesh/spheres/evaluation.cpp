@@ -1,4 +1,4 @@
-#include "mesh/spheres/evaluation.hpp"
+#include <icd/mesh/spheres/evaluation.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -11,10 +11,10 @@
 
 #include <Eigen/Geometry>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 namespace icd::mesh {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <Eigen/Core>
 
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh {
 

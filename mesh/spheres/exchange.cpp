@@ -1,12 +1,12 @@
-#include "mesh/spheres/exchange.hpp"
+#include <icd/mesh/spheres/exchange.hpp>
 
 #include <algorithm>
 #include <numeric>
 #include <set>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/sort_indices.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/sort_indices.hpp>
 
 namespace icd::mesh {
 

@@ -1,4 +1,4 @@
-#include "mesh/spheres/medial_axis.hpp"
+#include <icd/mesh/spheres/medial_axis.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -13,8 +13,8 @@
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/parallel.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/parallel.hpp>
 
 namespace icd::mesh {
 namespace {

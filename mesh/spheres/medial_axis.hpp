@@ -6,9 +6,9 @@
 
 #include <Eigen/Core>
 
-#include "mesh/io/types.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 namespace icd::mesh {
 

@@ -1,4 +1,4 @@
-#include "mesh/spheres/merge_burst.hpp"
+#include <icd/mesh/spheres/merge_burst.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -9,8 +9,8 @@
 #include <queue>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::mesh {
 namespace {

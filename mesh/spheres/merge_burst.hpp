@@ -6,7 +6,7 @@
 /// leaves the lowest error).
 #include <vector>
 
-#include "mesh/spheres/reduction.hpp"
+#include <icd/mesh/spheres/reduction.hpp>
 
 namespace icd::mesh {
 

@@ -1,4 +1,4 @@
-#include "mesh/spheres/mesh_oracle.hpp"
+#include <icd/mesh/spheres/mesh_oracle.hpp>
 
 #include <cmath>
 #include <map>
@@ -11,8 +11,8 @@
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/triangle_bvh.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/triangle_bvh.hpp>
 
 namespace icd::mesh {
 namespace {

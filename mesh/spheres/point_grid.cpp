@@ -1,12 +1,12 @@
-#include "mesh/spheres/point_grid.hpp"
+#include <icd/mesh/spheres/point_grid.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/sort_indices.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/sort_indices.hpp>
 
 namespace icd::mesh {
 

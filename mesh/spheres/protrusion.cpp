@@ -1,4 +1,4 @@
-#include "mesh/spheres/protrusion.hpp"
+#include <icd/mesh/spheres/protrusion.hpp>
 
 #include <algorithm>
 #include <array>
@@ -13,7 +13,7 @@
 
 #include <Eigen/Geometry>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::mesh {
 namespace {

@@ -7,9 +7,9 @@
 
 #include <Eigen/Core>
 
-#include "mesh/io/types.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/reduction.hpp"
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/reduction.hpp>
 
 namespace icd::mesh {
 

@@ -1,4 +1,4 @@
-#include "mesh/spheres/reduction.hpp"
+#include <icd/mesh/spheres/reduction.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -11,9 +11,9 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/convex_hull_3.h>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/parallel.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/parallel.hpp>
 
 namespace icd::mesh {
 

@@ -6,10 +6,10 @@
 
 #include <Eigen/Core>
 
-#include "mesh/io/types.hpp"
-#include "mesh/spheres/cpu_clock.hpp"
-#include "mesh/spheres/medial_axis.hpp"
-#include "mesh/spheres/point_grid.hpp"
+#include <icd/mesh/core/types.hpp>
+#include <icd/mesh/spheres/cpu_clock.hpp>
+#include <icd/mesh/spheres/medial_axis.hpp>
+#include <icd/mesh/spheres/point_grid.hpp>
 
 namespace icd::mesh {
 

@@ -1,4 +1,4 @@
-#include "mesh/spheres/regroup.hpp"
+#include <icd/mesh/spheres/regroup.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::mesh {
 namespace {

@@ -1,11 +1,11 @@
-#include "mesh/spheres/sum_exchange.hpp"
+#include <icd/mesh/spheres/sum_exchange.hpp>
 
 #include <algorithm>
 #include <map>
 #include <numeric>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/sort_indices.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/sort_indices.hpp>
 
 namespace icd::mesh {
 

@@ -5,7 +5,7 @@
 #include <functional>
 #include <vector>
 
-#include "mesh/spheres/reduction.hpp"
+#include <icd/mesh/spheres/reduction.hpp>
 
 namespace icd::mesh {
 

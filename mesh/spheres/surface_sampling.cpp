@@ -1,4 +1,4 @@
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::mesh {
 namespace {

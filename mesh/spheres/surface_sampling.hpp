@@ -2,7 +2,7 @@
 /// Deterministic surface sampling with a per-sample coverage margin.
 #include <Eigen/Core>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh {
 

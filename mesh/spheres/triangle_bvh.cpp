@@ -1,4 +1,4 @@
-#include "mesh/spheres/triangle_bvh.hpp"
+#include <icd/mesh/spheres/triangle_bvh.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <numeric>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/triangle_geometry.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/triangle_geometry.hpp>
 
 namespace icd::mesh {
 

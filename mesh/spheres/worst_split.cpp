@@ -1,4 +1,4 @@
-#include "mesh/spheres/worst_split.hpp"
+#include <icd/mesh/spheres/worst_split.hpp>
 
 #include <algorithm>
 #include <cassert>
@@ -10,9 +10,9 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/exchange.hpp"
-#include "mesh/spheres/parallel.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/exchange.hpp>
+#include <icd/mesh/spheres/parallel.hpp>
 
 namespace icd::mesh {
 namespace {

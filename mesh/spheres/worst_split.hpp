@@ -5,10 +5,10 @@
 /// while its parent has room and the split lowers its true error.
 #include <vector>
 
-#include "mesh/spheres/cpu_clock.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/protrusion.hpp"
-#include "mesh/spheres/reduction.hpp"
+#include <icd/mesh/spheres/cpu_clock.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/protrusion.hpp>
+#include <icd/mesh/spheres/reduction.hpp>
 
 namespace icd::mesh {
 

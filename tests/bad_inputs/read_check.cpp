@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <string>
 
-#include "collision/sph_io.hpp"
-#include "coupling/asset_bundle.hpp"
+#include <icd/collision/sph_io.hpp>
+#include <icd/coupling/asset_bundle.hpp>
 
 int main(int argc, char** argv) {
   if (argc != 2) {

@@ -12,9 +12,9 @@
 
 #include <Eigen/Core>
 
-#include "collision/aabb_tree.hpp"
-#include "collision/traversal.hpp"
-#include "collision/triangle_intersection.hpp"
+#include <icd/collision/aabb_tree.hpp>
+#include <icd/collision/traversal.hpp>
+#include <icd/collision/triangle_intersection.hpp>
 
 namespace icd::collision::testing {
 

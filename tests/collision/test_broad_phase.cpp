@@ -2,8 +2,8 @@
 
 #include <random>
 
-#include "collision/broad_phase.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/collision/broad_phase.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 namespace {

@@ -8,10 +8,10 @@
 
 #include <Eigen/Geometry>
 
-#include "collision/aabb_tree.hpp"
-#include "collision/node_association.hpp"
-#include "collision/sphere_update.hpp"
-#include "collision/triangle_intersection.hpp"
+#include <icd/collision/aabb_tree.hpp>
+#include <icd/collision/node_association.hpp>
+#include <icd/collision/sphere_update.hpp>
+#include <icd/collision/triangle_intersection.hpp>
 #include "contact_oracle.hpp"
 #include "tree_fixtures.hpp"
 

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "collision/cycle_clock.hpp"
+#include <icd/collision/cycle_clock.hpp>
 
 namespace icd::collision {
 namespace {

@@ -3,10 +3,10 @@
 #include <random>
 #include <set>
 
-#include "collision/node_association.hpp"
-#include "collision/octree_tree.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/collision/node_association.hpp>
+#include <icd/collision/octree_tree.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::collision {
 namespace {

@@ -4,8 +4,8 @@
 #include <sstream>
 #include <string>
 
-#include "collision/sph_io.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/collision/sph_io.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::collision {
 namespace {

@@ -4,12 +4,12 @@
 
 #include <Eigen/Geometry>
 
-#include "collision/coverage.hpp"
-#include "collision/node_association.hpp"
-#include "collision/octree_tree.hpp"
-#include "collision/sphere_update.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/collision/coverage.hpp>
+#include <icd/collision/node_association.hpp>
+#include <icd/collision/octree_tree.hpp>
+#include <icd/collision/sphere_update.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::collision {
 namespace {
@@ -201,6 +201,42 @@ TEST(Coverage, MatchesBruteForce) {
     EXPECT_NEAR(rep.max_gap, gap, 1e-12);
   }
   EXPECT_THROW(measure_coverage(t, P, 3), ParameterError);
+}
+
+}  // namespace
+}  // namespace icd::collision
+
+namespace icd::collision {
+namespace {
+
+// enclose_children turns a wrapped tree into a layered one: every parent
+// then contains each child sphere (checked on sample points of the child's
+// boundary, an independent test of containment), only radii grow, centres
+// and leaves stay.
+TEST(SphereUpdate, EncloseChildrenMakesEveryParentContainItsChildren) {
+  const SurfaceMesh m = make_icosphere(3, 1.0);
+  OctreeTreeOptions o;
+  o.levels = 4;
+  SphereTree t = build_octree_tree(m.V, m.F, o);
+  std::mt19937 rng(0);
+  std::normal_distribution<double> g;
+  for (Sphere& s : t.spheres) s.r *= 0.6;  // wrapped: children poke out of their parents
+  const SphereTree before = t;
+  enclose_children(t);
+  int grown = 0;
+  for (int i = 0; i < t.num_nodes(); ++i) {
+    EXPECT_EQ(t.spheres[i].center(), before.spheres[i].center());
+    EXPECT_GE(t.spheres[i].r, before.spheres[i].r);
+    if (t.child_count[i] == 0) EXPECT_EQ(t.spheres[i].r, before.spheres[i].r);
+    grown += t.spheres[i].r > before.spheres[i].r;
+    for (int c = t.first_child[i]; c < t.first_child[i] + t.child_count[i]; ++c)
+      for (int k = 0; k < 64; ++k) {
+        const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+        const Eigen::Vector3d p = t.spheres[c].center() + t.spheres[c].r * d;
+        EXPECT_LE((p - t.spheres[i].center()).norm(), t.spheres[i].r * (1 + 1e-12));
+      }
+  }
+  EXPECT_GT(grown, 0);
 }
 
 }  // namespace

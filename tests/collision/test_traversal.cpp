@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "collision/traversal.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/collision/traversal.hpp>
+#include <icd/mesh/core/error.hpp>
 #include "tree_fixtures.hpp"
 
 namespace icd::collision {
@@ -28,16 +28,14 @@ Scene torus_and_sphere(int levels, bool make_layered) {
 
 std::vector<CollisionRequest> all_modes() {
   std::vector<CollisionRequest> v;
-  for (auto mode :
-       {TraversalMode::BreadthFirstFifo, TraversalMode::DepthFirst, TraversalMode::Priority})
-    for (bool fast : {true, false}) {
-      CollisionRequest r;
-      r.mode = mode;
-      r.test_on_push = fast;
-      r.max_list_size = 1 << 20;
-      if (mode == TraversalMode::Priority && !fast) continue;
-      v.push_back(r);
-    }
+  for (auto mode : {TraversalMode::BreadthFirstFifo, TraversalMode::BreadthFirstLiteral,
+                    TraversalMode::DepthFirst, TraversalMode::DepthFirstLiteral,
+                    TraversalMode::Priority}) {
+    CollisionRequest r;
+    r.mode = mode;
+    r.max_list_size = 1 << 20;
+    v.push_back(r);
+  }
   CollisionRequest deepest;
   deepest.mode = TraversalMode::Priority;
   deepest.priority = PriorityKey::DeepestOverlap;
@@ -51,7 +49,7 @@ std::vector<CollisionRequest> all_modes() {
 std::vector<CollisionRequest> filtered_modes() {
   std::vector<CollisionRequest> v;
   for (const CollisionRequest& r : all_modes())
-    if (r.test_on_push || r.mode == TraversalMode::Priority) {
+    if (!is_literal(r.mode)) {
       v.push_back(r);
       v.back().parent_filter = true;
     }
@@ -59,7 +57,7 @@ std::vector<CollisionRequest> filtered_modes() {
 }
 
 std::string describe(const CollisionRequest& r) {
-  return "mode " + std::to_string(int(r.mode)) + " fast " + std::to_string(r.test_on_push) +
+  return "mode " + std::to_string(int(r.mode)) +
          " filter " + std::to_string(r.parent_filter) + " priority " +
          std::to_string(int(r.priority));
 }

@@ -5,10 +5,10 @@
 
 #include <Eigen/Geometry>
 
-#include "collision/aabb_tree.hpp"
-#include "collision/exact_predicates.hpp"
-#include "collision/triangle_intersection.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/collision/aabb_tree.hpp>
+#include <icd/collision/exact_predicates.hpp>
+#include <icd/collision/triangle_intersection.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::collision {
 namespace {

@@ -6,9 +6,9 @@
 #include <set>
 #include <vector>
 
-#include "collision/octree_tree.hpp"
-#include "collision/traversal.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/collision/octree_tree.hpp>
+#include <icd/collision/traversal.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::collision::testing {
 

@@ -3,9 +3,9 @@
 #include <set>
 #include <vector>
 
-#include "collision/node_association.hpp"
-#include "coupling/asset_bundle.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/collision/node_association.hpp>
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::coupling {
 

@@ -6,8 +6,8 @@
 #include <iterator>
 #include <string>
 
-#include "coupling/asset_bundle.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/mesh/core/error.hpp>
 #include "tests/coupling/small_bundle.hpp"
 
 namespace icd::coupling {

@@ -4,9 +4,9 @@
 
 #include <Eigen/Dense>
 
-#include "coupling/barycentric_embedding.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/coupling/barycentric_embedding.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::coupling {
 namespace {

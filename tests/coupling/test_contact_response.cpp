@@ -6,8 +6,8 @@
 
 #include <Eigen/Dense>
 
-#include "coupling/contact_response.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/coupling/contact_response.hpp>
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::coupling {
 namespace {

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "coupling/asset_bundle.hpp"
-#include "coupling/link_evaluator.hpp"
-#include "coupling/rigid_links.hpp"
-#include "icd/config.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/coupling/link_evaluator.hpp>
+#include <icd/coupling/rigid_links.hpp>
+#include <icd/config.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::coupling {
 namespace {

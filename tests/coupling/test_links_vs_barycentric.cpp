@@ -5,9 +5,9 @@
 
 #include <Eigen/Dense>
 
-#include "coupling/barycentric_embedding.hpp"
-#include "coupling/rigid_links.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/coupling/barycentric_embedding.hpp>
+#include <icd/coupling/rigid_links.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::coupling {
 namespace {

@@ -7,9 +7,9 @@
 #include <utility>
 #include <vector>
 
-#include "coupling/rigid_links.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/coupling/rigid_links.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::coupling {
 namespace {

@@ -1,4 +1,4 @@
-// The geometry of contact_tightness (experiments/spheretree/approach.hpp)
+// The geometry of contact_tightness (experiments/studies/spheretree/approach.hpp)
 // against independent references: the exact contact of two boxes by the
 // separating-axis theorem, and a dense scan of the leaf pairs' distances.
 #include <gtest/gtest.h>
@@ -12,10 +12,10 @@
 
 #include <Eigen/Geometry>
 
-#include "collision/sph_io.hpp"
-#include "experiments/spheretree/approach.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/collision/sph_io.hpp>
+#include "experiments/studies/spheretree/approach.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::experiments {
 namespace {

@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <string>
 
-#include "collision/sphere_tree.hpp"
+#include <icd/collision/sphere_tree.hpp>
 #include "experiments/runner/run.hpp"
-#include "experiments/runner/world.hpp"
-#include "mesh/io/vtu_reader.hpp"
+#include "experiments/runner/run.hpp"
+#include <icd/mesh/io/vtu_reader.hpp>
 #include "tests/experiments/head_on_scene.hpp"
 
 namespace icd::runner {
@@ -45,7 +45,7 @@ int find_node(const collision::SphereTree& tree, const Eigen::Vector3d& c, doubl
 // the head-on scene until a query reached leaves (complete query) or, with a
 // small test budget, was interrupted with pairs left untested.
 void expect_written_pairs_overlap(const std::string& collision, bool expect_untested) {
-  World world(head_on_scene(collision), "", "");
+  World world = make_world(head_on_scene(collision), "", "");
   // One folder per test and process: CTest runs these tests side by side.
   const fs::path dir =
       fs::path(::testing::TempDir()) /

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "experiments/runner/world.hpp"
+#include "experiments/runner/run.hpp"
 #include "tests/experiments/head_on_scene.hpp"
 
 namespace icd::runner {
@@ -23,7 +23,7 @@ Eigen::Vector3d centre(const RuntimeObject& o) { return o.positions.colwise().me
 TEST(HeadOn, SoftSpheresBounceApartSymmetrically) {
   Scene scene = head_on_scene(R"("budget_tests": 1000000, "layered": true)");
   scene.frames = 40;
-  World world(scene, "", "");
+  World world = make_world(scene, "", "");
   auto& objs = world.objects();
   const double mass = objs[0].sim->model().mass().sum();
   const double e0 = objs[0].sim->total_energy() + objs[1].sim->total_energy();

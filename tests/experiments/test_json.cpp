@@ -3,7 +3,7 @@
 #include <string>
 
 #include "experiments/runner/json.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::runner {
 namespace {

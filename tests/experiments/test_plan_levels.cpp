@@ -4,8 +4,8 @@
 #include <limits>
 #include <string>
 
-#include "collision/traversal.hpp"
-#include "experiments/runner/world.hpp"
+#include <icd/collision/traversal.hpp>
+#include "experiments/runner/run.hpp"
 
 namespace icd::runner {
 namespace {
@@ -31,33 +31,58 @@ int deepest_level(const collision::SphereTree& ta, const collision::SphereTree& 
   return d;
 }
 
-TEST(PlanLevels, BoundFollowsDepthCapAndBudget) {
-  EXPECT_EQ(max_usable_level(-1, std::numeric_limits<double>::infinity()), kAll);
-  EXPECT_EQ(max_usable_level(0, std::numeric_limits<double>::infinity()), 0);
-  EXPECT_EQ(max_usable_level(5, std::numeric_limits<double>::infinity()), 3);
-  EXPECT_EQ(max_usable_level(1000000, 1e-3), kAll);
-  EXPECT_EQ(max_usable_level(-1, 4.5 * kFastestTestSeconds), 2);
-  EXPECT_EQ(max_usable_level(1, std::numeric_limits<double>::infinity()), 1);
+TEST(PlanLevels, BoundFollowsDepthCapAndTestBudget) {
+  using coupling::max_usable_level;
+  EXPECT_EQ(max_usable_level(-1), kAll);
+  EXPECT_EQ(max_usable_level(0), 0);
+  EXPECT_EQ(max_usable_level(5), 3);
+  EXPECT_EQ(max_usable_level(1000000), kAll);
+  EXPECT_EQ(max_usable_level(1), 1);
 
   Scene s = two_spheres(R"("budget_seconds": 0.001, "depth_cap": 1)");
-  StagePlan p = make_plan(s);
+  coupling::StagePlan p = scene_plan(s);
   EXPECT_EQ(p.max_tree_level, 1);
-  const auto lines = p.describe(s);
+  EXPECT_EQ(p.tree_cut, coupling::TreeCut::DepthCap);
+  auto lines = describe_plan(s);
   EXPECT_NE(std::find(lines.begin(), lines.end(),
-                      "sphere trees: levels 0..1 only (deeper levels are beyond the depth cap; "
-                      "not loaded, not updated)"),
+                      "sphere trees: levels 0..1 only (collision.depth_cap; deeper levels not "
+                      "loaded, not updated)"),
             lines.end());
   s = two_spheres(R"("budget_tests": 2)");
-  EXPECT_EQ(make_plan(s).max_tree_level, 1);
-  s = two_spheres(R"("budget_seconds": 0.001)");
-  EXPECT_EQ(make_plan(s).max_tree_level, kAll);
+  p = scene_plan(s);
+  EXPECT_EQ(p.max_tree_level, 1);
+  EXPECT_EQ(p.tree_cut, coupling::TreeCut::TestBudget);
+  lines = describe_plan(s);
+  EXPECT_NE(std::find(lines.begin(), lines.end(),
+                      "sphere trees: levels 0..1 only (a level-L sphere needs 2L - 1 tests first, "
+                      "beyond the budget of 2 tests; deeper levels not loaded, not updated)"),
+            lines.end());
+}
+
+// A time budget cuts no level, and the plan does not claim that the queries
+// reach the leaves: how deep they get depends on the machine.
+TEST(PlanLevels, TimeBudgetsCutNoLevelAndClaimNothing) {
+  for (const char* budget : {R"("budget_seconds": 0.001)", R"("budget_seconds": 1e-6)",
+                             R"("budget_seconds": 1e-9)"}) {
+    const Scene s = two_spheres(budget);
+    const coupling::StagePlan p = scene_plan(s);
+    EXPECT_EQ(p.max_tree_level, kAll) << budget;
+    EXPECT_EQ(p.tree_cut, coupling::TreeCut::None) << budget;
+    const auto lines = describe_plan(s);
+    ASSERT_GE(lines.size(), 4u);
+    EXPECT_EQ(lines[2],
+              "sphere trees: every level kept (a time budget cuts no level: how deep a query gets "
+              "depends on the machine and the pair)")
+        << budget;
+    for (const std::string& l : lines) EXPECT_EQ(l.find("reach the leaves"), std::string::npos);
+  }
 }
 
 // Oracle: for every test budget and traversal mode, the query on the full
 // trees never reports a pair deeper than the bound, and the trees cut at the
 // bound give exactly the same answer -- cutting loses nothing.
 TEST(PlanLevels, CutTreesGiveTheSameAnswerAsFullTrees) {
-  World world(two_spheres(R"("unlimited": true)"), "", "");
+  World world = make_world(two_spheres(R"("unlimited": true)"), "", "");
   const collision::SphereTree& fa = world.objects()[0].asset.spheres;
   const collision::SphereTree& fb = world.objects()[1].asset.spheres;
   ASSERT_GE(fa.num_levels(), 3);
@@ -70,7 +95,7 @@ TEST(PlanLevels, CutTreesGiveTheSameAnswerAsFullTrees) {
       req.mode = mode;
       req.budget_tests = n;
       const collision::CollisionResult full = collision::collide(fa, fb, req);
-      const int bound = max_usable_level(n, std::numeric_limits<double>::infinity());
+      const int bound = coupling::max_usable_level(n);
       ASSERT_LE(deepest_level(fa, fb, full), bound) << "budget " << n;
       if (bound + 1 >= fa.num_levels()) continue;
       collision::SphereTree ca = fa, cb = fb;
@@ -87,8 +112,8 @@ TEST(PlanLevels, CutTreesGiveTheSameAnswerAsFullTrees) {
 }
 
 TEST(PlanLevels, WorldLoadsOnlyTheUsableLevels) {
-  World capped(two_spheres(R"("budget_seconds": 0.001, "depth_cap": 1)"), "", "");
-  World full(two_spheres(R"("budget_seconds": 0.001)"), "", "");
+  World capped = make_world(two_spheres(R"("budget_seconds": 0.001, "depth_cap": 1)"), "", "");
+  World full = make_world(two_spheres(R"("budget_seconds": 0.001)"), "", "");
   const collision::SphereTree& c = capped.objects()[0].asset.spheres;
   const collision::SphereTree& f = full.objects()[0].asset.spheres;
   EXPECT_EQ(c.num_levels(), 2);

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "experiments/runner/world.hpp"
+#include "experiments/runner/run.hpp"
 
 namespace icd::runner {
 namespace {
@@ -25,7 +25,7 @@ TEST(Reproducible, SameSceneSameTestBudgetGivesIdenticalFrames) {
   std::vector<std::vector<FrameMetrics>> runs(2);
   std::vector<MatX3d> final_positions;
   for (auto& frames : runs) {
-    World world(scene, "", "");
+    World world = make_world(scene, "", "");
     for (int f = 0; f < scene.frames; ++f) frames.push_back(world.step());
     final_positions.push_back(world.objects()[0].positions);
   }

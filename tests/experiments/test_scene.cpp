@@ -2,9 +2,9 @@
 
 #include <string>
 
-#include "experiments/runner/plan.hpp"
+#include "experiments/runner/run.hpp"
 #include "experiments/runner/scene.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::runner {
 namespace {
@@ -33,16 +33,43 @@ TEST(Scene, ParsesDefaultsAndFields) {
   EXPECT_DOUBLE_EQ(o.material.poisson, 0.45);
   EXPECT_DOUBLE_EQ(o.damping.beta, 0.001);
   EXPECT_EQ(o.integrator, fem::Integrator::SymplecticEuler);
-  EXPECT_EQ(s.collision.budget_tests, 100);
-  EXPECT_EQ(s.collision.mode, collision::TraversalMode::Priority);
-  EXPECT_TRUE(std::isinf(s.collision.budget_seconds));  // a test budget alone
-  EXPECT_FALSE(s.collision.parent_filter);
-  EXPECT_TRUE(s.collision.layered);
+  EXPECT_EQ(s.world.collision.query.budget_tests, 100);
+  EXPECT_EQ(s.world.collision.query.mode, collision::TraversalMode::Priority);
+  EXPECT_TRUE(std::isinf(s.world.collision.query.budget_seconds));  // a test budget alone
+  EXPECT_FALSE(s.world.collision.query.parent_filter);
+  EXPECT_TRUE(s.world.collision.layered);
   const Scene f = parse(with_objects(
       R"({"name": "a", "primitive": {"type": "sphere", "radius": 0.2}})",
       R"("collision": {"parent_filter": true, "layered": false})"));
-  EXPECT_TRUE(f.collision.parent_filter);
-  EXPECT_FALSE(f.collision.layered);
+  EXPECT_TRUE(f.world.collision.query.parent_filter);
+  EXPECT_FALSE(f.world.collision.layered);
+}
+
+// One default per value: a field left out of the scene keeps the library's
+// default (fem::Material, coupling::CollisionSpec).
+TEST(Scene, FieldsLeftOutKeepTheLibraryDefaults) {
+  const Scene s = parse(with_objects(
+      R"({"name": "a", "primitive": {}, "material": {"poisson": 0.25}})", R"("collision": {})"));
+  const fem::Material m;
+  EXPECT_EQ(s.objects[0].material.young, m.young);
+  EXPECT_EQ(s.objects[0].material.density, m.density);
+  EXPECT_EQ(s.objects[0].material.model, m.model);
+  const coupling::CollisionSpec c;
+  const collision::CollisionRequest& q = s.world.collision.query;
+  EXPECT_EQ(q.budget_seconds, c.query.budget_seconds);
+  EXPECT_EQ(q.budget_tests, c.query.budget_tests);
+  EXPECT_EQ(q.mode, c.query.mode);
+  EXPECT_EQ(q.clock_check_interval, c.query.clock_check_interval);
+  EXPECT_EQ(q.depth_cap, c.query.depth_cap);
+  EXPECT_EQ(q.max_list_size, c.query.max_list_size);
+  EXPECT_EQ(s.world.collision.contact.stiffness, c.contact.stiffness);
+  EXPECT_EQ(s.world.collision.update.mode, c.update.mode);
+  EXPECT_EQ(s.world.frame_rate, coupling::WorldSettings{}.frame_rate);
+
+  // The literal Fig. 7 mode is a traversal mode, with the paper's clock read at every test.
+  const Scene lit = parse(with_objects(R"({"primitive": {}})", R"("collision": {"mode": "fifo_literal"})"));
+  EXPECT_EQ(lit.world.collision.query.mode, collision::TraversalMode::BreadthFirstLiteral);
+  EXPECT_EQ(lit.world.collision.query.clock_check_interval, 1);
 }
 
 // Every bad field gets an InputError naming the file and the field.
@@ -66,6 +93,9 @@ TEST(Scene, EachBadFieldGetsAClearError) {
        "objects[0].material.rayleigh", "[alpha, beta]"},
       {with_objects(R"({"primitive": {}, "integrator": "euler"})"), "objects[0].integrator",
        "must be one of"},
+      {with_objects(R"({"primitive": {}})",
+                    R"("collision": {"mode": "fifo_literal", "parent_filter": true})"),
+       "collision.parent_filter", "no parent filter"},
       {with_objects(R"({"primitive": {}, "kind": "static", "velocity": [1, 0, 0]})"),
        "objects[0].velocity", "static"},
       {with_objects(R"({"primitive": {}, "velocity": [1, 0]})"), "objects[0].velocity",
@@ -108,14 +138,14 @@ TEST(Scene, EachBadFieldGetsAClearError) {
 // --dry-run plans: each scene runs only the stages it needs.
 TEST(Plan, OneObjectSceneHasNoCollisionPipeline) {
   const Scene s = parse(with_objects(kSphere, R"("output": {"vtu_every": 0})"));
-  const StagePlan p = make_plan(s);
+  const coupling::StagePlan p = scene_plan(s);
   EXPECT_TRUE(p.objects[0].fem);
   EXPECT_FALSE(p.objects[0].sphere_tree);
   EXPECT_FALSE(p.objects[0].sphere_update);
   EXPECT_FALSE(p.objects[0].dense_update);  // nothing consumes the dense mesh
   EXPECT_TRUE(p.pairs.empty());
   EXPECT_FALSE(p.response);
-  const auto lines = p.describe(s);
+  const auto lines = describe_plan(s);
   EXPECT_EQ(lines[0], "a: load, fem (stvk, rk4)");
   EXPECT_EQ(lines[1], "collision: none");
 }
@@ -124,7 +154,7 @@ TEST(Plan, RigidObstacleGetsNoFemButCollides) {
   const Scene s = parse(with_objects(
       R"({"name": "ball", "primitive": {}}, {"name": "wall", "primitive": {"type": "box"}, "kind": "static"})",
       R"("output": {"vtu_every": 5})"));
-  const StagePlan p = make_plan(s);
+  const coupling::StagePlan p = scene_plan(s);
   EXPECT_TRUE(p.objects[0].fem);
   EXPECT_FALSE(p.objects[1].fem);
   EXPECT_FALSE(p.objects[1].kinematic);
@@ -135,7 +165,7 @@ TEST(Plan, RigidObstacleGetsNoFemButCollides) {
   ASSERT_EQ(p.pairs.size(), 1u);
   EXPECT_TRUE(p.response);
   EXPECT_FALSE(p.broad_phase);
-  const auto lines = p.describe(s);
+  const auto lines = describe_plan(s);
   EXPECT_EQ(lines[1], "wall: load, static, sphere tree");
 }
 
@@ -144,14 +174,14 @@ TEST(Plan, TwoDeformableObjectsRunEverything) {
       R"({"name": "a", "primitive": {}}, {"name": "b", "primitive": {}, "integrator": "backward_euler"},
          {"name": "c", "primitive": {}, "kind": "rigid", "velocity": [0, 0, -1]})",
       R"("output": {"exact_reference": true})"));
-  const StagePlan p = make_plan(s);
+  const coupling::StagePlan p = scene_plan(s);
   EXPECT_EQ(p.pairs.size(), 3u);
   EXPECT_TRUE(p.broad_phase);
   EXPECT_TRUE(p.objects[2].kinematic);
   EXPECT_TRUE(p.objects[2].sphere_update);
-  for (const ObjectPlan& o : p.objects) EXPECT_TRUE(o.dense_update);  // exact reference needs them
+  for (const coupling::ObjectPlan& o : p.objects) EXPECT_TRUE(o.dense_update);  // exact reference needs them
   EXPECT_EQ(
-      p.describe(s)[1],
+      describe_plan(s)[1],
       "b: load, fem (stvk, backward_euler), sphere tree, sphere update, rigid links (dense mesh)");
 }
 

@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "experiments/runner/run.hpp"
-#include "experiments/runner/world.hpp"
+#include "experiments/runner/run.hpp"
 #include "tests/experiments/head_on_scene.hpp"
 
 namespace icd::runner {
@@ -24,8 +24,8 @@ double mean_velocity_x(const RuntimeObject& o) {
 // the single-cycle run must actually have skipped cycles and rolled back at
 // first contact.
 TEST(WorldCycles, SingleCycleFramesWhileApartMatchFullyCycledFrames) {
-  World fast(head_on_scene(R"("budget_tests": 1000000)"), "", "");
-  World full(head_on_scene(R"("budget_tests": 1000000, "single_cycle_when_apart": false)"), "", "");
+  World fast = make_world(head_on_scene(R"("budget_tests": 1000000)"), "", "");
+  World full = make_world(head_on_scene(R"("budget_tests": 1000000, "single_cycle_when_apart": false)"), "", "");
   int single = 0, rollbacks = 0, first_contact_fast = -1, first_contact_full = -1;
   double max_rel_dx = 0;
   for (int f = 0; f < 30; ++f) {
@@ -58,9 +58,9 @@ TEST(WorldCycles, SingleCycleFramesWhileApartMatchFullyCycledFrames) {
 // the much deeper overlap of inner spheres.
 TEST(WorldCycles, InterruptedQueryReusesThePreviousCompleteAnswer) {
   const char* unlimited = R"("unlimited": true)";
-  World exact(head_on_scene(std::string(unlimited) + R"(, "on_interrupt": "previous")"), "", "");
-  World previous(head_on_scene(std::string(unlimited) + R"(, "on_interrupt": "previous")"), "", "");
-  World untested(head_on_scene(std::string(unlimited) + R"(, "on_interrupt": "untested")"), "", "");
+  World exact = make_world(head_on_scene(std::string(unlimited) + R"(, "on_interrupt": "previous")"), "", "");
+  World previous = make_world(head_on_scene(std::string(unlimited) + R"(, "on_interrupt": "previous")"), "", "");
+  World untested = make_world(head_on_scene(std::string(unlimited) + R"(, "on_interrupt": "untested")"), "", "");
   // Same deterministic history up to two frames into the contact.
   int f = 0, in_contact = 0;
   for (; f < 30 && in_contact < 2; ++f) {
@@ -112,13 +112,13 @@ Scene overlapping_scene(double target_fps) {
 // impossible target leaves nothing, so every query gets the minimum budget and
 // answers interrupted -- and the simulation carries on without NaN.
 TEST(RealTime, CollisionGetsWhatIsLeftOfTheFrame) {
-  World slow(overlapping_scene(0.5), "", "");
+  World slow = make_world(overlapping_scene(0.5), "", "");
   const FrameMetrics s = slow.step();
   EXPECT_GT(s.budget, 1.0);  // 2 s frame minus the FEM time of its last cycle
   EXPECT_LE(s.budget, 2.0);
   EXPECT_EQ(s.interrupted, 0);
 
-  World fast(overlapping_scene(1e5), "", "");
+  World fast = make_world(overlapping_scene(1e5), "", "");
   for (int f = 0; f < 3; ++f) {
     const FrameMetrics m = fast.step();
     EXPECT_EQ(m.budget, 1e-6);  // the 10 us frame is over before the query starts
@@ -157,7 +157,7 @@ namespace {
 TEST(WorldCycles, MidpointSamplingKeepsTheBounceEnergy) {
   double gain[2];
   for (int mid = 0; mid < 2; ++mid) {
-    World w(
+    World w = make_world(
         head_on_scene(std::string(R"("budget_tests": 1000000, "passive": false, "midpoint": )") +
                       (mid ? "true" : "false")),
         "", "");
@@ -183,7 +183,7 @@ namespace {
 // thousands of cycles per frame): the response is softened to the stable
 // margin instead of pumping energy. Reference: the energy before contact.
 TEST(WorldCycles, TooStiffPenaltyIsSoftenedNotUnstable) {
-  World w(head_on_scene(R"("budget_tests": 1000000, "passive": false, "stiffness": 1e8)"), "", "");
+  World w = make_world(head_on_scene(R"("budget_tests": 1000000, "passive": false, "stiffness": 1e8)"), "", "");
   const double e0 = w.step().energy;
   int softened = 0;
   double e_max = 0;
@@ -214,7 +214,7 @@ namespace {
 TEST(WorldCycles, PassiveResponseBoundsTheEnergyOfInterruptedQueries) {
   double gain[2];
   for (int passive = 0; passive < 2; ++passive) {
-    World w(head_on_scene(
+    World w = make_world(head_on_scene(
                 std::string(R"("on_interrupt": "untested", "budget_tests": 64, "passive": )") +
                 (passive ? "true" : "false")),
             "", "");

@@ -8,10 +8,10 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "fem/material.hpp"
-#include "fem/model.hpp"
-#include "fem/tet_mesh_data.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/fem/material.hpp>
+#include <icd/fem/model.hpp>
+#include <icd/fem/tet_mesh_data.hpp>
+#include <icd/mesh/core/primitives.hpp>
 
 namespace icd::fem::test {
 

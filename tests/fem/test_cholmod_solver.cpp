@@ -1,11 +1,11 @@
-#include "fem/cholmod_solver.hpp"
+#include <icd/fem/cholmod_solver.hpp>
 
 #include <random>
 
 #include <gtest/gtest.h>
 #include <Eigen/SparseCholesky>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

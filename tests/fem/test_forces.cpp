@@ -1,15 +1,15 @@
 // Internal forces against independent oracles: finite differences of the
 // energy, rigid motions, and the affine patch test.
-#include "fem/forces.hpp"
+#include <icd/fem/forces.hpp>
 
 #include <gtest/gtest.h>
 #include <Eigen/SVD>
 
-#include "fem/constitutive.hpp"
-#include "fem/element_kernels.hpp"
-#include "fem/lane_kernels.hpp"
+#include <icd/fem/constitutive.hpp>
+#include <icd/fem/element_kernels.hpp>
+#include <icd/fem/lane_kernels.hpp>
 #include "fem_test_utils.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

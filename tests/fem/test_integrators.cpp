@@ -1,7 +1,7 @@
 // Dynamics against references: damped motion settles to the CHOLMOD static
 // solution, symplectic Euler conserves energy, the oscillation period matches
 // the discrete eigenfrequency.
-#include "fem/integrators.hpp"
+#include <icd/fem/integrators.hpp>
 
 #include <cmath>
 #include <limits>
@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
-#include "fem/simulator.hpp"
-#include "fem/static_solver.hpp"
+#include <icd/fem/simulator.hpp>
+#include <icd/fem/static_solver.hpp>
 #include "fem_test_utils.hpp"
 
 namespace icd::fem {

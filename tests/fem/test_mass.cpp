@@ -1,9 +1,9 @@
-#include "fem/mass.hpp"
+#include <icd/fem/mass.hpp>
 
 #include <gtest/gtest.h>
 
 #include "fem_test_utils.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

@@ -1,11 +1,11 @@
-#include "fem/material.hpp"
+#include <icd/fem/material.hpp>
 
 #include <cmath>
 #include <limits>
 
 #include <gtest/gtest.h>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "fem/forces.hpp"
-#include "fem/lane_loops.hpp"
-#include "fem/simulator.hpp"
+#include <icd/fem/forces.hpp>
+#include <icd/fem/lane_loops.hpp>
+#include <icd/fem/simulator.hpp>
 #include "fem_test_utils.hpp"
 
 namespace icd::fem {

@@ -1,4 +1,4 @@
-#include "fem/reorder.hpp"
+#include <icd/fem/reorder.hpp>
 
 #include <algorithm>
 #include <numeric>
@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "fem/forces.hpp"
+#include <icd/fem/forces.hpp>
 #include "fem_test_utils.hpp"
 
 namespace icd::fem {

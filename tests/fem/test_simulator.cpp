@@ -1,13 +1,13 @@
 // Simulator: the fixed-step guard, automatic sub-stepping on stiff and
 // extreme cases, health checks with rollback, retries and diagnostics.
-#include "fem/simulator.hpp"
+#include <icd/fem/simulator.hpp>
 
 #include <memory>
 
 #include <gtest/gtest.h>
 
 #include "fem_test_utils.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

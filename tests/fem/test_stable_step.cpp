@@ -1,15 +1,15 @@
 // Stable step: Lanczos estimate vs a dense generalized eigensolver, the
 // per-integrator limits vs the spectral radius of the amplification matrix,
 // and the integrators themselves on both sides of the limit.
-#include "fem/stable_step.hpp"
+#include <icd/fem/stable_step.hpp>
 
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
-#include "fem/integrators.hpp"
-#include "fem/simulator.hpp"
+#include <icd/fem/integrators.hpp>
+#include <icd/fem/simulator.hpp>
 #include "fem_test_utils.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {
@@ -133,7 +133,7 @@ TEST(StableStep, MaxFrequencyGrowsUnderCompression) {
 TEST(StableStep, LanczosMatchesDenseEigenvaluesAt70PercentCompressionForEveryMaterial) {
   // F = diag(a, a, 0.3) on a free cube: laterally confined (a = 1), a generic
   // bulge (a = 1.3) and the isochoric one (a = 1/sqrt(0.3)); the measured
-  // growth per material is in experiments/fem/results/fem_compression.txt.
+  // growth per material is in experiments/studies/fem/results/fem_compression.txt.
   const TetMesh m = test::box(3, 3, 3, {0.3, 0.3, 0.3});
   for (MaterialModel mm : test::all_models()) {
     Model model(m.V, m.T, test::material(mm, 1e6, 0.45));

@@ -1,6 +1,6 @@
 // Static equilibrium (Newton + CHOLMOD) against beam theory: stretched bar
 // FL/(EA) and the Timoshenko cantilever, with mesh-convergence trends.
-#include "fem/static_solver.hpp"
+#include <icd/fem/static_solver.hpp>
 
 #include <cmath>
 

@@ -3,14 +3,14 @@
 // function, the affine patch test against the analytic viscous stress, the
 // largest damping rate against a dense eigensolver, and explicit stability
 // with the damping included in the step limit.
-#include "fem/strain_rate_damping.hpp"
+#include <icd/fem/strain_rate_damping.hpp>
 
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
-#include "fem/simulator.hpp"
+#include <icd/fem/simulator.hpp>
 #include "fem_test_utils.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

@@ -1,9 +1,9 @@
-#include "fem/tet_mesh_data.hpp"
+#include <icd/fem/tet_mesh_data.hpp>
 
 #include <gtest/gtest.h>
 
 #include "fem_test_utils.hpp"
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
 namespace {

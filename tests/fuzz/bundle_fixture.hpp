@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "coupling/asset_bundle.hpp"
+#include <icd/coupling/asset_bundle.hpp>
 #include "tests/coupling/small_bundle.hpp"
 
 namespace icd::fuzz {

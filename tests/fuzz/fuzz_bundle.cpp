@@ -17,7 +17,7 @@
 #include <iterator>
 #include <string>
 
-#include "coupling/asset_bundle.hpp"
+#include <icd/coupling/asset_bundle.hpp>
 #include "tests/fuzz/bundle_fixture.hpp"
 #include "tests/fuzz/fuzz_common.hpp"
 

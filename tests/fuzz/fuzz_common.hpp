@@ -8,8 +8,8 @@
 #include <exception>
 #include <typeinfo>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::fuzz {
 

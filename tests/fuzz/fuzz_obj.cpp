@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "mesh/io/surface_reader.hpp"
+#include <icd/mesh/io/surface_reader.hpp>
 #include "tests/fuzz/fuzz_common.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

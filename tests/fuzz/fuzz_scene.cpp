@@ -16,7 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   icd::fuzz::expect_clean([&] {
     const icd::runner::Json json = icd::runner::parse_json(text, "fuzz.json");
     const icd::runner::Scene scene = icd::runner::parse_scene(json, "fuzz.json", "/nonexistent");
-    if (scene.frames < 0 || !(scene.frame_rate > 0))
+    if (scene.frames < 0 || !(scene.world.frame_rate > 0))
       icd::fuzz::finding("scene: absurd frames accepted");
   });
   return 0;

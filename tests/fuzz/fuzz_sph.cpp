@@ -6,7 +6,7 @@
 #include <sstream>
 #include <string>
 
-#include "collision/sph_io.hpp"
+#include <icd/collision/sph_io.hpp>
 #include "tests/fuzz/fuzz_common.hpp"
 
 namespace {

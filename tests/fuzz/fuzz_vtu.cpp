@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "mesh/io/vtu_reader.hpp"
+#include <icd/mesh/io/vtu_reader.hpp>
 #include "tests/fuzz/fuzz_common.hpp"
 
 namespace {

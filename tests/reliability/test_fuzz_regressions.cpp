@@ -13,12 +13,12 @@
 #include <typeinfo>
 #include <vector>
 
-#include "collision/sph_io.hpp"
+#include <icd/collision/sph_io.hpp>
 #include "experiments/runner/json.hpp"
 #include "experiments/runner/scene.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/surface_reader.hpp"
-#include "mesh/io/vtu_reader.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/io/surface_reader.hpp>
+#include <icd/mesh/io/vtu_reader.hpp>
 #include "tests/fuzz/bundle_fixture.hpp"
 
 namespace icd {

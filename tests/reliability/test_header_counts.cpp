@@ -13,10 +13,10 @@
 #include <sstream>
 #include <string>
 
-#include "collision/sph_io.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/surface_reader.hpp"
-#include "mesh/io/vtu_reader.hpp"
+#include <icd/collision/sph_io.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/io/surface_reader.hpp>
+#include <icd/mesh/io/vtu_reader.hpp>
 #include "tests/fuzz/bundle_fixture.hpp"
 
 namespace icd {

@@ -1,4 +1,4 @@
-#include "mesh/io/detail/file_bytes.hpp"
+#include <icd/mesh/io/detail/file_bytes.hpp>
 
 #include <cerrno>
 #include <cstdio>
@@ -6,7 +6,7 @@
 #include <memory>
 #include <system_error>
 
-#include "mesh/io/detail/input_error.hpp"
+#include <icd/mesh/io/detail/input_error.hpp>
 
 namespace icd::detail {
 

@@ -1,6 +1,6 @@
-#include "mesh/io/detail/input_error.hpp"
+#include <icd/mesh/io/detail/input_error.hpp>
 
-#include "mesh/io/error.hpp"
+#include <icd/mesh/core/error.hpp>
 
 namespace icd::detail {
 

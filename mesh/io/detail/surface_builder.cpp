@@ -1,9 +1,9 @@
-#include "mesh/io/detail/surface_builder.hpp"
+#include <icd/mesh/io/detail/surface_builder.hpp>
 
 #include <cmath>
 #include <limits>
 
-#include "mesh/io/detail/input_error.hpp"
+#include <icd/mesh/io/detail/input_error.hpp>
 
 namespace icd::detail {
 

@@ -7,8 +7,8 @@
 #include <string_view>
 #include <vector>
 
-#include "mesh/io/read_report.hpp"
-#include "mesh/io/types.hpp"
+#include <icd/mesh/io/read_report.hpp>
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::detail {
 

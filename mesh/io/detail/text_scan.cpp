@@ -1,4 +1,4 @@
-#include "mesh/io/detail/text_scan.hpp"
+#include <icd/mesh/io/detail/text_scan.hpp>
 
 #include <charconv>
 #include <system_error>

@@ -1,10 +1,10 @@
-#include "mesh/io/detail/xml_scanner.hpp"
+#include <icd/mesh/io/detail/xml_scanner.hpp>
 
 #include <algorithm>
 
-#include "mesh/io/detail/input_error.hpp"
-#include "mesh/io/detail/text_scan.hpp"
-#include "mesh/io/detail/xml_text.hpp"
+#include <icd/mesh/io/detail/input_error.hpp>
+#include <icd/mesh/io/detail/text_scan.hpp>
+#include <icd/mesh/io/detail/xml_text.hpp>
 
 namespace icd::detail {
 

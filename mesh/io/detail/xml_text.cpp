@@ -1,4 +1,4 @@
-#include "mesh/io/detail/xml_text.hpp"
+#include <icd/mesh/io/detail/xml_text.hpp>
 
 #include <charconv>
 

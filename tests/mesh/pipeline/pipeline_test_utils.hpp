@@ -6,7 +6,7 @@
 #include <set>
 #include <utility>
 
-#include "mesh/io/types.hpp"
+#include <icd/mesh/core/types.hpp>
 
 namespace icd::mesh::test {
 

@@ -9,14 +9,14 @@
 #include <filesystem>
 #include <random>
 
-#include "collision/sphere_tree.hpp"
-#include "coupling/asset_bundle.hpp"
-#include "coupling/link_evaluator.hpp"
-#include "icd/config.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/io/surface_reader.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/coupling/link_evaluator.hpp>
+#include <icd/config.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/io/surface_reader.hpp>
 #include "mesh/pipeline/pipeline_test_utils.hpp"
-#include "mesh/pipeline/preprocess.hpp"
+#include <icd/mesh/pipeline/preprocess.hpp>
 
 namespace icd::mesh {
 namespace {

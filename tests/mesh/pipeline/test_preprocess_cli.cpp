@@ -8,10 +8,10 @@
 #include <filesystem>
 #include <string>
 
-#include "collision/sph_io.hpp"
-#include "coupling/asset_bundle.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/io/surface_writer.hpp"
+#include <icd/collision/sph_io.hpp>
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/io/surface_writer.hpp>
 #include "mesh/program_run.hpp"
 
 namespace {

@@ -5,10 +5,10 @@
 #include <set>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 #include "mesh/pipeline/pipeline_test_utils.hpp"
-#include "mesh/pipeline/repair.hpp"
+#include <icd/mesh/pipeline/repair.hpp>
 
 namespace icd::mesh {
 namespace {

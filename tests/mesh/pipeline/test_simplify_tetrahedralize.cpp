@@ -3,11 +3,11 @@
 #include <cmath>
 #include <numbers>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
 #include "mesh/pipeline/pipeline_test_utils.hpp"
-#include "mesh/pipeline/simplify.hpp"
-#include "mesh/pipeline/tetrahedralize.hpp"
+#include <icd/mesh/pipeline/simplify.hpp>
+#include <icd/mesh/pipeline/tetrahedralize.hpp>
 
 namespace icd::mesh {
 namespace {

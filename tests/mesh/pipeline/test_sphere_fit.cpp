@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/pipeline/preprocess.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/pipeline/preprocess.hpp>
 
 namespace icd::mesh {
 namespace {

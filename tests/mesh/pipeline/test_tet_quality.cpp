@@ -3,8 +3,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "mesh/io/primitives.hpp"
-#include "mesh/pipeline/tet_quality.hpp"
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/pipeline/tet_quality.hpp>
 
 namespace icd::mesh {
 namespace {

@@ -14,8 +14,8 @@
 #include <random>
 #include <vector>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/allocation.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/allocation.hpp>
 
 namespace {
 

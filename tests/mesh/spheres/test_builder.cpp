@@ -15,13 +15,13 @@
 #include <Eigen/Geometry>
 
 #include "collision/contact_oracle.hpp"
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/builder.hpp"
-#include "mesh/spheres/evaluation.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/protrusion.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/builder.hpp>
+#include <icd/mesh/spheres/evaluation.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/protrusion.hpp>
 
 namespace {
 

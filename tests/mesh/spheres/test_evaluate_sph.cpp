@@ -15,10 +15,10 @@
 
 #include <Eigen/Geometry>
 
-#include "mesh/io/primitives.hpp"
-#include "mesh/io/surface_writer.hpp"
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/io/surface_writer.hpp>
 #include "mesh/program_run.hpp"
-#include "mesh/spheres/evaluation.hpp"
+#include <icd/mesh/spheres/evaluation.hpp>
 
 namespace {
 

@@ -11,10 +11,10 @@
 
 #include <Eigen/Geometry>
 
-#include "collision/sphere_tree.hpp"
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/evaluation.hpp"
+#include <icd/collision/sphere_tree.hpp>
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/evaluation.hpp>
 
 namespace {
 

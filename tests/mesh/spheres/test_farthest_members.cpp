@@ -10,8 +10,8 @@
 #include <random>
 #include <vector>
 
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/reduction.hpp"
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/reduction.hpp>
 
 namespace {
 

@@ -1,9 +1,9 @@
 // Medial-axis approximation against analytic medial radii of a box and a sphere.
 #include <gtest/gtest.h>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/medial_axis.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/medial_axis.hpp>
 
 namespace {
 

@@ -10,12 +10,12 @@
 #include <numeric>
 #include <string>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/medial_axis.hpp"
-#include "mesh/spheres/merge_burst.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/medial_axis.hpp>
+#include <icd/mesh/spheres/merge_burst.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 namespace {
 

@@ -3,10 +3,10 @@
 
 #include <random>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 namespace {
 

@@ -3,8 +3,8 @@
 
 #include <random>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/point_grid.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/point_grid.hpp>
 
 namespace {
 

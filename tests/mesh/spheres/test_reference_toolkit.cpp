@@ -4,7 +4,7 @@
 // spheres and the worst and mean error measured on its 42 sphere points, in
 // units where the model's longest side is 2000. Evaluated in the toolkit's
 // probe frame, the trees it wrote for the dragon and the bunny (committed
-// as reference data, experiments/spheretree/results/reference/) must give
+// as reference data, experiments/studies/spheretree/results/reference/) must give
 // those numbers: an independent check of our inside tests, distances and
 // probe frame. Skipped when the meshes have not been fetched
 // (scripts/fetch_meshes.sh).
@@ -17,10 +17,10 @@
 #include <utility>
 #include <vector>
 
-#include "collision/sph_io.hpp"
-#include "icd/config.hpp"
-#include "mesh/io/surface_reader.hpp"
-#include "mesh/spheres/evaluation.hpp"
+#include <icd/collision/sph_io.hpp>
+#include <icd/config.hpp>
+#include <icd/mesh/io/surface_reader.hpp>
+#include <icd/mesh/spheres/evaluation.hpp>
 
 namespace {
 
@@ -51,7 +51,7 @@ std::vector<ToolkitLevel> toolkit_evaluation(const fs::path& sph) {
 TEST(ReferenceToolkit, OurEvaluationInItsFrameGivesItsOwnNumbers) {
   const char* env = std::getenv("ICD_DATA_DIR");
   const fs::path data = fs::path(env ? env : ICD_DATA_DIR);
-  const fs::path reference = fs::path(ICD_SOURCE_DIR) / "experiments/spheretree/results/reference";
+  const fs::path reference = fs::path(ICD_SOURCE_DIR) / "experiments/studies/spheretree/results/reference";
   int checked = 0;
   for (const auto& [mesh_file, tree_file] :
        {std::pair{"ChineseDragon-10kv.off", "dragon_readme-medial.sph"},

@@ -11,8 +11,8 @@
 #include <random>
 #include <vector>
 
-#include "mesh/io/error.hpp"
-#include "mesh/spheres/regroup.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/spheres/regroup.hpp>
 
 namespace {
 

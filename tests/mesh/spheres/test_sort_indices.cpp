@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "mesh/spheres/sort_indices.hpp"
+#include <icd/mesh/spheres/sort_indices.hpp>
 
 namespace {
 

@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <random>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/medial_axis.hpp"
-#include "mesh/spheres/sum_exchange.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/medial_axis.hpp>
+#include <icd/mesh/spheres/sum_exchange.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 namespace {
 

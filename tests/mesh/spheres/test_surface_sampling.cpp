@@ -7,9 +7,9 @@
 
 #include <Eigen/Geometry>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 namespace {
 

@@ -6,10 +6,10 @@
 
 #include <Eigen/Geometry>
 
-#include "mesh/io/error.hpp"
-#include "mesh/io/primitives.hpp"
-#include "mesh/io/triangle_geometry.hpp"
-#include "mesh/spheres/triangle_bvh.hpp"
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/core/triangle_geometry.hpp>
+#include <icd/mesh/spheres/triangle_bvh.hpp>
 
 namespace {
 

@@ -8,11 +8,11 @@
 #include <array>
 #include <random>
 
-#include "mesh/io/primitives.hpp"
-#include "mesh/spheres/medial_axis.hpp"
-#include "mesh/spheres/mesh_oracle.hpp"
-#include "mesh/spheres/reduction.hpp"
-#include "mesh/spheres/surface_sampling.hpp"
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/spheres/medial_axis.hpp>
+#include <icd/mesh/spheres/mesh_oracle.hpp>
+#include <icd/mesh/spheres/reduction.hpp>
+#include <icd/mesh/spheres/surface_sampling.hpp>
 
 namespace {
 

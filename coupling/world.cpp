@@ -1,0 +1,434 @@
+#include <icd/coupling/world.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <icd/collision/aabb_tree.hpp>
+#include <icd/collision/sphere_update.hpp>
+#include <icd/coupling/contact_response.hpp>
+#include <icd/mesh/core/error.hpp>
+
+namespace icd::coupling {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Kinetic + elastic + gravity potential (J). Not fem::Simulator::total_energy(),
+// which also counts -f_ext . x for the external (here: contact) forces: a
+// penalty force is not a constant load, and that term depends on the origin.
+double mechanical_energy(fem::Simulator& sim, const Eigen::Vector3d& gravity) {
+  const fem::Model& model = sim.model();
+  const MatX3d& x = sim.positions();
+  return model.kinetic_energy(sim.velocities()) + sim.model().elastic().energy(x) -
+         (x.transpose() * model.mass()).dot(gravity);
+}
+
+}  // namespace
+
+World::World(std::vector<WorldObject> objects, WorldSettings settings)
+    : m_settings(std::move(settings)) {
+  validate(m_settings);
+  std::vector<ObjectSetup> setups;
+  setups.reserve(objects.size());
+  for (const WorldObject& w : objects) setups.push_back(w.setup);
+  m_plan = make_plan(setups, m_settings);
+  const CollisionSpec& cs = m_settings.collision;
+  m_objects.reserve(objects.size());
+  for (size_t i = 0; i < objects.size(); ++i) {
+    RuntimeObject o;
+    o.setup = std::move(objects[i].setup);
+    o.plan = m_plan.objects[i];
+    o.asset = std::move(objects[i].asset);
+    if (o.plan.sphere_tree && o.asset.spheres.num_nodes() == 0)
+      throw InputError("object \"" + o.setup.name + "\": takes part in collisions but has no sphere tree");
+    // No tree levels deeper than the queries can reach.
+    if (o.plan.sphere_tree && m_plan.tree_cut != TreeCut::None)
+      collision::truncate_levels(o.asset.spheres, m_plan.max_tree_level);
+    // Static objects are never updated: make their trees layered once here.
+    if (cs.layered) collision::enclose_children(o.asset.spheres);
+    o.rest = o.asset.coarse.V;
+    o.positions = o.rest;
+    o.contact_forces = MatX3d::Zero(o.rest.rows(), 3);
+    if (o.plan.fem) {
+      fem::ModelOptions mo;
+      mo.damping = o.setup.damping;
+      mo.gravity = m_settings.gravity;
+      fem::Model model(o.rest, o.asset.coarse.T, o.setup.material, mo);
+      for (int n : o.setup.fixed_nodes)
+        if (n < 0 || n >= model.num_nodes())
+          throw InputError("object \"" + o.setup.name + "\": fixed node " + std::to_string(n) +
+                           " out of range (the coarse mesh has " +
+                           std::to_string(model.num_nodes()) + " nodes)");
+      model.set_fixed_nodes(o.setup.fixed_nodes);
+      fem::SimulatorOptions so;
+      so.integrator = o.setup.integrator;
+      so.max_step = 1.0 / m_settings.frame_rate;
+      so.frequency_reuse_time = 1.0 / m_settings.frame_rate;  // one estimate per frame
+      if (m_plan.response) so.frequency.contact_stiffness = cs.contact.stiffness;
+      o.sim = std::make_unique<fem::Simulator>(std::move(model), so);
+      MatX3d v(o.rest.rows(), 3);
+      v.rowwise() = o.setup.velocity.transpose();
+      for (int n : o.setup.fixed_nodes) v.row(n).setZero();
+      o.sim->set_velocities(v);
+    }
+    if (o.plan.dense_update) {
+      o.dense = o.asset.dense.V;
+      o.links = LinkEvaluator(o.asset.links);
+    }
+    m_objects.push_back(std::move(o));
+  }
+  // Node masses for the mass-weighted response; objects without FEM never
+  // move under contact: infinite mass for the stability estimate.
+  for (RuntimeObject& o : m_objects)
+    o.node_mass =
+        o.sim ? o.sim->model().mass() : Eigen::VectorXd::Constant(o.rest.rows(), kImmovableMass);
+  m_min_node_mass = std::numeric_limits<double>::infinity();
+  for (const RuntimeObject& o : m_objects)
+    if (o.sim) m_min_node_mass = std::min(m_min_node_mass, o.node_mass.minCoeff());
+  m_results.resize(m_plan.pairs.size());
+  m_fronts.resize(m_plan.pairs.size());
+  m_complete.resize(m_plan.pairs.size());
+  m_complete_time.assign(m_plan.pairs.size(), -std::numeric_limits<double>::infinity());
+  m_complete_depth.assign(m_plan.pairs.size(), 0.0);
+}
+
+int World::contact_cycles(double dt) const {
+  if (!m_plan.response) return 1;
+  // Conservative: the largest node stiffness (at least k) on the lightest
+  // node, every frame. (ContactStats::max_rate, per node k share / m, gave
+  // ~4x fewer cycles but let a head-on bounce gain ~15% energy, left for
+  // study. Frames that start apart are tried as one cycle in step(), with a
+  // rollback when they end in contact.)
+  const double k = std::max(m_node_stiffness, m_settings.collision.contact.stiffness);
+  const double omega = std::sqrt(k / m_min_node_mass);
+  return std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1,
+                    kMaxContactCycles);
+}
+
+void World::update_dense(RuntimeObject& o) {
+  if (o.dense.rows() != o.asset.dense.V.rows()) o.dense.resize(o.asset.dense.V.rows(), 3);
+  o.links.apply(o.positions, o.dense);
+}
+
+void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics& m) {
+  Clock::time_point t0 = Clock::now();
+  // 1. Deformation: FEM for deformable objects (with last frame's contact
+  //    forces), rigid motion for kinematic ones.
+  for (RuntimeObject& o : m_objects) {
+    if (o.plan.fem) {
+      const bool track_work =
+          m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
+      if (m_plan.response) o.sim->set_external_forces(o.contact_forces);
+      // The forces are constant over the cycle: their work is f . x1 - f . x0.
+      if (track_work) m_contact_work -= o.contact_forces.cwiseProduct(o.positions).sum();
+      const fem::AdvanceReport rep = o.sim->advance(h);
+      o.positions = o.sim->positions();
+      if (track_work) m_contact_work += o.contact_forces.cwiseProduct(o.positions).sum();
+      m.substeps += rep.substeps;
+      m.min_step = std::min(m.min_step, rep.step);
+      if (last) m.energy += mechanical_energy(*o.sim, m_settings.gravity);
+    } else if (o.plan.kinematic) {
+      o.positions.rowwise() += (h * o.setup.velocity).transpose();
+    }
+  }
+  m.times.fem += seconds_since(t0);
+
+  // 2. Dense meshes follow through the rigid links (only where consumed).
+  if (last) {
+    t0 = Clock::now();
+    for (RuntimeObject& o : m_objects)
+      if (o.plan.dense_update) update_dense(o);
+    m.times.links += seconds_since(t0);
+  }
+
+  // 3. Sphere trees follow the coarse nodes (paper 4.4).
+  t0 = Clock::now();
+  for (RuntimeObject& o : m_objects)
+    if (o.plan.sphere_update) {
+      if (m_settings.collision.midpoint && o.sim && m_plan.response) {
+        // Midpoint sampling: the forces of this query act during the next
+        // cycle, so detect at the positions predicted for its middle.
+        o.predicted = o.positions + (0.5 * h) * o.sim->velocities();
+        collision::update_spheres(o.asset.spheres, o.rest, o.predicted, m_settings.collision.update);
+      } else {
+        collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+      }
+      if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
+    }
+  m.times.sphere_update += seconds_since(t0);
+
+  // 4. Interruptible collision queries, one per candidate pair.
+  t0 = Clock::now();
+  const CollisionSpec& cs = m_settings.collision;
+  if (last) {
+    m.pair_list = m.collision_list = 0;
+    m.completed_level = std::numeric_limits<int>::max();
+  }
+  for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+    const auto [i, j] = m_plan.pairs[p];
+    collision::CollisionRequest req = cs.query;
+    req.budget_seconds = budget;
+    req.start_front = nullptr;
+    req.record_front = cs.temporal_coherence;
+    if (cs.temporal_coherence && !m_fronts[p].empty()) req.start_front = &m_fronts[p];
+    collision::CollisionResult& r = m_results[p];
+    if (m_plan.broad_phase && !collision::overlap(m_objects[i].asset.spheres.spheres[0],
+                                                  m_objects[j].asset.spheres.spheres[0])) {
+      // Broad phase: root spheres apart, nothing to refine.
+      r = collision::CollisionResult{};
+      continue;
+    }
+    collision::collide(m_objects[i].asset.spheres, m_objects[j].asset.spheres, req, r);
+    if (cs.temporal_coherence) m_fronts[p] = r.front;
+    if (!r.interrupted && cs.on_interrupt == InterruptedResponse::Previous) {
+      m_complete[p].colliding = r.colliding;  // copies into reused storage
+      m_complete[p].untested = r.untested;
+      m_complete_time[p] = t_end;
+    }
+    if (last) {
+      m.pair_list += static_cast<int64_t>(r.untested.size());
+      m.collision_list += static_cast<int64_t>(r.colliding.size());
+      m.completed_level = std::min(m.completed_level, r.completed_level);
+    }
+    m.tests += r.tests;
+    m.interrupted += r.interrupted ? 1 : 0;
+  }
+  if (m_plan.pairs.empty()) m.completed_level = 0;
+  m.times.collision += seconds_since(t0);
+
+  // 5. Penalty response onto the coarse nodes, applied in the next frame.
+  t0 = Clock::now();
+  if (m_plan.response) {
+    for (RuntimeObject& o : m_objects) o.contact_forces.setZero();
+    m_node_stiffness = 0;
+    m_penalty_energy = 0;
+    for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+      const auto [i, j] = m_plan.pairs[p];
+      RuntimeObject& a = m_objects[i];
+      RuntimeObject& b = m_objects[j];
+      ContactOptions co = cs.contact;
+      const Eigen::Vector3d ca = a.positions.colwise().mean().transpose();
+      const Eigen::Vector3d cb = b.positions.colwise().mean().transpose();
+      co.coincident_direction = cb - ca;
+      co.mass_a = &a.node_mass;
+      co.mass_b = &b.node_mass;
+      // An interrupted query answers with coarse spheres; with on_interrupt =
+      // "previous" the last complete answer (if recent) stands in, evaluated
+      // at the current sphere positions; if it is older, the untested pairs
+      // respond (the paper) but with at most the penetration that answer had.
+      const collision::CollisionResult& r = m_results[p];
+      const bool previous = r.interrupted && cs.on_interrupt == InterruptedResponse::Previous &&
+                            std::isfinite(m_complete_time[p]);
+      // (relative slack: cycle end times are sums of h, the age of a
+      // one-frame-old answer can exceed 1 / frame_rate by rounding)
+      const bool reuse = previous && t_end - m_complete_time[p] <= cs.previous_max_age * (1 + 1e-9);
+      if (previous && !reuse && m_complete_depth[p] > 0)
+        co.max_untested_penetration = m_complete_depth[p];
+      if (reuse) ++m.reused;
+      const ContactStats st = apply_contact_forces(
+          a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : r, co, a.contact_forces,
+          b.contact_forces);
+      if (!r.interrupted) m_complete_depth[p] = st.max_penetration;
+      m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
+      m_penalty_energy += st.penalty_energy;
+      m.max_penetration = std::max(m.max_penetration, st.max_penetration);
+      if (last) {
+        m.active_pairs += st.active_pairs;
+        m.contact_force += st.total_force_a.norm();
+      }
+    }
+  }
+  // Past the staggered scheme's stability margin (explicit limit: omega h = 2)
+  // soften the response rather than let it pump energy. The scale only
+  // decreases during a contact (reset once every pair is apart): a penalty
+  // that is softer while loading than while unloading would gain energy.
+  if (m_plan.response) {
+    if (m_node_stiffness == 0 && contact_free()) m_contact_scale = 1;
+    if (m_node_stiffness > 0) {
+      const double omega_h = std::sqrt(m_node_stiffness / m_min_node_mass) * h;
+      if (omega_h > kContactOmegaLimit)
+        m_contact_scale = std::min(m_contact_scale,
+                                   (kContactOmegaLimit / omega_h) * (kContactOmegaLimit / omega_h));
+    }
+    if (m_contact_scale < 1 && m_node_stiffness > 0) {
+      for (RuntimeObject& o : m_objects) o.contact_forces *= m_contact_scale;
+      m_penalty_energy *= m_contact_scale;
+      ++m.softened;
+    }
+    if (m_settings.collision.passive) limit_contact_work(h, m);
+  }
+  m.times.response += seconds_since(t0);
+  if (last) {
+    m.energy += m_penalty_energy;
+    m.penalty_energy = m_penalty_energy;
+  }
+}
+
+void World::limit_contact_work(double h, FrameMetrics& m) {
+  if (m_node_stiffness == 0) {
+    if (contact_free()) {  // the episode is over
+      m_contact_work = 0;
+      m_passive_allowance = -1;
+    }
+    return;
+  }
+  double power = 0, kinetic = 0;  // contact force . velocity (W); kinetic energy (J)
+  for (const RuntimeObject& o : m_objects) {
+    if (!o.sim) continue;  // static and kinematic objects: external motion
+    const MatX3d& v = o.sim->velocities();
+    power += o.contact_forces.cwiseProduct(v).sum();
+    if (m_passive_allowance < 0) kinetic += o.sim->model().kinetic_energy(v);
+  }
+  if (m_passive_allowance < 0) m_passive_allowance = kPassiveTolerance * kinetic;
+  // The contact is passive while the net work its forces have done on the
+  // objects (negative while it resists their approach, positive while it
+  // pushes them apart) stays below the allowance: it may give back what it
+  // absorbed, not more. The work of the coming cycle is predicted from the
+  // current velocities; the actual work is summed in cycle().
+  const double work = h * power;
+  const double room = m_passive_allowance - m_contact_work;
+  if (work <= 0 || work <= room) return;
+  const double s = std::clamp(room / work, 0.0, 1.0);
+  for (RuntimeObject& o : m_objects) o.contact_forces *= s;
+  m_penalty_energy *= s;
+  ++m.limited;
+}
+
+bool World::contact_free() const {
+  for (const collision::CollisionResult& r : m_results)
+    if (!r.colliding.empty() || !r.untested.empty()) return false;
+  return true;
+}
+
+void World::save(Snapshot& s) const {
+  s.positions.resize(m_objects.size());
+  s.velocities.resize(m_objects.size());
+  for (size_t i = 0; i < m_objects.size(); ++i) {
+    const RuntimeObject& o = m_objects[i];
+    s.positions[i] = o.positions;
+    if (o.sim) s.velocities[i] = o.sim->velocities();
+  }
+  s.fronts = m_fronts;
+  s.complete = m_complete;
+  s.complete_time = m_complete_time;
+  s.complete_depth = m_complete_depth;
+  s.node_stiffness = m_node_stiffness;
+  s.contact_scale = m_contact_scale;
+  s.contact_work = m_contact_work;
+  s.passive_allowance = m_passive_allowance;
+}
+
+void World::restore(const Snapshot& s) {
+  for (size_t i = 0; i < m_objects.size(); ++i) {
+    RuntimeObject& o = m_objects[i];
+    o.positions = s.positions[i];
+    o.contact_forces.setZero();  // the trial started contact-free: no forces
+    if (o.sim) {
+      o.sim->set_positions(s.positions[i]);
+      o.sim->set_velocities(s.velocities[i]);
+    }
+  }
+  m_fronts = s.fronts;
+  m_complete = s.complete;
+  m_complete_time = s.complete_time;
+  m_complete_depth = s.complete_depth;
+  m_node_stiffness = s.node_stiffness;
+  m_contact_scale = s.contact_scale;
+  m_contact_work = s.contact_work;
+  m_passive_allowance = s.passive_allowance;
+  m_penalty_energy = 0;  // the trial started contact-free
+}
+
+FrameMetrics World::step() { return advance(std::nullopt); }
+
+FrameMetrics World::step(double budget_seconds) {
+  if (!(budget_seconds > 0))
+    throw ParameterError("World::step: budget_seconds must be > 0 (infinity for none)");
+  return advance(budget_seconds);
+}
+
+FrameMetrics World::advance(std::optional<double> budget) {
+  const Clock::time_point frame_start = Clock::now();
+  const double dt = 1.0 / m_settings.frame_rate;
+  FrameMetrics m;
+  m.frame = m_frame;
+  m.min_step = std::numeric_limits<double>::infinity();
+  m.budget = budget ? *budget : m_settings.collision.query.budget_seconds;
+
+  // Real-time mode: collision detection gets what is left of the frame (of
+  // the first `fraction` of it), shared between the pairs.
+  const auto budget_at = [&](double fraction) {
+    if (budget || m_settings.target_fps <= 0 || m_plan.pairs.empty()) return m.budget;
+    const double left = fraction / m_settings.target_fps - seconds_since(frame_start);
+    return std::max(kMinRealTimeBudget, left / static_cast<double>(m_plan.pairs.size()));
+  };
+
+  // The contact response is explicit and staggered: forces computed from one
+  // query act until the next. Its stiffness k on a node of mass m oscillates
+  // at omega = sqrt(k / m), stable only if the query interval h obeys
+  // omega h <= kContactOmegaStep (under the explicit limit 2). So a frame runs as
+  // many detection/response cycles as that needs; FEM sub-steps inside each.
+  const int cycles = contact_cycles(dt);
+  m.cycles = cycles;
+
+  // While the objects are apart, no force acts and one cycle per frame gives
+  // the same motion. So a frame that starts contact-free is first tried as a
+  // single cycle; if its closing query finds a contact, the frame is rolled
+  // back and re-run in `cycles` cycles, so contact forces start from the
+  // cycle in which the contact begins, as if every frame had been cycled.
+  // (A contact that begins and ends inside one trial frame is missed: it
+  // would need the objects to cross a whole contact within 1 / frame_rate.)
+  if (cycles > 1 && m_settings.collision.single_cycle_when_apart && contact_free()) {
+    save(m_snapshot);
+    FrameMetrics trial = m;
+    trial.cycles = 1;
+    trial.budget = budget_at(1.0);
+    cycle(dt, m_time + dt, trial.budget, true, trial);
+    if (contact_free()) {
+      m = trial;
+      return finish_frame(m, frame_start);
+    }
+    restore(m_snapshot);
+    m.rollback = 1;
+    m.times = trial.times;  // the rolled-back work is part of the frame's cost
+  }
+
+  const double h = dt / cycles;
+  for (int c = 0; c < cycles; ++c) {
+    const bool last = c + 1 == cycles;
+    m.budget = budget_at((c + 1) / static_cast<double>(cycles));
+    cycle(h, m_time + (c + 1) * h, m.budget, last, m);
+  }
+  return finish_frame(m, frame_start);
+}
+
+FrameMetrics World::finish_frame(FrameMetrics& m, Clock::time_point frame_start) {
+  // Exact reference: intersecting dense triangles (for accuracy studies).
+  if (m_plan.exact_reference) {
+    m.exact_contacts = 0;
+    for (const auto& [i, j] : m_plan.pairs) {
+      const RuntimeObject& a = m_objects[i];
+      const RuntimeObject& b = m_objects[j];
+      const collision::AabbTree ta(a.dense, a.asset.dense.F);
+      const collision::AabbTree tb(b.dense, b.asset.dense.F);
+      m.exact_contacts +=
+          static_cast<int>(collision::intersecting_triangle_pairs(ta, a.dense, a.asset.dense.F, tb,
+                                                                  b.dense, b.asset.dense.F)
+                               .size());
+    }
+  }
+
+  if (!std::isfinite(m.min_step)) m.min_step = 0;
+  ++m_frame;
+  m_time += 1.0 / m_settings.frame_rate;
+  m.time = m_time;
+  m.wall = seconds_since(frame_start);
+  return m;
+}
+
+}  // namespace icd::coupling

@@ -1,0 +1,178 @@
+#pragma once
+/// The simulation loop (paper sections 3.2, 4 and 5): FEM on the coarse
+/// meshes, sphere-tree update, interruptible collision detection, penalty
+/// response, rigid links, each stage only where the plan needs it. A library
+/// type: it takes loaded objects and does no file I/O.
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <icd/collision/traversal.hpp>
+#include <icd/coupling/link_evaluator.hpp>
+#include <icd/coupling/stage_plan.hpp>
+#include <icd/coupling/world_settings.hpp>
+#include <icd/fem/simulator.hpp>
+
+namespace icd::coupling {
+
+/// Wall time of each stage in one frame, seconds.
+struct StageTimes {
+  double fem = 0, links = 0, sphere_update = 0, collision = 0, response = 0, output = 0;
+  double total() const { return fem + links + sphere_update + collision + response + output; }
+};
+
+/// Metrics of one frame (summed over object pairs where that makes sense).
+struct FrameMetrics {
+  int frame = 0;
+  double time = 0;  ///< simulated time at the end of the frame, s
+  StageTimes times;
+  double wall = 0;             ///< wall time of the whole frame, s
+  double budget = 0;           ///< time budget given to each query, s (inf = none)
+  int64_t pair_list = 0;       ///< PAIRLIST size at the end of the queries (untested pairs)
+  int64_t collision_list = 0;  ///< COLLISIONLIST size (colliding leaf pairs)
+  int64_t tests = 0;           ///< sphere tests done
+  int interrupted = 0;         ///< queries interrupted by their budget
+  int completed_level = 0;     ///< smallest completed level over the queries
+  int active_pairs = 0;        ///< sphere pairs that produced a force
+  double max_penetration = 0;  ///< deepest sphere penetration, m
+  double contact_force = 0;    ///< |total contact force| on the first object of each pair, N (sum)
+  int cycles = 1;              ///< detection/response cycles in the frame (stable penalty)
+  /// 1 when the frame was first tried as one contact-free cycle, found a
+  /// contact at its end, and was rolled back and re-run in `cycles` cycles.
+  int rollback = 0;
+  /// Interrupted queries whose response used the pair's previous complete
+  /// answer (collision.on_interrupt = "previous").
+  int reused = 0;
+  /// Cycles whose penalty forces were scaled down because the stiffness on
+  /// the lightest node exceeded what the cycle length allows (see World::kContactOmegaLimit).
+  int softened = 0;
+  /// Cycles whose penalty forces were scaled down to keep the contact
+  /// passive (collision.passive).
+  int limited = 0;
+  int substeps = 0;     ///< FEM sub-steps summed over objects
+  double min_step = 0;  ///< smallest FEM step used, s
+  /// Mechanical energy of the deformable objects, J: kinetic + elastic +
+  /// gravity potential, plus the energy in the penalty springs of the last
+  /// response (contact forces are not counted as loads with a potential).
+  double energy = 0;
+  /// The part of `energy` held by the penalty springs of the last response, J
+  /// (for an interrupted query, springs between coarse spheres assumed colliding).
+  double penalty_energy = 0;
+  int exact_contacts = -1;  ///< exact intersecting dense triangle pairs (-1: not computed)
+};
+
+/// One object at run time.
+struct RuntimeObject {
+  ObjectSetup setup;
+  ObjectPlan plan;
+  AssetBundle asset;  ///< the sphere tree's current spheres follow the coarse nodes
+  std::unique_ptr<fem::Simulator> sim;  ///< deformable objects only (not movable: held by pointer)
+  MatX3d positions;                     ///< current coarse positions (#V x 3)
+  MatX3d rest;                          ///< rest coarse positions, placed in the world
+  MatX3d contact_forces;                ///< forces from the last collision response (#V x 3)
+  MatX3d dense;                         ///< current dense positions (when the plan updates them)
+  LinkEvaluator links;            ///< the rigid links, grouped by node triple (when dense_update)
+  MatX3d predicted;               ///< coarse positions half a cycle ahead (collision.midpoint)
+  Eigen::VectorXd node_mass;      ///< lumped coarse node masses (kg); huge for objects without FEM
+};
+
+/// A simulation: objects, the plan of the stages they need, and the frame loop.
+class World {
+ public:
+  /// Sets up the plan and the FEM models of `objects` (placed in world
+  /// units). Trees are cut below the plan's deepest usable level and, with
+  /// collision.layered, their parents grown to enclose their children.
+  /// Throws ParameterError for invalid settings and InputError naming the
+  /// object for an invalid object (e.g. a fixed node out of range).
+  World(std::vector<WorldObject> objects, WorldSettings settings);
+
+  const WorldSettings& settings() const { return m_settings; }
+  const StagePlan& plan() const { return m_plan; }
+  std::vector<RuntimeObject>& objects() { return m_objects; }
+  const std::vector<RuntimeObject>& objects() const { return m_objects; }
+  /// The last query of each collision pair (same order as plan().pairs).
+  const std::vector<collision::CollisionResult>& results() const { return m_results; }
+
+  /// Advances one frame of 1 / frame_rate simulated seconds with the
+  /// settings' query budget (in real-time mode: what is left of the frame).
+  FrameMetrics step();
+  /// As step(), with a time budget of `budget_seconds` (> 0, infinity for
+  /// none) per query in place of the settings' (and of real-time mode's).
+  FrameMetrics step(double budget_seconds);
+
+  /// Net energy a contact episode may give the objects with collision.passive,
+  /// as a fraction of their kinetic energy when it began (the explicit
+  /// penalty's own small gain, ~0.4% per bounce, stays untouched).
+  static constexpr double kPassiveTolerance = 0.01;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  FrameMetrics advance(std::optional<double> budget_seconds);
+  void update_dense(RuntimeObject& o);
+  /// Exact reference, frame counter and wall time at the end of step().
+  FrameMetrics finish_frame(FrameMetrics& m, Clock::time_point frame_start);
+  /// One detection/response cycle of length h (s) inside a frame, ending at
+  /// simulated time t_end.
+  void cycle(double h, double t_end, double budget, bool last, FrameMetrics& m);
+  /// Detection/response cycles a frame of dt needs for a stable penalty.
+  int contact_cycles(double dt) const;
+  /// True when the last queries reported no pair at all (every pair pruned:
+  /// the covered surfaces are apart).
+  bool contact_free() const;
+  /// State a rolled-back frame returns to.
+  struct Snapshot {
+    std::vector<MatX3d> positions, velocities;
+    std::vector<std::vector<collision::NodePair>> fronts;
+    std::vector<collision::CollisionResult> complete;
+    std::vector<double> complete_time, complete_depth;
+    double node_stiffness = 0;
+    double contact_scale = 1;
+    double contact_work = 0, passive_allowance = -1;
+  };
+  void save(Snapshot& s) const;
+  void restore(const Snapshot& s);
+
+  static constexpr int kMaxContactCycles = 64;
+  /// Smallest per-query budget in real-time mode when the frame is already
+  /// over (the query then answers with the root pair), s.
+  static constexpr double kMinRealTimeBudget = 1e-6;
+  /// Node mass standing for "does not move under contact" (static, rigid objects).
+  static constexpr double kImmovableMass = 1e30;
+  /// Largest omega h of the staggered penalty (explicit limit 2; smaller
+  /// values inject less energy per contact).
+  static constexpr double kContactOmegaStep = 0.25;
+  /// Largest omega h a response may reach; beyond it (more cycles needed
+  /// than kMaxContactCycles, or stiffness jumping within a frame) its forces
+  /// are scaled by (kContactOmegaLimit / omega h)^2: a softer but stable penalty.
+  static constexpr double kContactOmegaLimit = 1.0;
+  /// Scales this cycle's contact forces so the episode stays passive (see
+  /// CollisionSpec::passive); h is the cycle length (s).
+  void limit_contact_work(double h, FrameMetrics& m);
+
+  WorldSettings m_settings;
+  StagePlan m_plan;
+  std::vector<RuntimeObject> m_objects;
+  std::vector<collision::CollisionResult> m_results;
+  std::vector<std::vector<collision::NodePair>> m_fronts;
+  /// Last complete (not interrupted) answer of each pair and its simulated time.
+  std::vector<collision::CollisionResult> m_complete;
+  std::vector<double> m_complete_time;
+  /// Deepest penetration of the response to each pair's last complete answer
+  /// (0: it had no contact), m: caps untested pairs once that answer is too old.
+  std::vector<double> m_complete_depth;
+  double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
+  double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
+  double m_penalty_energy = 0;  ///< penalty spring energy of the last response, J
+  double m_contact_scale = 1;   ///< softening of the current contact episode (1: none)
+  /// Work done by the contact forces on the deformable objects since the
+  /// contact episode began, J (collision.passive).
+  double m_contact_work = 0;
+  /// Net energy the current episode may add, J (-1: no episode under way).
+  double m_passive_allowance = -1;
+  Snapshot m_snapshot;  ///< reused storage for the single-cycle trial
+  int m_frame = 0;
+  double m_time = 0;
+};
+
+}  // namespace icd::coupling

@@ -1,0 +1,33 @@
+#include <icd/coupling/world_settings.hpp>
+
+#include <cmath>
+#include <string>
+
+#include <icd/mesh/core/error.hpp>
+
+namespace icd::coupling {
+namespace {
+
+[[noreturn]] void fail(const std::string& field, const std::string& what, double value) {
+  throw ParameterError("WorldSettings: " + field + ": " + what + ", got " + std::to_string(value));
+}
+
+}  // namespace
+
+void validate(const WorldSettings& s) {
+  if (!(s.frame_rate > 0) || !std::isfinite(s.frame_rate))
+    fail("frame_rate", "must be > 0 and finite", s.frame_rate);
+  if (!(s.target_fps >= 0) || !std::isfinite(s.target_fps))
+    fail("target_fps", "must be >= 0 and finite (0 = off)", s.target_fps);
+  if (!s.gravity.allFinite()) throw ParameterError("WorldSettings: gravity: must be finite");
+  const CollisionSpec& c = s.collision;
+  collision::validate(c.query);
+  if (!(c.contact.stiffness > 0) || !std::isfinite(c.contact.stiffness))
+    fail("collision.contact.stiffness", "must be > 0 and finite", c.contact.stiffness);
+  if (!(c.previous_max_age >= 0))
+    fail("collision.previous_max_age", "must be >= 0", c.previous_max_age);
+  if (!(c.update.margin >= 0) || !std::isfinite(c.update.margin))
+    fail("collision.update.margin", "must be >= 0 and finite", c.update.margin);
+}
+
+}  // namespace icd::coupling

@@ -1,0 +1,136 @@
+#pragma once
+/// What a simulation is made of, before it runs: each object's role and
+/// physics (WorldObject), and the scene-wide settings of the frame loop and
+/// of the collision detection and response (WorldSettings, CollisionSpec).
+/// Plain data with one default per value; validate() checks them once.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include <icd/collision/sphere_update.hpp>
+#include <icd/collision/traversal.hpp>
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/coupling/contact_response.hpp>
+#include <icd/fem/integrators.hpp>
+#include <icd/fem/material.hpp>
+#include <icd/fem/model.hpp>
+
+namespace icd::coupling {
+
+/// How an object moves.
+enum class ObjectKind {
+  Deformable,  ///< explicit FEM on the coarse mesh (paper section 3)
+  Rigid,       ///< kinematic: moves with its initial velocity, no FEM
+  Static,      ///< never moves: no FEM, no sphere update
+};
+
+/// One object's role and physics (no geometry).
+struct ObjectSetup {
+  std::string name;
+  ObjectKind kind = ObjectKind::Deformable;
+  fem::Material material;
+  fem::RayleighDamping damping;
+  fem::Integrator integrator = fem::Integrator::RK4;
+  std::vector<int> fixed_nodes;  ///< coarse node indices held fixed
+  /// Initial velocity of a deformable object, constant velocity of a rigid one, m/s.
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+};
+
+/// One object ready to simulate: its setup and its geometry (dense surface,
+/// coarse tets, rigid links, sphere tree with its node association), placed
+/// in world units (m).
+struct WorldObject {
+  ObjectSetup setup;
+  AssetBundle asset;
+};
+
+/// What the response uses when a query is interrupted by its budget.
+enum class InterruptedResponse {
+  /// The paper (4.2): the untested pairs (PAIRLIST) count as colliding, with
+  /// their own, coarser spheres. An interruption at a coarse level (e.g. the
+  /// process lost the processor for longer than the budget) then pushes with
+  /// the penetration of large inner spheres: an energy kick.
+  Untested,
+  /// The last complete answer of the pair, if it is at most
+  /// CollisionSpec::previous_max_age old, re-evaluated at the current sphere
+  /// positions. If it is older, the untested pairs respond (as Untested) but
+  /// none deeper than that answer's deepest pair (when it had a contact).
+  /// With no complete answer yet: as Untested.
+  Previous,
+};
+
+/// The collision request of every pair query of a simulation: 1 ms per
+/// query in the fast breadth-first mode.
+inline collision::CollisionRequest default_query() {
+  collision::CollisionRequest r;
+  r.budget_seconds = 1e-3;
+  return r;
+}
+
+/// Collision detection and response settings.
+struct CollisionSpec {
+  /// The request of every pair query: budget (budget_seconds, or
+  /// budget_tests for deterministic runs), traversal mode, clock interval,
+  /// depth cap, list cap, parent filter. start_front and record_front are
+  /// set per query by the World (temporal_coherence).
+  collision::CollisionRequest query = default_query();
+  /// Seed each query with the previous query's front of the same pair.
+  bool temporal_coherence = false;
+  /// After each update, grow parents to enclose their children (a layered
+  /// tree): the penalty force then grows continuously from first contact.
+  /// false keeps the paper's wrapped tree, where a leaf pair can appear
+  /// already deeply overlapping once its parents start to overlap (an energy
+  /// kick: a ball bouncing between static walls gained ~30x its energy).
+  bool layered = true;
+  /// A frame that starts with every pair apart runs as one detection/response
+  /// cycle, rolled back and re-run in full cycles if its closing query finds
+  /// a contact (see World::step). false: every frame runs all its cycles.
+  bool single_cycle_when_apart = true;
+  /// Detect at the coarse positions predicted for the middle of the next
+  /// cycle (x + h v / 2), during which the resulting forces act, instead of
+  /// at its start: the staggered penalty then engages and releases half a
+  /// cycle earlier, centred on the contact, which cancels most of the energy
+  /// it would otherwise gain per contact.
+  bool midpoint = true;
+  /// Keep the response passive: over a contact episode (from first contact
+  /// until every pair is apart again) the contact forces may give the
+  /// objects back the work they absorbed, plus World::kPassiveTolerance of
+  /// the kinetic energy at the episode's start, not more. A cycle whose
+  /// forces would do more is scaled down. A switching contact set (an
+  /// interrupted query answering with coarser or partial pairs, a pair
+  /// appearing already overlapping) is not a conservative force and
+  /// otherwise gains energy; false: the paper's response as computed.
+  bool passive = true;
+  collision::SphereUpdateOptions update;
+  ContactOptions contact;
+  InterruptedResponse on_interrupt = InterruptedResponse::Previous;
+  /// Oldest complete answer on_interrupt = Previous reuses as is, simulated
+  /// s. Reusing an old answer misses contacts that began since (a pair that
+  /// was apart stays apart), so by default one 60 Hz frame.
+  double previous_max_age = 1.0 / 60;
+};
+
+/// Scene-wide settings of a simulation.
+struct WorldSettings {
+  double frame_rate = 60;  ///< simulated frames per simulated second
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< m/s^2
+  /// Real-time mode: hold this wall-clock frame rate, collision detection
+  /// getting what is left of each frame (0 = off).
+  double target_fps = 0;
+  CollisionSpec collision;
+  /// Keep the dense meshes of moving objects up to date every frame (the
+  /// rigid links; for output). Without it they are evaluated only where the
+  /// exact reference needs them.
+  bool dense_meshes = false;
+  /// Per frame, count the exactly intersecting dense triangle pairs
+  /// (FrameMetrics::exact_contacts; needs the dense meshes).
+  bool exact_reference = false;
+};
+
+/// Checks the settings (rates, budgets, the query request) and throws
+/// ParameterError naming the field, e.g. "collision.query.budget_seconds:
+/// must be > 0 (infinity for none), got 0".
+void validate(const WorldSettings& settings);
+
+}  // namespace icd::coupling

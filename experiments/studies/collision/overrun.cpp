@@ -1,0 +1,207 @@
+// Budget overrun of the interruptible traversal (issue 6): for budgets from
+// 10 us to 100 ms, many queries each, overrun = wall time of the call minus
+// the budget (p50 / p99 / p99.9), for the paper's literal Fig. 7 (clock read
+// at every test) and for the fast path (clock every 16 tests, steady_clock or
+// rdtsc). A second thread measures the floor in the same run: it spins on the
+// clock towards deadlines of the same length and records how late it sees
+// them (the time the VM takes the processor away), plus the gaps between
+// consecutive reads.
+//
+// Usage: icd_collision_overrun [--queries N] [--max-seconds S] [--csv FILE]
+//   N: queries per (configuration, budget), default 10000; S: time cap per
+//   (configuration, budget), default 4 s (so 100 ms budgets run S/0.1 queries).
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <icd/collision/traversal.hpp>
+#include "experiments/studies/collision/workloads.hpp"
+#include "experiments/common/command_line.hpp"
+
+using namespace icd::collision;
+using namespace icd::collision::experiments;
+using icd::experiments::Clock;
+using icd::experiments::seconds_since;
+
+namespace {
+
+void spin_for(double s) {
+  const auto t0 = Clock::now();
+  while (seconds_since(t0) < s) {
+  }
+}
+
+// The floor: a thread that only spins on the clock. It waits for deadlines
+// of the budget currently measured (plus the same random start jitter) and
+// records how late it sees them, binned per budget, plus the gaps between
+// consecutive clock reads.
+struct Floor {
+  std::atomic<bool> stop{false};
+  std::atomic<int> bin{-1};  // index of the budget being measured, -1 = idle
+  std::vector<double> budgets;
+  std::vector<std::vector<double>> lateness;  // per budget, seconds past the deadline
+  std::vector<double> gaps;                   // gaps > 1 us between consecutive clock reads
+  double spun = 0;
+  void run() {
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<double> jitter(0.0, 20e-6);
+    lateness.assign(budgets.size(), {});
+    const auto t_begin = Clock::now();
+    auto prev = Clock::now();
+    while (!stop.load(std::memory_order_relaxed)) {
+      const int k = bin.load(std::memory_order_relaxed);
+      const double wait = (k < 0 ? 10e-6 : budgets[k]) + jitter(rng);
+      const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                               std::chrono::duration<double>(wait));
+      for (;;) {
+        const auto now = Clock::now();
+        const double gap = std::chrono::duration<double>(now - prev).count();
+        if (gap > 1e-6) gaps.push_back(gap);
+        prev = now;
+        if (now >= deadline) {
+          if (k >= 0) lateness[k].push_back(std::chrono::duration<double>(now - deadline).count());
+          break;
+        }
+      }
+    }
+    spun = seconds_since(t_begin);
+  }
+};
+
+struct Config {
+  std::string name;
+  CollisionRequest request;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  long long max_queries = 10000;
+  double max_seconds = 4.0;
+  std::string csv_path;
+  icd::experiments::CommandLine cli("icd_collision_overrun");
+  cli.integer("--queries", max_queries, "N", "queries at most (default 10000)", 1LL)
+      .real("--max-seconds", max_seconds, "S", "wall time at most (default 4)", 0.0)
+      .text("--csv", csv_path, "FILE", "also write the measurements as CSV");
+  if (const auto status = cli.parse(argc, argv)) return *status;
+  // Workload: two deep octree trees over overlapping icospheres: a full
+  // traversal takes longer than the largest budget.
+  std::printf("building trees...\n");
+  const Object a = icosphere_object(6, 1.0, {0, 0, 0}, 9);
+  const Object b = icosphere_object(6, 1.0, {0.01, 0.005, 0.0}, 9);
+  CollisionResult result;
+  {
+    const auto t0 = Clock::now();
+    collide(a.tree, b.tree, CollisionRequest{}, result);
+    std::printf(
+        "trees: %d and %d spheres; full fast traversal: %lld tests, %zu leaf pairs, %.1f ms\n",
+        a.tree.num_nodes(), b.tree.num_nodes(), (long long)result.tests, result.colliding.size(),
+        1e3 * seconds_since(t0));
+  }
+  // Costs measured in this run.
+  {
+    const int n = 2000000;
+    auto t0 = Clock::now();
+    Clock::rep sink = 0;
+    for (int i = 0; i < n; ++i) sink += Clock::now().time_since_epoch().count();
+    const double clock_ns = 1e9 * seconds_since(t0) / n;
+    std::printf("steady_clock::now(): %.1f ns per read (sink %lld)\n", clock_ns,
+                (long long)(sink & 1));
+  }
+
+  std::vector<Config> configs;
+  configs.push_back(
+      {"paper Fig.7 literal, clock every test", CollisionRequest::paper_reference(1)});
+  {
+    CollisionRequest r;
+    r.clock_check_interval = 16;
+    configs.push_back({"fast path, steady_clock every 16", r});
+    r.clock = ClockSource::CycleCounter;
+    configs.push_back({"fast path, rdtsc every 16", r});
+    r.clock = ClockSource::SteadyClock;
+    r.clock_check_interval = 1;
+    configs.push_back({"fast path, steady_clock every test", r});
+  }
+  const std::vector<double> budgets{10e-6, 100e-6, 1e-3, 10e-3, 100e-3};
+
+  Floor floor;
+  floor.budgets = budgets;
+  std::thread floor_thread([&] { floor.run(); });
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(0.0, 20e-6);
+  std::ofstream csv;
+  if (!csv_path.empty()) {
+    csv.open(csv_path);
+    csv << "config,budget_s,queries,interrupted,p50_us,p99_us,p999_us,max_us,median_tests\n";
+  }
+  // Warm up the result buffers and calibrations.
+  for (const Config& c : configs) {
+    CollisionRequest r = c.request;
+    r.budget_seconds = 0.1;
+    collide(a.tree, b.tree, r, result);
+  }
+  std::printf("\n%-40s %9s %7s %6s %9s %9s %9s %9s %10s\n", "configuration", "budget", "queries",
+              "intr%", "p50 us", "p99 us", "p99.9 us", "max us", "tests p50");
+  for (const Config& c : configs) {
+    for (std::size_t bi = 0; bi < budgets.size(); ++bi) {
+      const double budget = budgets[bi];
+      floor.bin = static_cast<int>(bi);
+      CollisionRequest r = c.request;
+      r.budget_seconds = budget;
+      std::vector<double> over, tests;
+      long long interrupted = 0;
+      const auto t_cfg = Clock::now();
+      for (long long q = 0; q < max_queries && seconds_since(t_cfg) < max_seconds; ++q) {
+        spin_for(jitter(rng));  // random start: do not lock onto periodic host ticks
+        const auto t0 = Clock::now();
+        collide(a.tree, b.tree, r, result);
+        const double used = seconds_since(t0);
+        if (result.interrupted) {
+          ++interrupted;
+          over.push_back(used - budget);
+        }
+        tests.push_back(static_cast<double>(result.tests));
+      }
+      const double n = static_cast<double>(tests.size());
+      std::printf("%-40s %8.0fus %7.0f %6.1f %9.2f %9.2f %9.2f %9.1f %10.0f\n", c.name.c_str(),
+                  budget * 1e6, n, 100.0 * interrupted / n, 1e6 * quantile(over, 0.5),
+                  1e6 * quantile(over, 0.99), 1e6 * quantile(over, 0.999),
+                  1e6 * quantile(over, 1.0), median(tests));
+      std::fflush(stdout);
+      if (csv)
+        csv << '"' << c.name << "\"," << budget << ',' << n << ',' << interrupted << ','
+            << 1e6 * quantile(over, 0.5) << ',' << 1e6 * quantile(over, 0.99) << ','
+            << 1e6 * quantile(over, 0.999) << ',' << 1e6 * quantile(over, 1.0) << ','
+            << median(tests) << '\n';
+    }
+  }
+  floor.bin = -1;
+  floor.stop = true;
+  floor_thread.join();
+  std::printf(
+      "\nfloor (other thread, same run, %.1f s): lateness past deadlines of the same length, per "
+      "budget:\n",
+      floor.spun);
+  std::printf("%9s %9s %9s %9s %9s %9s\n", "budget", "deadlines", "p50 us", "p99 us", "p99.9 us",
+              "max us");
+  for (std::size_t bi = 0; bi < budgets.size(); ++bi) {
+    const auto& l = floor.lateness[bi];
+    std::printf("%8.0fus %9zu %9.2f %9.2f %9.2f %9.1f\n", budgets[bi] * 1e6, l.size(),
+                1e6 * quantile(l, 0.5), 1e6 * quantile(l, 0.99), 1e6 * quantile(l, 0.999),
+                1e6 * quantile(l, 1.0));
+    if (csv)
+      csv << "floor," << budgets[bi] << ',' << l.size() << ",0," << 1e6 * quantile(l, 0.5) << ','
+          << 1e6 * quantile(l, 0.99) << ',' << 1e6 * quantile(l, 0.999) << ','
+          << 1e6 * quantile(l, 1.0) << ",0\n";
+  }
+  std::printf(
+      "floor: %zu clock gaps > 1 us (%.0f per second), gap p50 %.1f us, p99 %.1f us, max %.1f us\n",
+      floor.gaps.size(), floor.gaps.size() / floor.spun, 1e6 * quantile(floor.gaps, 0.5),
+      1e6 * quantile(floor.gaps, 0.99), 1e6 * quantile(floor.gaps, 1.0));
+  return 0;
+}

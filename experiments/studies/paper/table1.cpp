@@ -1,0 +1,176 @@
+// table1: reproduces the paper's Table 1. For each interaction (scene) and
+// each critical time, a fresh run from identical initial conditions is taken
+// to the same moment of contact; we record PAIRLIST and COLLISIONLIST sizes
+// there, and the frame rate over the contact window, and print them next to
+// the paper's numbers. Writes table1.csv and table1.md into --out.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "experiments/common/command_line.hpp"
+#include "experiments/runner/run.hpp"
+#include <icd/config.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
+
+namespace fs = std::filesystem;
+using namespace icd::runner;
+
+namespace {
+
+// The paper's Table 1: critical time -> {pairList, collisionList, FPS} per interaction.
+struct PaperRow {
+  int pair_list, collision_list, fps;
+};
+const std::map<std::string, std::map<double, PaperRow>> kPaper = {
+    {"dragon_dragon",
+     {{1e-4, {3, 0, 60}},
+      {1e-3, {17, 0, 60}},
+      {1e-2, {30, 0, 42}},
+      {1e-1, {41, 6, 35}},
+      {1, {1345, 30, 25}}}},
+    {"bunny_bunny",
+     {{1e-4, {3, 0, 52}},
+      {1e-3, {25, 0, 48}},
+      {1e-2, {44, 0, 37}},
+      {1e-1, {61, 11, 30}},
+      {1, {1405, 36, 22}}}},
+    {"bunny_dragon",
+     {{1e-4, {3, 0, 56}},
+      {1e-3, {21, 0, 51}},
+      {1e-2, {33, 0, 42}},
+      {1e-1, {52, 12, 33}},
+      {1, {1387, 28, 23}}}},
+};
+
+struct Row {
+  std::string scene;
+  double budget = 0;
+  int contact_frame = -1, measure_frame = -1;
+  FrameMetrics at;          // metrics of the measured frame
+  double fps = 0;           // frames per wall second over the contact window
+  double collision_ms = 0;  // mean collision time per frame in the window
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fs::path out = "results/table1";
+  std::vector<fs::path> scenes;
+  std::vector<double> budgets = {1e-4, 1e-3, 1e-2, 1e-1, 1.0};
+  int max_frames = 200, after = 3;
+  double paper_scale = 1;  // our critical time x paper_scale = the paper's row we sit beside
+  icd::experiments::CommandLine cli(
+      "table1",
+      "  Runs each scene once per critical time (default 1e-4,1e-3,1e-2,1e-1,1 s) and\n"
+      "  records the list sizes N frames (--after, default 3) after first contact.\n"
+      "  Default scenes: the paper's dragon-dragon, bunny-bunny, bunny-dragon.");
+  cli.path("--out", out, "DIR", "output folder (default results/table1)")
+      .custom("--scene", "FILE", "a scene to run (repeatable)",
+              [&](const std::string& v) { scenes.emplace_back(v); })
+      .custom("--budgets", "a,b,...", "critical times (s)",
+              [&](const std::string& v) {
+                budgets.clear();
+                std::stringstream ss(v);
+                for (std::string t; std::getline(ss, t, ',');)
+                  budgets.push_back(icd::experiments::CommandLine::parse_real(t, 0.0));
+                if (budgets.empty()) throw std::invalid_argument("needs at least one time");
+              })
+      .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1)
+      .real("--paper-scale", paper_scale, "F",
+            "the paper's row at critical time x F sits beside ours (default 1)", 0.0)
+      .integer("--after", after, "N", "frames after first contact (default 3)", 0);
+  if (const auto status = cli.parse(argc, argv)) return *status;
+  if (scenes.empty())
+    for (const char* s : {"dragon_dragon", "bunny_bunny", "bunny_dragon"})
+      scenes.push_back(fs::path(ICD_SOURCE_DIR) / "experiments/scenes" /
+                       (std::string(s) + ".json"));
+  const fs::path cache = fs::path(ICD_SOURCE_DIR) / "assets";
+  const fs::path tools = fs::canonical("/proc/self/exe").parent_path();
+  std::vector<Row> rows;
+  try {
+    for (const fs::path& sp : scenes) {
+      Scene scene = load_scene(sp);
+      scene.output = OutputSpec{};
+      scene.output.csv = false;
+      scene.world.target_fps = 0;
+      scene.world.collision.query.budget_tests = -1;
+      for (double budget : budgets) {
+        scene.world.collision.query.budget_seconds = budget;
+        World world = make_world(scene, cache, tools);
+        Row row;
+        row.scene = scene.name;
+        row.budget = budget;
+        std::vector<FrameMetrics> frames;
+        for (int f = 0; f < max_frames; ++f) {
+          frames.push_back(world.step());
+          // Contact: some sphere pair produced a force.
+          if (row.contact_frame < 0 && frames.back().active_pairs > 0) row.contact_frame = f;
+          if (row.contact_frame >= 0 && f == row.contact_frame + after) break;
+        }
+        if (row.contact_frame < 0) {
+          std::fprintf(stderr, "table1: %s at %g s: no contact within %d frames\n",
+                       scene.name.c_str(), budget, max_frames);
+          row.at = frames.back();
+        } else {
+          row.measure_frame = static_cast<int>(frames.size()) - 1;
+          row.at = frames.back();
+          double wall = 0, coll = 0;
+          for (int f = row.contact_frame; f <= row.measure_frame; ++f) {
+            wall += frames[f].wall;
+            coll += frames[f].times.collision;
+          }
+          const int n = row.measure_frame - row.contact_frame + 1;
+          row.fps = n / wall;
+          row.collision_ms = 1e3 * coll / n;
+        }
+        std::printf(
+            "%-14s budget %-7g contact frame %3d: PAIRLIST %6lld COLLISIONLIST %5lld fps %6.1f\n",
+            row.scene.c_str(), budget, row.contact_frame, static_cast<long long>(row.at.pair_list),
+            static_cast<long long>(row.at.collision_list), row.fps);
+        std::fflush(stdout);
+        rows.push_back(row);
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "table1: %s\n", e.what());
+    return 1;
+  }
+
+  std::ostringstream csv, md;
+  csv << "scene,critical_time,contact_frame,measure_frame,pair_list,collision_list,fps,"
+         "collision_ms,tests,interrupted,completed_level,paper_pair_list,paper_collision_list,"
+         "paper_fps\n";
+  md << "| interaction | critical time (s) | PAIRLIST ours | paper | COLLISIONLIST ours | paper | "
+        "FPS ours | paper | completed level |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    const auto ps = kPaper.find(r.scene);
+    const PaperRow* p = nullptr;
+    if (ps != kPaper.end()) {
+      for (const auto& [t, row] : ps->second)
+        if (std::abs(t - r.budget * paper_scale) <= 1e-9 * t) p = &row;
+    }
+    csv << r.scene << ',' << r.budget << ',' << r.contact_frame << ',' << r.measure_frame << ','
+        << r.at.pair_list << ',' << r.at.collision_list << ',' << r.fps << ',' << r.collision_ms
+        << ',' << r.at.tests << ',' << r.at.interrupted << ',' << r.at.completed_level << ','
+        << (p ? std::to_string(p->pair_list) : "") << ','
+        << (p ? std::to_string(p->collision_list) : "") << ',' << (p ? std::to_string(p->fps) : "")
+        << '\n';
+    char fps[32];
+    std::snprintf(fps, sizeof fps, "%.1f", r.fps);
+    md << "| " << r.scene << " | " << r.budget << " | " << r.at.pair_list << " | "
+       << (p ? std::to_string(p->pair_list) : "-") << " | " << r.at.collision_list << " | "
+       << (p ? std::to_string(p->collision_list) : "-") << " | " << fps << " | "
+       << (p ? std::to_string(p->fps) : "-") << " | " << r.at.completed_level << " |\n";
+  }
+  fs::create_directories(out);
+  icd::write_file_atomically(out / "table1.csv", csv.str());
+  icd::write_file_atomically(out / "table1.md", md.str());
+  std::printf("\n%s\nresults: %s\n", md.str().c_str(), fs::absolute(out).c_str());
+  return 0;
+}
