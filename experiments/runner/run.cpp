@@ -200,7 +200,7 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
     const int ranges = std::max(1, std::min(opt.summary_ranges, scene.frames));
     for (int r = 0; r < ranges; ++r) {
       const int a = r * scene.frames / ranges, b = (r + 1) * scene.frames / ranges;
-      StageTimes sum;
+      coupling::StageTimes sum;
       double wall = 0, pl = 0, cl = 0;
       int intr = 0, reused = 0;
       double cycles = 0;

@@ -250,17 +250,21 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
                                  : collision::SphereUpdateMode::DisplacementBound;
   c.update.margin = f.number("sphere_margin", c.update.margin, 0, 1e3);
   c.contact.stiffness = f.number("stiffness", c.contact.stiffness, 0, 1e12, true);
-  static_assert(coupling::ContactOptions{}.distribution ==
-                coupling::ContactDistribution::PartitionOfUnity);  // the field's default below
-  const std::string dist = f.string("distribution", "partition_of_unity",
-                                    {"mass_weighted", "partition_of_unity", "paper_average"});
+  const coupling::ContactDistribution d0 = c.contact.distribution;
+  const std::string dist =
+      f.string("distribution",
+               d0 == coupling::ContactDistribution::PaperAverage       ? "paper_average"
+               : d0 == coupling::ContactDistribution::PartitionOfUnity ? "partition_of_unity"
+                                                                        : "mass_weighted",
+               {"mass_weighted", "partition_of_unity", "paper_average"});
   c.contact.distribution = dist == "paper_average" ? coupling::ContactDistribution::PaperAverage
                            : dist == "partition_of_unity"
                                ? coupling::ContactDistribution::PartitionOfUnity
                                : coupling::ContactDistribution::MassWeighted;
   c.contact.use_untested = f.boolean("use_untested", c.contact.use_untested);
-  static_assert(CollisionSpec{}.on_interrupt == InterruptedResponse::Previous);
-  c.on_interrupt = f.string("on_interrupt", "previous", {"untested", "previous"}) == "untested"
+  const bool untested = c.on_interrupt == InterruptedResponse::Untested;
+  c.on_interrupt = f.string("on_interrupt", untested ? "untested" : "previous",
+                            {"untested", "previous"}) == "untested"
                        ? InterruptedResponse::Untested
                        : InterruptedResponse::Previous;
   c.previous_max_age = f.number("previous_max_age", c.previous_max_age, 0, kInf);

@@ -227,7 +227,9 @@ TEST(SphereUpdate, EncloseChildrenMakesEveryParentContainItsChildren) {
   for (int i = 0; i < t.num_nodes(); ++i) {
     EXPECT_EQ(t.spheres[i].center(), before.spheres[i].center());
     EXPECT_GE(t.spheres[i].r, before.spheres[i].r);
-    if (t.child_count[i] == 0) EXPECT_EQ(t.spheres[i].r, before.spheres[i].r);
+    if (t.child_count[i] == 0) {
+      EXPECT_EQ(t.spheres[i].r, before.spheres[i].r);
+    }
     grown += t.spheres[i].r > before.spheres[i].r;
     for (int c = t.first_child[i]; c < t.first_child[i] + t.child_count[i]; ++c)
       for (int k = 0; k < 64; ++k) {
