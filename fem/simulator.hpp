@@ -51,7 +51,8 @@ struct SimulatorOptions {
   /// Lanczos tolerance (residual / Ritz value) of those warm re-estimates;
   /// the step limit uses FrequencyEstimate::omega_bound, which includes the
   /// residual. Measured on the fem_realtime bar over 3 s against converged
-  /// cold-start estimates of every frame's state (experiments/fem/results):
+  /// cold-start estimates of every frame's state (fem_frequency_tracking;
+  /// experiments/studies/fem/results/README.md):
   /// with frequency.warm_modes = 3, 5 iterations and 1e-3 the estimate is
   /// at most 2.3% low; a single warm vector with 4 iterations was up to 7%
   /// (tolerance 1e-5) or 10% (1e-2) low, as the top mode changes.
@@ -70,12 +71,12 @@ struct SimulatorOptions {
   /// EnergyCheck::Full, the elastic energy) of state n in the element pass
   /// of its first force evaluation (at x_n), kinetic energy and load
   /// potential in its first node pass. Cost per simulated second on the
-  /// fem_realtime bar (StVK, AVX2 lane loops; measured in
-  /// experiments/fem/results/README.md): the kernel part of
+  /// fem_realtime bar (StVK, AVX2 lane loops; experiments/studies/fem/results/
+  /// README.md, "fem_realtime: the real-time claim"): the kernel part of
   /// EnergyCheck::Bound (the default here) is 0-2 ns/tet of a ~23 ns/tet
   /// force evaluation, of Full ~3; every step against frame ends only costs
   /// RK4 +2-3% and symplectic Euler +4-7% with Bound (+2% / +7-8% with
-  /// Full, +4% / +12% in the previous session's run). Only the last state of an
+  /// Full, +4% / +12% with the code of commit 0a53428). Only the last state of an
   /// advance()/step() call needs a separate element pass, always with the
   /// full check (which also computes the forces there for the next call).
   /// A blow-up is caught at most this many steps late and rolled back to the

@@ -29,8 +29,8 @@ enum class SphereBuilder {
 /// How far the medial-axis sphere tree is optimised (icd-preprocess
 /// --sphere-fit, scene field preprocess.tree_fit). Measured against light
 /// (icd-preprocess defaults otherwise, 400 approach poses of
-/// contact_tightness; experiments/spheretree/results/README.md, "This
-/// session (12)"), dragon / bunny: full -12 % / +10 % false leaf pairs near
+/// contact_tightness; experiments/studies/preprocess/README.md, "Sphere-tree
+/// fit"), dragon / bunny: full -12 % / +10 % false leaf pairs near
 /// contact, -5 % / +28 % sphere tests; shell -15 % / +3 %, +26 % / +21 %.
 /// No fit is better on both models, so light stays the default.
 enum class SphereFit {

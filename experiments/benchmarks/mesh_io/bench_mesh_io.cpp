@@ -1,6 +1,6 @@
 // Benchmarks of the mesh readers on the real meshes, each against a baseline
 // measured in the same run: a straightforward iostream OFF parser (operator>>).
-// Run: build/experiments/tools/bench_mesh_io [--benchmark_repetitions=5]
+// Run: <build>/bin/bench_mesh_io [--benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

@@ -6,10 +6,11 @@
 //  - CoverRadius (the polish's covering radius) along a pattern-search walk
 //    against the maximum over every member.
 // The builder's distance queries must keep their visiting order to keep the
-// trees (see experiments/spheretree/results/README.md, "This session (8)"):
-// judge changes to them here, where the run-to-run spread of a whole build
-// (about 10 %) does not hide them.
-// Run: build/experiments/spheretree/bench_spheretree [--benchmark_repetitions=5]
+// trees (the build flips early greedy decisions on a last-bit change of a
+// distance): judge changes to them here, where the run-to-run spread of a
+// whole build (about 10 %) does not hide them. Recorded figures:
+// experiments/studies/spheretree/results/README.md, "Build time".
+// Run: <build>/bin/bench_spheretree [--benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

@@ -1,8 +1,8 @@
 // Full traversals of two copies of a wrapped sphere tree near contact, with
 // and without CollisionRequest::parent_filter, measured in the same run.
 //
-// Scenes: the committed trees of experiments/spheretree/results (ours:
-// {dragon,bunny}_medial.sph; the reference toolkit's:
+// Scenes: the committed trees of experiments/studies/spheretree/results
+// (ours: {dragon,bunny}_medial.sph; the reference toolkit's:
 // reference/{dragon,bunny}_readme-medial.sph) on 32 approach poses of
 // contact_tightness's kind (seed 1): the second copy turned by a random
 // rotation and moved to 1 unit (longest side 2000) short of where the
@@ -11,8 +11,10 @@
 // Counters: sphere tests and leaf pairs per query. Compare filter=1 against
 // filter=0 of the same tree and mode, within one run. BM_NearContactTestBudget:
 // the same queries interrupted by a budget of sphere tests.
-// Run: build/experiments/spheretree/bench_wrapped_traversal --benchmark_repetitions=7
+// Run: <build>/bin/bench_wrapped_traversal --benchmark_repetitions=7
 //          --benchmark_enable_random_interleaving=true (the machine is noisy)
+// Recorded results: experiments/studies/spheretree/results/bench_parent_filter.txt
+// (README.md there, "Parent filter").
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # perturb_sweep.sh BINARY LOG [sphere_tree_table options...]
 # Builds the dragon tree for the mesh scaled by 1 + E, E in {0, 1, -1, 2, 3,
-# -3, 5} x 1e-12 (rounding sensitivity of the build, see results/README.md),
+# -3, 5} x 1e-12 (a last-bit change of the input flips early greedy decisions
+# of the build; see results/README.md, "Reproduce"),
 # one build after the other, appends every run's output to LOG and prints the
 # leaf-level summary (median and range over the 7 builds; summarize_sweep.py).
 # EPS="0 1e-12" overrides the list of E; a later "--models bunny" in the

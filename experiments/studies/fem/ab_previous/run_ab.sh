@@ -4,7 +4,7 @@
 # mesh/core/ sources are compiled with the namespace icd renamed to icd_old;
 # the working tree's libraries come from an existing build directory. The
 # commit must have the layered layout (mesh/core, <icd/...> includes).
-# Usage: experiments/fem/ab_previous/run_ab.sh <commit> [build dir] [mesh 0|1] [repetitions] [check interval]
+# Usage: experiments/studies/fem/ab_previous/run_ab.sh <commit> [build dir] [mesh 0|1] [repetitions] [check interval]
 # (run from the repository root; compiles with 2 jobs into /tmp/icd_fem_ab_<commit>).
 set -euo pipefail
 commit=${1:?usage: run_ab.sh <commit> [build dir] [mesh] [repetitions] [check interval]}
