@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   try {
     const icd::runner::Scene scene = icd::runner::load_scene(scene_path);
     std::printf("scene \"%s\" (%s)\n", scene.name.c_str(), scene_path.c_str());
-    for (const std::string& line : icd::runner::make_plan(scene).describe(scene))
+    for (const std::string& line : icd::runner::describe_plan(scene))
       std::printf("  %s\n", line.c_str());
     icd::runner::RunOptions opt;
     opt.out_dir = out;
