@@ -79,11 +79,15 @@ std::vector<std::string> StagePlan::describe(std::span<const ObjectSetup> setups
     const collision::CollisionRequest& q = settings.collision.query;
     switch (tree_cut) {
       case TreeCut::None:
-        lines.emplace_back(
-            std::isfinite(q.budget_seconds)
-                ? "sphere trees: every level kept (a time budget cuts no level: how deep a "
-                  "query gets depends on the machine and the pair)"
-                : "sphere trees: every level kept (no budget or depth cap bounds the queries)");
+        if (q.budget_tests >= 0)
+          lines.push_back("sphere trees: every level kept (a budget of " +
+                          std::to_string(q.budget_tests) + " tests cuts no level)");
+        else if (std::isfinite(q.budget_seconds))
+          lines.emplace_back(
+              "sphere trees: every level kept (a time budget cuts no level: how deep a query "
+              "gets depends on the machine and the pair)");
+        else
+          lines.emplace_back("sphere trees: every level kept (no budget, no depth cap)");
         break;
       case TreeCut::DepthCap:
         lines.push_back("sphere trees: levels 0.." + std::to_string(max_tree_level) +

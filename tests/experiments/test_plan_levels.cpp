@@ -76,6 +76,10 @@ TEST(PlanLevels, TimeBudgetsCutNoLevelAndClaimNothing) {
         << budget;
     for (const std::string& l : lines) EXPECT_EQ(l.find("reach the leaves"), std::string::npos);
   }
+  EXPECT_EQ(describe_plan(two_spheres(R"("budget_tests": 20000)"))[2],
+            "sphere trees: every level kept (a budget of 20000 tests cuts no level)");
+  EXPECT_EQ(describe_plan(two_spheres(R"("unlimited": true)"))[2],
+            "sphere trees: every level kept (no budget, no depth cap)");
 }
 
 // Oracle: for every test budget and traversal mode, the query on the full

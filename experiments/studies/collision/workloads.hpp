@@ -2,9 +2,12 @@
 // Shared scenes of the collision experiments: real meshes (bunny, dragon),
 // their octree sphere trees, a coarse node set, and a smooth deformation.
 #include <string>
+#include <vector>
 
 #include <icd/collision/sphere_tree.hpp>
 #include <icd/mesh/core/types.hpp>
+
+#include "experiments/common/timing.hpp"
 
 namespace icd::collision::experiments {
 
