@@ -97,6 +97,20 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
   m_complete_depth.assign(m_plan.pairs.size(), 0.0);
 }
 
+void World::set_external_forces(int i, const MatX3d& forces) {
+  if (i < 0 || i >= static_cast<int>(m_objects.size()))
+    throw ParameterError("World::set_external_forces: no object " + std::to_string(i));
+  RuntimeObject& o = m_objects[static_cast<size_t>(i)];
+  if (forces.size() > 0 && forces.rows() != o.rest.rows())
+    throw ParameterError("object \"" + o.setup.name + "\": external forces need " +
+                         std::to_string(o.rest.rows()) + " rows (one per coarse node), got " +
+                         std::to_string(forces.rows()));
+  if (!forces.allFinite())
+    throw ParameterError("object \"" + o.setup.name + "\": external forces must be finite");
+  o.external_forces = forces;
+  if (forces.size() == 0 && o.sim) o.sim->set_external_forces(MatX3d::Zero(o.rest.rows(), 3));
+}
+
 int World::contact_cycles(double dt) const {
   if (!m_plan.response) return 1;
   // Conservative: the largest node stiffness (at least k) on the lightest
@@ -123,7 +137,11 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     if (o.plan.fem) {
       const bool track_work =
           m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
-      if (m_plan.response) o.sim->set_external_forces(o.contact_forces);
+      if (o.external_forces.size() > 0)
+        o.sim->set_external_forces(m_plan.response ? MatX3d(o.contact_forces + o.external_forces)
+                                                   : o.external_forces);
+      else if (m_plan.response)
+        o.sim->set_external_forces(o.contact_forces);
       // The forces are constant over the cycle: their work is f . x1 - f . x0.
       if (track_work) m_contact_work -= o.contact_forces.cwiseProduct(o.positions).sum();
       const fem::AdvanceReport rep = o.sim->advance(h);

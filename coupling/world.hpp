@@ -71,6 +71,10 @@ struct RuntimeObject {
   MatX3d positions;                     ///< current coarse positions (#V x 3)
   MatX3d rest;                          ///< rest coarse positions, placed in the world
   MatX3d contact_forces;                ///< forces from the last collision response (#V x 3)
+  /// Loads set by the user on the coarse nodes (N, #V x 3; empty = none),
+  /// held until changed: a scripted or haptic probe, a pull. They act on
+  /// deformable objects beside the contact forces (and gravity).
+  MatX3d external_forces;
   MatX3d dense;                         ///< current dense positions (when the plan updates them)
   LinkEvaluator links;            ///< the rigid links, grouped by node triple (when dense_update)
   MatX3d predicted;               ///< coarse positions half a cycle ahead (collision.midpoint)
@@ -91,6 +95,11 @@ class World {
   const StagePlan& plan() const { return m_plan; }
   std::vector<RuntimeObject>& objects() { return m_objects; }
   const std::vector<RuntimeObject>& objects() const { return m_objects; }
+  /// Sets the user loads of object `i` (N per coarse node, #V x 3; an empty
+  /// matrix removes them). Throws ParameterError for a wrong shape or a
+  /// non-finite entry, naming the object.
+  void set_external_forces(int i, const MatX3d& forces);
+
   /// The last query of each collision pair (same order as plan().pairs).
   const std::vector<collision::CollisionResult>& results() const { return m_results; }
 

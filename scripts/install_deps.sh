@@ -7,7 +7,8 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git ca-certificates
   libeigen3-dev libsuitesparse-dev libmetis-dev libopenblas-dev libcgal-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-meshio python3-numpy python3-matplotlib
+  python3 python3-dev python3-meshio python3-numpy python3-matplotlib
+  pybind11-dev python3-pybind11
 )
 # Optional extras: the FCL baseline of the collision benchmark.
 OPTIONAL=(libfcl-dev)
