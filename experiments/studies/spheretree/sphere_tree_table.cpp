@@ -13,7 +13,7 @@
 //                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
 //                   [--prune 0|1]  (SphereTreeOptions::prune_redundant_leaves)
 //                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]
-//                   [--split-stop-stuck 0|1] [--split-redivide N]  (split_worst)
+//                                 (split_worst)
 //                   [--caps 1,8,64,N[,M]]  (spheres allowed per level; depth = count - 1)
 //                   [--branching B]  (children per node at most; default 8)
 //                   [--build-branching B]  (SphereTreeOptions::build_branching)
@@ -217,9 +217,6 @@ int run(int argc, char** argv) {
       .integer("--split-tries", split.max_tries, "N", "split_worst: tries")
       .real("--split-relief", split.relief_fraction, "F", "split_worst: relief fraction")
       .real("--split-mean-rise", split.mean_rise_limit, "F", "split_worst: mean rise limit")
-      .boolean("--split-stop-stuck", split.stop_relief_when_stuck,
-               "split_worst: stop the relief when stuck")
-      .integer("--split-redivide", split.redivide_siblings, "N", "split_worst: siblings")
       .custom(
           "--caps", "1,8,64,N[,M]", "spheres allowed per level (depth = count - 1)",
           [&](const std::string& v) {
@@ -310,11 +307,10 @@ int run(int argc, char** argv) {
       const auto& w = ours.worst_split;
       std::printf(
           "# %s worst split: %d splits in %d tries (%d merges; %d worst leaves with a full parent; "
-          "relief band: %d without two better halves, %d without a merge; %d re-divided with a "
-          "sibling), %d spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d "
-          "dirs) %.2f\n",
+          "relief band: %d without two better halves, %d without a merge), %d spheres measured, "
+          "true worst (%d dirs) %.1f -> %.1f, mean at the start (%d dirs) %.2f\n",
           model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent, w.relief_no_split,
-          w.relief_no_merge, w.redivisions, w.measured, options.worst_split.measure_directions,
+          w.relief_no_merge, w.measured, options.worst_split.measure_directions,
           to_2000 * w.worst_before, to_2000 * w.worst_after, options.worst_split.choice_directions,
           to_2000 * w.mean_before);
     }

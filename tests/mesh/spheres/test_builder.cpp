@@ -250,8 +250,8 @@ SphereTreeOptions lossy_leaf_options() {
   o.medial_spacing = 1.0 / 6;
   o.worst_split.measure_directions = 300;
   o.worst_split.choice_directions = 100;
-  // The cases below were set up (to exercise fills, failed tries and
-  // re-divisions) with the fixed-split leaf allocation.
+  // The cases below were set up (to exercise fills and failed tries) with
+  // the fixed-split leaf allocation.
   o.leaf_worst_target = 0;
   o.leaf_worst_factor = 0;
   return o;
@@ -488,58 +488,6 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
   EXPECT_LE(leaf_sum(build.tree, measure),
             leaf_sum(plain.tree, measure) + result.splits * mean_before + 1e-9);
   EXPECT_EQ(build.tree.num_nodes() - build.tree.level_offset[2], plain_leaves + result.splits);
-}
-
-TEST(SphereTreeBuilder, SplitWorstStopReliefWhenStuckClosesTheBandAtItsFirstFailure) {
-  // With stop_relief_when_stuck the relief band closes at its first failed
-  // try: at most one failure is counted, never more tries than without it,
-  // and every guarantee holds. The case must fail in the band at least twice
-  // without the option, so that the option has something to stop.
-  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = lossy_leaf_options();
-  o.max_spheres_per_level = {1, 8, 40};
-  o.worst_split.relief_fraction = 0.5;
-  const SphereTreeBuild open = build_sphere_tree(sphere, o);
-  const auto& a = open.worst_split;
-  ASSERT_GE(a.relief_no_split + a.relief_no_merge, 2) << "the case must fail in the band twice";
-  o.worst_split.stop_relief_when_stuck = true;
-  const SphereTreeBuild build = build_sphere_tree(sphere, o);
-  const auto& b = build.worst_split;
-  EXPECT_LE(b.relief_no_split + b.relief_no_merge, 1);
-  EXPECT_LE(b.tries, a.tries);
-  EXPECT_LE(b.worst_after, b.worst_before);
-  const auto& tree = build.tree;
-  EXPECT_NO_THROW(icd::collision::validate(tree));
-  EXPECT_LE(tree.num_nodes() - tree.level_offset[2], 40);
-  expect_nodes_cover_and_children_divide(build);
-  expect_every_level_covers(tree, sphere, 23);
-}
-
-TEST(SphereTreeBuilder, SplitWorstRedivideWithASiblingKeepsEveryGuarantee) {
-  // The case of the test above fails in the relief band: re-dividing the
-  // stuck leaf together with a sibling (redivide_siblings) must happen at
-  // least once and keep every guarantee: the leaf count bookkeeping (a
-  // re-division keeps it: plain + splits - merges), the cap and branching,
-  // the true worst on the measuring directions (recomputed here) equal to the
-  // reported one and not above the start's (recomputed on the build without
-  // the split), coverage with margin, children dividing their parent's
-  // samples, and every level covering a dense random sampling.
-  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = lossy_leaf_options();
-  o.max_spheres_per_level = {1, 8, 40};
-  o.worst_split.relief_fraction = 0.5;
-  o.worst_split.redivide_siblings = 3;
-  SphereTreeOptions p = o;
-  p.split_worst = false;
-  const SphereTreeBuild plain = build_sphere_tree(sphere, p);
-  const SphereTreeBuild build = build_sphere_tree(sphere, o);
-  const auto& r = build.worst_split;
-  EXPECT_GT(r.redivisions, 0) << "the case must exercise the re-division";
-  EXPECT_NO_THROW(icd::collision::validate(build.tree));
-  ASSERT_EQ(build.tree.num_levels(), 3);
-  expect_worst_split_guarantees(plain, build, sphere, o, 40, 29);
-  o.worst_split.redivide_siblings = -1;
-  EXPECT_THROW(build_sphere_tree(sphere, o), icd::ParameterError);
 }
 
 TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
