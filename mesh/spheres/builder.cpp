@@ -37,7 +37,6 @@ void check_options(const SphereTreeOptions& o) {
   if (o.refinement_iterations < 0) fail("refinement_iterations must be >= 0");
   if (!(o.refinement_tolerance > 0)) fail("refinement_tolerance must be > 0");
   if (o.lloyd_iterations < 0) fail("lloyd_iterations must be >= 0");
-  if (o.merge_burst_lloyd_iterations < 0) fail("merge_burst_lloyd_iterations must be >= 0");
   if (o.exchange_rounds < 0) fail("exchange_rounds must be >= 0");
   if (o.relieve_moves < 0) fail("relieve_moves must be >= 0");
   if (o.protrusion_exchange_rounds < 0) fail("protrusion_exchange_rounds must be >= 0");
@@ -84,13 +83,6 @@ struct ParentChoices {
     return worst;
   }
 };
-
-/// Worst error, then summed error: the order in which best_of_both compares configurations.
-bool better_config(const std::vector<FittedSphere>& a, const std::vector<FittedSphere>& b) {
-  const double wa = ParentChoices::worst_error(a), wb = ParentChoices::worst_error(b);
-  if (wa != wb) return wa < wb;
-  return ParentChoices::total_error(a) < ParentChoices::total_error(b);
-}
 
 /// The sphere cap of level l: branching^l, lowered by max_spheres_per_level[l] when positive.
 long long level_cap(const SphereTreeOptions& options, int l) {
@@ -737,31 +729,7 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   ReductionOptions reduction;
   reduction.lloyd_iterations = options.lloyd_iterations;
   reduction.deadline = deadline;
-  MergeBurstOptions merge_burst;
-  merge_burst.neighbour_radius = 1.5 * options.medial_spacing * scale;
-  merge_burst.lloyd_iterations = options.merge_burst_lloyd_iterations;
-  std::vector<int> owners;
-  if (options.reduction != ReductionMethod::split_lloyd) {
-    owners = medial_owners(coarse, options.medial_spacing * scale);
-  }
   const int build_branching = std::max(options.branching, options.build_branching);
-  // `threads` > 1 only where one node is reduced (the root's children).
-  auto reduce = [&](const std::vector<int>& members, int max_k, int threads) {
-    ReductionOptions split_options = reduction;
-    split_options.threads = threads;
-    if (options.reduction == ReductionMethod::split_lloyd) {
-      return reduce_to_spheres(coarse, members, max_k, split_options);
-    }
-    std::vector<std::vector<FittedSphere>> mb =
-        merge_burst_reduce(coarse, owners, members, max_k, reduction, merge_burst);
-    if (options.reduction == ReductionMethod::best_of_both) {
-      const auto split = reduce_to_spheres(coarse, members, max_k, split_options);
-      for (size_t k = 0; k < mb.size(); ++k) {
-        if (better_config(split[k], mb[k])) mb[k] = split[k];
-      }
-    }
-    return mb;
-  };
 
   // Root.
   Node root;
@@ -784,9 +752,11 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     const std::vector<Node>& parents = levels.back();
     std::vector<ParentChoices> choices(parents.size());
     const int max_k = l >= 2 ? build_branching : options.branching;
-    const int reduce_threads = parents.size() == 1 ? workers : 1;
+    // With one parent (the root) its reduction is spread over the workers instead.
+    ReductionOptions node_reduction = reduction;
+    node_reduction.threads = parents.size() == 1 ? workers : 1;
     parallel_for(parents.size(), workers, [&](size_t p, int) {
-      choices[p].configs = reduce(parents[p].medial, max_k, reduce_threads);
+      choices[p].configs = reduce_to_spheres(coarse, parents[p].medial, max_k, node_reduction);
     });
     long long cap =
         std::max<long long>(level_cap(options, l), static_cast<long long>(parents.size()));

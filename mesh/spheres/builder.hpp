@@ -8,20 +8,12 @@
 #include <icd/collision/sphere_tree.hpp>
 #include <icd/mesh/core/types.hpp>
 #include <icd/mesh/spheres/exchange.hpp>
-#include <icd/mesh/spheres/merge_burst.hpp>
 #include <icd/mesh/spheres/protrusion.hpp>
 #include <icd/mesh/spheres/reduction.hpp>
 #include <icd/mesh/spheres/surface_sampling.hpp>
 #include <icd/mesh/spheres/worst_split.hpp>
 
 namespace icd::mesh {
-
-/// How the medial spheres of a node are reduced to its children.
-enum class ReductionMethod {
-  split_lloyd,   ///< greedy splitting + Lloyd rounds (reduce_to_spheres)
-  merge_burst,   ///< merge/burst from the medial set + Lloyd rounds (merge_burst_reduce)
-  best_of_both,  ///< both; for each child count the configuration with the lower worst error
-};
 
 /// Options of build_sphere_tree(). Lengths are fractions of the longest side
 /// of the model's axis-aligned bounding box (so 0.001 is 2 units when that
@@ -88,9 +80,6 @@ struct SphereTreeOptions {
   int refinement_iterations = 2;        ///< adaptive medial-axis rounds (>= 0)
   double refinement_tolerance = 0.002;  ///< medial sphere error that triggers refinement (relative)
   int lloyd_iterations = 8;             ///< see ReductionOptions
-  ReductionMethod reduction =
-      ReductionMethod::split_lloyd;      ///< see ReductionMethod (split_lloyd measured best)
-  int merge_burst_lloyd_iterations = 4;  ///< see MergeBurstOptions::lloyd_iterations
   /// Rounds of boundary exchange among the children of each node, each
   /// followed by a centre polish (see shrink_by_exchange, polish_sphere; >= 0).
   int exchange_rounds = 2;

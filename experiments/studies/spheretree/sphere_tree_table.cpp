@@ -2,7 +2,6 @@
 //                   [--cover-spacing REL] [--joint 0|1] [--regroup 0|1] [--lloyd N] [--octree 0|1]
 //                   [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]
 //                   [--coverage-spacing UNITS] [--shell-samples N]  (evaluation)
-//                   [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
 //                   [--polish 0|1] [--polish-rounds N] [--polish-evals N]
@@ -184,17 +183,6 @@ int run(int argc, char** argv) {
       .real("--coverage-spacing", evaluation.coverage_spacing, "UNITS",
             "evaluation: dense coverage spacing")
       .integer("--shell-samples", evaluation.shell_samples, "N", "evaluation: points per sphere")
-      .custom("--reduction", "split|merge|both", "reduction method",
-              [&](const std::string& v) {
-                if (v == "split")
-                  options.reduction = icd::mesh::ReductionMethod::split_lloyd;
-                else if (v == "merge")
-                  options.reduction = icd::mesh::ReductionMethod::merge_burst;
-                else if (v == "both")
-                  options.reduction = icd::mesh::ReductionMethod::best_of_both;
-                else
-                  throw std::invalid_argument("expects split, merge or both, got '" + v + "'");
-              })
       .integer("--diagnose", diagnose, "N", "print the N leaves of largest 162-probe error", 0)
       .integer("--exchange-rounds", options.exchange_rounds, "N", "boundary exchange rounds")
       .integer("--relieve-moves", options.relieve_moves, "N", "relieve_worst moves")

@@ -38,31 +38,22 @@ std::vector<Case> cases() {
           {"torus", icd::make_torus(1.0, 0.3, 24, 12)}};
 }
 
-SphereTreeOptions small_options(ReductionMethod method = SphereTreeOptions{}.reduction);
-
-/// The reduction methods every tree-level guarantee is checked for.
-const std::vector<std::pair<std::string, ReductionMethod>> kMethods = {
-    {"split_lloyd", ReductionMethod::split_lloyd}, {"merge_burst", ReductionMethod::merge_burst}};
-
-/// The builds of cases(), made once per test program (each takes seconds).
-const SphereTreeBuild& cached_build(const Case& c,
-                                    ReductionMethod method = SphereTreeOptions{}.reduction) {
-  static std::map<std::pair<std::string, ReductionMethod>, SphereTreeBuild> builds;
-  const auto key = std::make_pair(c.name, method);
-  auto it = builds.find(key);
-  if (it == builds.end())
-    it = builds.emplace(key, build_sphere_tree(c.mesh, small_options(method))).first;
-  return it->second;
-}
-
-SphereTreeOptions small_options(ReductionMethod method) {
+SphereTreeOptions small_options() {
   SphereTreeOptions o;
   o.branching = 4;
   o.depth = 2;
   o.cover_spacing = 1.0 / 80;
   o.medial_spacing = 1.0 / 20;
-  o.reduction = method;
   return o;
+}
+
+/// The builds of cases(), made once per test program (each takes seconds).
+const SphereTreeBuild& cached_build(const Case& c) {
+  static std::map<std::string, SphereTreeBuild> builds;
+  auto it = builds.find(c.name);
+  if (it == builds.end())
+    it = builds.emplace(c.name, build_sphere_tree(c.mesh, small_options())).first;
+  return it->second;
 }
 
 /// Random surface points, uniform by area (independent of the builder's lattice).
@@ -166,52 +157,47 @@ TEST(SphereTreeBuilder, LayoutIsBreadthFirstWithContiguousChildren) {
 }
 
 TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem) {
-  for (const auto& [method_name, method] : kMethods)
-    for (const auto& c : cases()) {
-      SCOPED_TRACE(c.name + " " + method_name);
-      const SphereTreeBuild& build = cached_build(c, method);
-      expect_nodes_cover_and_children_divide(build);
-      ASSERT_FALSE(build.node_samples.empty());
-      EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()),
-                build.samples.points.rows());
-    }
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    expect_nodes_cover_and_children_divide(build);
+    ASSERT_FALSE(build.node_samples.empty());
+    EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), build.samples.points.rows());
+  }
 }
 
 TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
-  for (const auto& [method_name, method] : kMethods)
-    for (const auto& c : cases()) {
-      SCOPED_TRACE(c.name + " " + method_name);
-      const SphereTreeBuild& build = cached_build(c, method);
-      const auto& tree = build.tree;
-      const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
-      for (int l = 0; l < tree.num_levels(); ++l)
-        EXPECT_EQ(uncovered_on_level(tree, l, P), 0) << "level " << l;
-    }
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto& tree = build.tree;
+    const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
+    for (int l = 0; l < tree.num_levels(); ++l)
+      EXPECT_EQ(uncovered_on_level(tree, l, P), 0) << "level " << l;
+  }
 }
 
 TEST(SphereTreeBuilder, ErrorDecreasesFromLevelToLevel) {
   EvaluationOptions eval;
   eval.coverage_spacing = 10.0;
-  for (const auto& [method_name, method] : kMethods)
-    for (const auto& c : cases()) {
-      SCOPED_TRACE(c.name + " " + method_name);
-      const SphereTreeBuild& build = cached_build(c, method);
-      const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
-      ASSERT_EQ(metrics.size(), 3u);
-      for (size_t l = 1; l < metrics.size(); ++l) {
-        // The sphere is already fitted exactly by its root (error = margin only).
-        const double slack = c.name == "icosphere" ? 0.01 * 2000 : 0.0;
-        EXPECT_LE(metrics[l].mean_error_162, metrics[l - 1].mean_error_162 + slack)
-            << "level " << l;
-        EXPECT_LE(metrics[l].worst_error_162, metrics[l - 1].worst_error_162 + slack)
-            << "level " << l;
-        if (c.name != "icosphere") {
-          EXPECT_LT(metrics[l].mean_error_162, 0.8 * metrics[l - 1].mean_error_162);
-        }
-        EXPECT_EQ(metrics[l].num_uncovered_samples, 0);
-        EXPECT_EQ(metrics[l].num_uncovered_vertices, 0);
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
+    ASSERT_EQ(metrics.size(), 3u);
+    for (size_t l = 1; l < metrics.size(); ++l) {
+      // The sphere is already fitted exactly by its root (error = margin only).
+      const double slack = c.name == "icosphere" ? 0.01 * 2000 : 0.0;
+      EXPECT_LE(metrics[l].mean_error_162, metrics[l - 1].mean_error_162 + slack) << "level " << l;
+      EXPECT_LE(metrics[l].worst_error_162, metrics[l - 1].worst_error_162 + slack)
+          << "level " << l;
+      if (c.name != "icosphere") {
+        EXPECT_LT(metrics[l].mean_error_162, 0.8 * metrics[l - 1].mean_error_162);
       }
+      EXPECT_EQ(metrics[l].num_uncovered_samples, 0);
+      EXPECT_EQ(metrics[l].num_uncovered_vertices, 0);
     }
+  }
 }
 
 SphereTreeOptions lossy_leaf_options();
@@ -226,8 +212,7 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
   for (const Case& c : cases()) {
     for (int variant = 0; variant < 2; ++variant) {
       SCOPED_TRACE(c.name + (variant == 0 ? " small options" : " lossy options"));
-      SphereTreeOptions o =
-          variant == 0 ? small_options(ReductionMethod::split_lloyd) : lossy_leaf_options();
+      SphereTreeOptions o = variant == 0 ? small_options() : lossy_leaf_options();
       o.joint_leaf_refinement = true;
       const SphereTreeBuild build = build_sphere_tree(c.mesh, o);
       const auto& tree = build.tree;
@@ -245,7 +230,7 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
 /// with branching 8 make the top-down pass lose leaves, so the fill and the
 /// worst-leaf split have free slots to use.
 SphereTreeOptions lossy_leaf_options() {
-  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  SphereTreeOptions o = small_options();
   o.branching = 8;
   o.medial_spacing = 1.0 / 6;
   o.worst_split.measure_directions = 300;
