@@ -45,8 +45,8 @@ void check_options(const SphereTreeOptions& o) {
     fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
   }
   if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
-  if (!(o.leaf_worst_target >= 0) || !(o.leaf_worst_factor >= 0) || !(o.inner_worst_target >= 0))
-    fail("leaf_worst_target, leaf_worst_factor and inner_worst_target must be >= 0");
+  if (!(o.leaf_worst_target >= 0) || !(o.leaf_worst_factor >= 0))
+    fail("leaf_worst_target and leaf_worst_factor must be >= 0");
   if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
       o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
       !(o.worst_split.mean_rise_limit >= 0)) {
@@ -330,140 +330,6 @@ void exchange_across_leaves(const ReductionProblem& dense,
   for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
   // Radii grow only within each level's worst error (accepts_growing).
   refit_inner_nodes(dense, levels, parent_of);
-}
-
-/// Removes the leaves that cover nothing alone: a leaf all of whose samples
-/// other leaves cover with margin, those leaves' ancestors too, is dropped
-/// and its samples go to them (the first such leaf, in level order). The
-/// boundary exchanges leave such leaves behind (stripped to one sample, the
-/// last one a sphere keeps, by neighbours that grew over their patch): they
-/// cost a leaf slot and cover nothing. Fewest samples first, so that of two
-/// leaves that cover each other's samples the larger stays. No radius grows;
-/// every sample stays covered with margin by a leaf and its ancestors, and
-/// the inner nodes' samples become the union of their children's again.
-/// Siblings stay contiguous. Returns the number of leaves removed.
-int prune_redundant_leaves(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
-                           std::vector<std::vector<int>>& parent_of) {
-  if (levels.size() < 2) return 0;
-  const size_t last = levels.size() - 1;
-  std::vector<Node>& leaves = levels[last];
-  const size_t n = leaves.size();
-  // Leaves whose spheres meet: the only ones that can cover each other's samples.
-  std::vector<std::vector<size_t>> near(n);
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t j = 0; j < n; ++j) {
-      const FittedSphere &a = leaves[i].sphere, &b = leaves[j].sphere;
-      if (j != i && (a.center - b.center).norm() < a.radius + b.radius) near[i].push_back(j);
-    }
-  }
-  std::vector<size_t> order(n);
-  std::iota(order.begin(), order.end(), size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return leaves[a].sphere.members.size() < leaves[b].sphere.members.size();
-  });
-  std::vector<int> children(levels[last - 1].size(), 0);
-  for (int p : parent_of[last]) children[static_cast<size_t>(p)] += 1;
-  std::vector<char> gone(n, 0);
-  int removed = 0;
-  for (size_t i : order) {
-    // A parent keeps at least one child.
-    if (children[static_cast<size_t>(parent_of[last][i])] < 2) continue;
-    const std::vector<int>& members = leaves[i].sphere.members;
-    std::vector<size_t> to;
-    for (int s : members) {
-      size_t k = n;
-      for (size_t j : near[i]) {
-        if (!gone[j] && dense.reach(s, leaves[j].sphere) <= leaves[j].sphere.radius &&
-            ancestors_cover(dense, levels, parent_of, static_cast<int>(j), s)) {
-          k = j;
-          break;
-        }
-      }
-      if (k == n) break;
-      to.push_back(k);
-    }
-    if (to.size() != members.size()) continue;
-    for (size_t m = 0; m < to.size(); ++m) {
-      std::vector<int>& into = leaves[to[m]].sphere.members;
-      into.insert(std::upper_bound(into.begin(), into.end(), members[m]), members[m]);
-    }
-    gone[i] = 1;
-    children[static_cast<size_t>(parent_of[last][i])] -= 1;
-    ++removed;
-  }
-  if (removed == 0) return 0;
-  std::vector<Node> kept;
-  std::vector<int> kept_parent;
-  for (size_t i = 0; i < n; ++i) {
-    if (gone[i]) continue;
-    kept.push_back(std::move(leaves[i]));
-    kept_parent.push_back(parent_of[last][i]);
-  }
-  leaves = std::move(kept);
-  parent_of[last] = std::move(kept_parent);
-  refit_inner_nodes(dense, levels, parent_of);
-  return removed;
-}
-
-/// Spends leaf spheres that the top-down pass lost (a child of a chosen
-/// configuration that receives no coverage sample is dropped): while the leaf
-/// level holds fewer than `cap` spheres, the leaf with the largest error bound
-/// whose parent has fewer than `branching` children is split in two (the
-/// two-sphere configuration of its medial samples, its coverage samples
-/// divided between them, centres polished), if both halves have a smaller
-/// error bound than it. The halves divide the leaf's samples, so every
-/// ancestor still covers them, and they stay next to each other (siblings
-/// contiguous). Returns the number of splits.
-int fill_leaf_budget(const ReductionProblem& coarse, const ReductionProblem& dense,
-                     const MeshOracle& oracle, const ReductionOptions& reduction,
-                     std::vector<std::vector<Node>>& levels,
-                     std::vector<std::vector<int>>& parent_of, long long cap, int branching) {
-  if (levels.size() < 2) return 0;
-  std::vector<Node>& leaves = levels.back();
-  std::vector<int>& parent = parent_of.back();
-  std::vector<int> children(levels[levels.size() - 2].size(), 0);
-  for (int p : parent) children[static_cast<size_t>(p)] += 1;
-  std::vector<char> tried(leaves.size(), 0);
-  int splits = 0;
-  while (static_cast<long long>(leaves.size()) < cap) {
-    int pick = -1;
-    for (size_t i = 0; i < leaves.size(); ++i) {
-      if (tried[i] || children[static_cast<size_t>(parent[i])] >= branching) continue;
-      if (leaves[i].medial.size() < 2 || leaves[i].sphere.members.size() < 2) continue;
-      if (pick < 0 || leaves[i].sphere.error > leaves[static_cast<size_t>(pick)].sphere.error)
-        pick = static_cast<int>(i);
-    }
-    if (pick < 0) break;
-    tried[static_cast<size_t>(pick)] = 1;
-    const Node& leaf = leaves[static_cast<size_t>(pick)];
-    std::vector<FittedSphere> halves = reduce_to_spheres(coarse, leaf.medial, 2, reduction)[1];
-    if (halves.size() < 2) continue;
-    std::vector<std::vector<int>> medial;
-    for (size_t k = 0; k < halves.size(); ++k) {
-      halves[k].tag = static_cast<int>(k);
-      medial.push_back(halves[k].members);
-    }
-    assign_and_refit(dense, leaf.sphere.members, halves);
-    for (auto& h : halves) polish_sphere(dense, oracle, h);
-    assign_and_refit(dense, leaf.sphere.members, halves);
-    if (halves.size() < 2) continue;
-    shrink_by_exchange(dense, halves);
-    if (!(halves[0].error < leaf.sphere.error && halves[1].error < leaf.sphere.error)) continue;
-    Node a, b;
-    a.sphere = std::move(halves[0]);
-    b.sphere = std::move(halves[1]);
-    a.medial = a.sphere.tag >= 0 ? medial[static_cast<size_t>(a.sphere.tag)] : leaf.medial;
-    b.medial = b.sphere.tag >= 0 ? medial[static_cast<size_t>(b.sphere.tag)] : leaf.medial;
-    const int p = parent[static_cast<size_t>(pick)];
-    leaves[static_cast<size_t>(pick)] = std::move(a);
-    leaves.insert(leaves.begin() + pick + 1, std::move(b));
-    parent.insert(parent.begin() + pick + 1, p);
-    tried.insert(tried.begin() + pick + 1, 0);
-    tried[static_cast<size_t>(pick)] = 0;
-    children[static_cast<size_t>(p)] += 1;
-    ++splits;
-  }
-  return splits;
 }
 
 /// The protrusion polish of every node (polish_protrusion), leaves first;
@@ -796,8 +662,6 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       }
     } else if (l == options.depth) {
       allocation.worst_threshold = options.leaf_worst_target * scale;
-    } else if (l >= 2 && options.inner_worst_target > 0) {
-      allocation.worst_threshold = options.inner_worst_target * scale;
     }
     const std::vector<int> count = allocate_children(costs, cap, allocation);
     out.allocated_worst_bound.push_back(chosen_worst(count));
@@ -862,11 +726,6 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
                 static_cast<long long>(levels[levels.size() - 2].size()) * options.branching);
   const int leaf_parent_limit =
       regroup ? static_cast<int>(std::max<long long>(leaf_cap, 2)) : options.branching;
-  if (options.fill_leaf_budget && options.depth >= 1) {
-    out.num_budget_splits = fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
-                                             leaf_cap, leaf_parent_limit);
-    end_step("leaf budget");
-  }
   if (options.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
     assert(children_divide_samples(levels, parent_of));
@@ -891,12 +750,6 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     refit_inner_nodes(dense, levels, parent_of);
   }
   end_step("sum exchange");
-  if (options.prune_redundant_leaves && levels.size() > 1) {
-    out.num_pruned = prune_redundant_leaves(dense, levels, parent_of);
-    out.num_budget_splits += fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
-                                              leaf_cap, leaf_parent_limit);
-    end_step("prune");
-  }
   if (options.protrusion_polish) {
     const auto polish_start = CpuClock::now();
     // With regrouping ahead, the inner nodes are polished after it.

@@ -67,10 +67,6 @@ struct SphereTreeOptions {
   /// of its bounding box); the smaller of the two when leaf_worst_target > 0.
   /// 0: off.
   double leaf_worst_factor = 1.05;
-  /// When > 0 (relative): the threshold rule (see leaf_worst_target) with
-  /// this threshold at the inner levels 2 .. depth - 1 instead of
-  /// worst_share. 0: off.
-  double inner_worst_target = 0;
   /// Spacing of the coverage samples (relative); their gap (<= spacing /
   /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
   double cover_spacing = 1.0 / 550.0;
@@ -93,22 +89,6 @@ struct SphereTreeOptions {
   /// leaf grows below the worst leaf error; its ancestors may grow, each within
   /// its level's worst error bound before the moves.
   int relieve_moves = 200000;
-  /// After the top-down pass, spend the leaf spheres it lost (a child that
-  /// received no coverage sample is dropped, so the leaf level can hold fewer
-  /// than its cap): the leaf with the largest error bound whose parent has
-  /// room is split in two, while that lowers both halves' bound below it.
-  bool fill_leaf_budget = false;
-  /// After lower_error_sum: remove the leaves that cover nothing alone (all
-  /// their samples covered with margin by other leaves, and by those leaves'
-  /// ancestors; the boundary exchanges strip such leaves down to one sample)
-  /// and spend their slots as fill_leaf_budget does (the leaf with the
-  /// largest error bound whose parent has room split in two). Measured (7
-  /// perturbed builds per model, medians): the union's shell 33.25 -> 30.25
-  /// (dragon), 19.12 -> 17.70 (bunny), lower in every build, true worst
-  /// unchanged, but the plain mean42 rises (idle leaves with errors near 0
-  /// become working ones) and the dragon's worst42 is <= 80 in 4 of 7
-  /// builds instead of 6; hence off ("This session (6)").
-  bool prune_redundant_leaves = false;
   /// After the top-down pass, optimise the leaves jointly (a leaf may take
   /// samples of a neighbour of its parent) and refit the inner nodes
   /// bottom-up so that each still covers the union of its children's samples.
@@ -200,8 +180,6 @@ struct SphereTreeBuild {
   double polish_cpu_seconds = 0;   ///< CPU time of the protrusion polish
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
-  int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget (and after pruning)
-  int num_pruned = 0;              ///< leaves removed by prune_redundant_leaves
   int num_regrouped = 0;           ///< parent changes made by build_branching's regrouping
   WorstSplitResult worst_split;    ///< what split_worst_leaves did (with split_worst)
   /// For each level l >= 1 (index l - 1): the largest worst child error bound

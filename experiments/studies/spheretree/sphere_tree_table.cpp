@@ -9,14 +9,11 @@
 //                   [--sum-passes N] [--sum-cap F] [--sum-share F]   (lower_error_sum)
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
-//                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
-//                   [--prune 0|1]  (SphereTreeOptions::prune_redundant_leaves)
 //                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]
 //                                 (split_worst)
 //                   [--caps 1,8,64,N[,M]]  (spheres allowed per level; depth = count - 1)
 //                   [--branching B]  (children per node at most; default 8)
 //                   [--build-branching B]  (SphereTreeOptions::build_branching)
-//                   [--inner-worst-target REL]  (SphereTreeOptions::inner_worst_target)
 //                   [--threads N]  (worker threads of the build; 0 = all cores, the default)
 //                   [--flat N]  (diagnostic: one level of at most N spheres under the root,
 //                                every other step as usual: the cost of the nested partition)
@@ -198,9 +195,6 @@ int run(int argc, char** argv) {
       .real("--sum-cap", options.sum_exchange_cap, "F", "lower_error_sum cap fraction")
       .real("--sum-share", options.sum_exchange_max_share, "F", "lower_error_sum receiver share")
       .real("--perturb", perturb, "E", "build for the mesh scaled by 1 + E")
-      .boolean("--fill", options.fill_leaf_budget, "SphereTreeOptions::fill_leaf_budget")
-      .boolean("--prune", options.prune_redundant_leaves,
-               "SphereTreeOptions::prune_redundant_leaves")
       .boolean("--split-worst", options.split_worst, "split_worst_leaves")
       .integer("--split-tries", split.max_tries, "N", "split_worst: tries")
       .real("--split-relief", split.relief_fraction, "F", "split_worst: relief fraction")
@@ -221,8 +215,6 @@ int run(int argc, char** argv) {
       .integer("--branching", options.branching, "B", "children per node at most")
       .integer("--build-branching", options.build_branching, "B",
                "SphereTreeOptions::build_branching")
-      .real("--inner-worst-target", options.inner_worst_target, "REL",
-            "SphereTreeOptions::inner_worst_target")
       .integer("--threads", options.threads, "N", "worker threads (0: all cores)", 0)
       .custom("--flat", "N", "diagnostic: one level of at most N spheres under the root",
               [&](const std::string& v) {
@@ -287,10 +279,6 @@ int run(int argc, char** argv) {
         ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // Model units -> the table's (longest bounding-box side 2000).
     const double to_2000 = icd::experiments::to_normalized_units(mesh);
-    if (options.prune_redundant_leaves || options.fill_leaf_budget) {
-      std::printf("# %s: %d redundant leaves pruned, %d leaves split to fill the budget\n",
-                  model.name.c_str(), ours.num_pruned, ours.num_budget_splits);
-    }
     if (options.split_worst) {
       const auto& w = ours.worst_split;
       std::printf(

@@ -227,15 +227,15 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
 }
 
 /// Options of the leaf-budget tests: the icosphere's coarse medial samples
-/// with branching 8 make the top-down pass lose leaves, so the fill and the
-/// worst-leaf split have free slots to use.
+/// with branching 8 make the top-down pass lose leaves, so the worst-leaf
+/// split has free slots to use.
 SphereTreeOptions lossy_leaf_options() {
   SphereTreeOptions o = small_options();
   o.branching = 8;
   o.medial_spacing = 1.0 / 6;
   o.worst_split.measure_directions = 300;
   o.worst_split.choice_directions = 100;
-  // The cases below were set up (to exercise fills and failed tries) with
+  // The cases below were set up (to exercise splits and failed tries) with
   // the fixed-split leaf allocation.
   o.leaf_worst_target = 0;
   o.leaf_worst_factor = 0;
@@ -292,123 +292,6 @@ void expect_worst_split_guarantees(const SphereTreeBuild& plain, const SphereTre
   EXPECT_NEAR(r.worst_after, after, 1e-12);
   EXPECT_LE(after, before);
   EXPECT_LE(r.worst_after, r.worst_before);
-}
-
-TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
-  // Splitting leaves to spend the lost budget. On this sphere (coarse medial
-  // samples, branching 8) the top-down pass loses leaves and the fill splits
-  // some: the leaf level never exceeds its cap nor a parent its branching,
-  // every node covers its samples with margin, children divide their
-  // parent's samples (so each parent covers the union of its children's
-  // patches), and every level covers a dense random sampling (brute force).
-  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = lossy_leaf_options();
-  o.split_worst = false;  // counts the fill's splits alone
-  const SphereTreeBuild plain = build_sphere_tree(sphere, o);
-  o.fill_leaf_budget = true;
-  const SphereTreeBuild build = build_sphere_tree(sphere, o);
-  const auto& tree = build.tree;
-  EXPECT_NO_THROW(icd::collision::validate(tree));
-  ASSERT_EQ(tree.num_levels(), 3);
-  EXPECT_GT(build.num_budget_splits, 0) << "the case must exercise the fill";
-  const int leaves = tree.level_offset[3] - tree.level_offset[2];
-  EXPECT_EQ(leaves,
-            plain.tree.level_offset[3] - plain.tree.level_offset[2] + build.num_budget_splits);
-  EXPECT_LE(leaves, 64);
-  expect_nodes_cover_and_children_divide(build);
-  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-  expect_every_level_covers(tree, sphere, 13);
-}
-
-/// Leaves of `build` all of whose samples some other leaf covers with margin,
-/// that leaf's ancestors too (brute force over every leaf and ancestor).
-int leaves_covered_by_others(const SphereTreeBuild& build) {
-  const auto& tree = build.tree;
-  const auto& P = build.samples.points;
-  const int leaf_level = tree.num_levels() - 1;
-  std::vector<int> parent(static_cast<size_t>(tree.num_nodes()), -1);
-  for (int i = 0; i < tree.num_nodes(); ++i) {
-    for (int k = 0; k < tree.child_count[i]; ++k) parent[tree.first_child[i] + k] = i;
-  }
-  auto covers = [&](int node, int s) {
-    return (P.row(s).transpose() - tree.spheres[node].center()).norm() + build.samples.gap[s] <=
-           tree.spheres[node].r;
-  };
-  int count = 0;
-  for (int i = tree.level_offset[leaf_level]; i < tree.num_nodes(); ++i) {
-    bool all = true;
-    for (int s : build.node_samples[i]) {
-      bool found = false;
-      for (int j = tree.level_offset[leaf_level]; j < tree.num_nodes() && !found; ++j) {
-        if (j == i || !covers(j, s)) continue;
-        found = true;
-        for (int a = parent[j]; a >= 0 && found; a = parent[a]) found = covers(a, s);
-      }
-      if (!found) {
-        all = false;
-        break;
-      }
-    }
-    count += all ? 1 : 0;
-  }
-  return count;
-}
-
-TEST(SphereTreeBuilder, PruneRedundantLeavesRemovesOnlyThemAndKeepsEveryGuarantee) {
-  // With the protrusion polish and split_worst off, the pruning (and the fill
-  // of the slots it frees) is the last change to the leaves. Every leaf it
-  // removes was one whose samples other leaves (and their ancestors) cover
-  // with margin, counted by brute force on the same build without it; the
-  // independent evaluation finds fewer leaves that cover nothing alone; no
-  // inner node grows; and the tree keeps its caps, branching and coverage.
-  // On the torus (coarse medial samples, branching 8) the boundary exchanges
-  // leave 40 of 64 leaves covered by others; on the box with depth 3, 28 of
-  // 139, and 5 more covered by leaves whose ancestors do not cover the
-  // sample (which the pruning must not use).
-  struct PruneCase {
-    icd::SurfaceMesh mesh;
-    int depth;
-  };
-  const std::vector<PruneCase> prune_cases = {{icd::make_torus(1.0, 0.3, 24, 12), 2},
-                                              {icd::make_box_surface({0, 0, 0}, {2, 1, 0.6}), 3}};
-  for (const PruneCase& c : prune_cases) {
-    SCOPED_TRACE("depth " + std::to_string(c.depth));
-    SphereTreeOptions o = lossy_leaf_options();
-    o.depth = c.depth;
-    o.protrusion_polish = false;
-    o.split_worst = false;
-    const SphereTreeBuild plain = build_sphere_tree(c.mesh, o);
-    o.prune_redundant_leaves = true;
-    const SphereTreeBuild build = build_sphere_tree(c.mesh, o);
-    const auto& tree = build.tree;
-    const int redundant = leaves_covered_by_others(plain);
-    EXPECT_GT(build.num_pruned, 0) << "the case must exercise the pruning";
-    EXPECT_LE(build.num_pruned, redundant);
-    const int leaf_level = tree.num_levels() - 1;
-    EXPECT_EQ(tree.num_nodes() - tree.level_offset[leaf_level],
-              plain.tree.num_nodes() - plain.tree.level_offset[leaf_level] - build.num_pruned +
-                  build.num_budget_splits);
-    EXPECT_LT(leaves_covered_by_others(build), redundant);
-    // A sample moves only to a leaf whose ancestors cover it already: no inner
-    // node grows (the inner levels keep their nodes and centres).
-    ASSERT_EQ(tree.level_offset[leaf_level], plain.tree.level_offset[leaf_level]);
-    for (int i = 0; i < tree.level_offset[leaf_level]; ++i) {
-      EXPECT_EQ(tree.spheres[i].center(), plain.tree.spheres[i].center());
-      EXPECT_LE(tree.spheres[i].r, plain.tree.spheres[i].r) << "inner node " << i;
-    }
-    EvaluationOptions evaluation;
-    evaluation.coverage_spacing = 10;
-    evaluation.shell_samples = 0;
-    EXPECT_LT(evaluate_sphere_tree(c.mesh, tree, evaluation).back().num_redundant_spheres,
-              evaluate_sphere_tree(c.mesh, plain.tree, evaluation).back().num_redundant_spheres);
-    EXPECT_NO_THROW(icd::collision::validate(tree));
-    for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-    long long cap = 1;
-    for (int l = 0; l < c.depth; ++l) cap *= o.branching;
-    EXPECT_LE(tree.num_nodes() - tree.level_offset[leaf_level], cap);
-    expect_nodes_cover_and_children_divide(build);
-    expect_every_level_covers(tree, c.mesh, 29);
-  }
 }
 
 TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst) {
