@@ -27,39 +27,45 @@ using Clock = std::chrono::steady_clock;
 void check_options(const SphereTreeOptions& o) {
   auto fail = [](const std::string& what) { throw ParameterError("SphereTreeOptions::" + what); };
   if (o.branching < 2) fail("branching must be >= 2, got " + std::to_string(o.branching));
-  if (o.build_branching != 0 && o.build_branching < o.branching) {
-    fail("build_branching must be 0 or >= branching, got " + std::to_string(o.build_branching));
+  if (o.allocation.build_branching != 0 && o.allocation.build_branching < o.branching) {
+    fail("allocation.build_branching must be 0 or >= branching, got " +
+         std::to_string(o.allocation.build_branching));
   }
   if (o.depth < 0 || o.depth > 8) fail("depth must be in [0, 8], got " + std::to_string(o.depth));
-  if (!(o.cover_spacing > 0) || !(o.medial_spacing >= o.cover_spacing)) {
-    fail("cover_spacing must be > 0 and medial_spacing >= cover_spacing");
+  const auto& sampling = o.sampling;
+  if (!(sampling.cover_spacing > 0) || !(sampling.medial_spacing >= sampling.cover_spacing)) {
+    fail("sampling: cover_spacing must be > 0 and medial_spacing >= cover_spacing");
   }
-  if (o.refinement_iterations < 0) fail("refinement_iterations must be >= 0");
-  if (!(o.refinement_tolerance > 0)) fail("refinement_tolerance must be > 0");
-  if (o.lloyd_iterations < 0) fail("lloyd_iterations must be >= 0");
-  if (o.exchange_rounds < 0) fail("exchange_rounds must be >= 0");
-  if (o.relieve_moves < 0) fail("relieve_moves must be >= 0");
-  if (o.protrusion_exchange_rounds < 0) fail("protrusion_exchange_rounds must be >= 0");
-  if (o.sum_exchange_passes < 0 || !(o.sum_exchange_cap > 0 && o.sum_exchange_cap <= 1) ||
-      !(o.sum_exchange_max_share > 0)) {
-    fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
+  if (sampling.refinement_iterations < 0) fail("sampling.refinement_iterations must be >= 0");
+  if (!(sampling.refinement_tolerance > 0)) fail("sampling.refinement_tolerance must be > 0");
+  if (o.reduction.lloyd_iterations < 0) fail("reduction.lloyd_iterations must be >= 0");
+  const auto& exchange = o.exchange;
+  if (exchange.sibling_rounds < 0) fail("exchange.sibling_rounds must be >= 0");
+  if (exchange.relieve_moves < 0) fail("exchange.relieve_moves must be >= 0");
+  if (exchange.sum_passes < 0 || !(exchange.sum_cap > 0 && exchange.sum_cap <= 1) ||
+      !(exchange.sum_max_share > 0)) {
+    fail("exchange: sum_passes must be >= 0, sum_cap in (0, 1], sum_max_share > 0");
   }
-  if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
-  if (!(o.leaf_worst_target >= 0) || !(o.leaf_worst_factor >= 0))
-    fail("leaf_worst_target and leaf_worst_factor must be >= 0");
-  if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
-      o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
-      !(o.worst_split.mean_rise_limit >= 0)) {
+  const auto& allocation = o.allocation;
+  if (!(allocation.worst_share >= 0 && allocation.worst_share <= 1))
+    fail("allocation.worst_share must be in [0, 1]");
+  if (!(allocation.leaf_worst_target >= 0) || !(allocation.leaf_worst_factor >= 0))
+    fail("allocation: leaf_worst_target and leaf_worst_factor must be >= 0");
+  const WorstSplitOptions& split = o.worst_split.options;
+  if (split.measure_directions < 1 || split.choice_directions < 1 || split.max_tries < 0 ||
+      !(split.relief_fraction >= 0) || !(split.mean_rise_limit >= 0)) {
     fail(
-        "worst_split: measure/choice directions must be >= 1, max_tries >= 0, "
+        "worst_split.options: measure/choice directions must be >= 1, max_tries >= 0, "
         "relief_fraction >= 0");
   }
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
   if (o.threads < 0) fail("threads must be >= 0, got " + std::to_string(o.threads));
-  if (o.protrusion.search_directions < 1 || o.protrusion.check_directions < 1 ||
-      o.protrusion.max_evaluations < 0 || !(o.protrusion.initial_step > 0) ||
-      !(o.protrusion.min_step > 0)) {
-    fail("protrusion: search/check directions must be >= 1, evaluations >= 0, steps > 0");
+  const ProtrusionPolishOptions& protrusion = o.polish.protrusion;
+  if (o.polish.exchange_rounds < 0) fail("polish.exchange_rounds must be >= 0");
+  if (protrusion.search_directions < 1 || protrusion.check_directions < 1 ||
+      protrusion.max_evaluations < 0 || !(protrusion.initial_step > 0) ||
+      !(protrusion.min_step > 0)) {
+    fail("polish.protrusion: search/check directions must be >= 1, evaluations >= 0, steps > 0");
   }
 }
 
@@ -573,13 +579,14 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   if (!(scale > 0)) throw InputError("build_sphere_tree: the mesh has a degenerate bounding box");
 
   // Samples: coverage (dense) on the input surface, medial (coarse) on the closed one.
-  out.samples = sample_surface(input.V, input.F, SamplingOptions{options.cover_spacing * scale});
+  const SphereTreeOptions::Sampling& sampling = options.sampling;
+  out.samples = sample_surface(input.V, input.F, SamplingOptions{sampling.cover_spacing * scale});
   const SurfaceSamples medial_samples =
-      sample_surface(closed.V, closed.F, SamplingOptions{options.medial_spacing * scale});
+      sample_surface(closed.V, closed.F, SamplingOptions{sampling.medial_spacing * scale});
   end_step("hole closing, oracle, sampling");
   MedialAxisOptions medial_options;
-  medial_options.refinement_iterations = options.refinement_iterations;
-  medial_options.error_tolerance = options.refinement_tolerance * scale;
+  medial_options.refinement_iterations = sampling.refinement_iterations;
+  medial_options.error_tolerance = sampling.refinement_tolerance * scale;
   const MedialSpheres medial = approximate_medial_axis(oracles, medial_samples, medial_options);
   out.num_medial_spheres = static_cast<int>(medial.radii.size());
   out.num_refinement_points = medial.num_inserted;
@@ -593,9 +600,9 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   const ReductionProblem coarse{medial_samples.points, medial_gap, medial, grid};
   const ReductionProblem dense{out.samples.points, out.samples.gap, medial, grid};
   ReductionOptions reduction;
-  reduction.lloyd_iterations = options.lloyd_iterations;
+  reduction.lloyd_iterations = options.reduction.lloyd_iterations;
   reduction.deadline = deadline;
-  const int build_branching = std::max(options.branching, options.build_branching);
+  const int build_branching = std::max(options.branching, options.allocation.build_branching);
 
   // Root.
   Node root;
@@ -633,8 +640,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       // A parent cannot use more children than it has coverage samples (a
       // child without one is dropped), whatever its medial samples allow.
       // Applied with build_branching only: on the default it changes the
-      // trees and measured no better (7 dragon builds: mean42 17.16 vs
-      // 16.88, worst42 <= 80 in 5 of 7; results README, "This session (6)").
+      // trees and measured no better (dragon: mean42 17.16 vs 16.88, worst42
+      // <= 80 in 5 of 7 builds).
       const size_t usable = build_branching > options.branching
                                 ? std::max<size_t>(1, parents[p].sphere.members.size())
                                 : choices[p].configs.size();
@@ -651,17 +658,18 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
         worst = std::max(worst, costs[p].worst[static_cast<size_t>(count[p] - 1)]);
       return worst;
     };
+    const SphereTreeOptions::Allocation& share = options.allocation;
     AllocationOptions allocation;
-    allocation.worst_share = options.worst_share;
-    if (l == options.depth && options.leaf_worst_factor > 0) {
+    allocation.worst_share = share.worst_share;
+    if (l == options.depth && share.leaf_worst_factor > 0) {
       allocation.worst_threshold =
-          options.leaf_worst_factor * chosen_worst(allocate_children(costs, cap, allocation));
-      if (options.leaf_worst_target > 0) {
+          share.leaf_worst_factor * chosen_worst(allocate_children(costs, cap, allocation));
+      if (share.leaf_worst_target > 0) {
         allocation.worst_threshold =
-            std::min(allocation.worst_threshold, options.leaf_worst_target * scale);
+            std::min(allocation.worst_threshold, share.leaf_worst_target * scale);
       }
     } else if (l == options.depth) {
-      allocation.worst_threshold = options.leaf_worst_target * scale;
+      allocation.worst_threshold = share.leaf_worst_target * scale;
     }
     const std::vector<int> count = allocate_children(costs, cap, allocation);
     out.allocated_worst_bound.push_back(chosen_worst(count));
@@ -690,11 +698,11 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       assign_and_refit(dense, parents[p].sphere.members, fitted);
       ExchangeOptions exchange;
       exchange.rounds = 2;
-      for (int round = 0; round < options.exchange_rounds; ++round) {
+      for (int round = 0; round < options.exchange.sibling_rounds; ++round) {
         shrink_by_exchange(dense, fitted, exchange);
         polish_all(fitted);
       }
-      if (options.exchange_rounds > 0) shrink_by_exchange(dense, fitted, exchange);
+      if (options.exchange.sibling_rounds > 0) shrink_by_exchange(dense, fitted, exchange);
       for (auto& f : fitted) {
         Node n;
         n.sphere = std::move(f);
@@ -726,14 +734,15 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
                 static_cast<long long>(levels[levels.size() - 2].size()) * options.branching);
   const int leaf_parent_limit =
       regroup ? static_cast<int>(std::max<long long>(leaf_cap, 2)) : options.branching;
-  if (options.joint_leaf_refinement && levels.size() > 2) {
+  if (options.reduction.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
     assert(children_divide_samples(levels, parent_of));
   }
-  if (options.leaf_exchange && levels.size() > 1)
-    exchange_across_leaves(dense, oracles, levels, parent_of, 3, options.relieve_moves);
+  const SphereTreeOptions::Exchange& exchange = options.exchange;
+  if (exchange.across_leaves && levels.size() > 1)
+    exchange_across_leaves(dense, oracles, levels, parent_of, 3, exchange.relieve_moves);
   end_step("leaf exchange");
-  if (options.sum_exchange_passes > 0 && levels.size() > 1) {
+  if (exchange.sum_passes > 0 && levels.size() > 1) {
     const size_t last = levels.size() - 1;
     std::vector<FittedSphere> leaves;
     double worst = 0;
@@ -743,29 +752,29 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       return ancestors_cover(dense, levels, parent_of, leaf, s);
     };
     SumExchangeOptions sum;
-    sum.passes = options.sum_exchange_passes;
-    sum.cap_fraction = options.sum_exchange_cap;
-    lower_error_sum(dense, leaves, options.sum_exchange_max_share * worst, sum, accepts);
+    sum.passes = exchange.sum_passes;
+    sum.cap_fraction = exchange.sum_cap;
+    lower_error_sum(dense, leaves, exchange.sum_max_share * worst, sum, accepts);
     for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
     refit_inner_nodes(dense, levels, parent_of);
   }
   end_step("sum exchange");
-  if (options.protrusion_polish) {
+  if (options.polish.enabled) {
     const auto polish_start = CpuClock::now();
     // With regrouping ahead, the inner nodes are polished after it.
-    out.num_polished = polish_tree(dense, oracles, levels, parent_of, options.protrusion,
-                                   options.protrusion_exchange_rounds, deadline, !regroup);
+    out.num_polished = polish_tree(dense, oracles, levels, parent_of, options.polish.protrusion,
+                                   options.polish.exchange_rounds, deadline, !regroup);
     out.polish_cpu_seconds = std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }
   end_step("protrusion polish");
-  if (options.split_worst && levels.size() > 1) {
+  if (options.worst_split.enabled && levels.size() > 1) {
     LeafLevel leaf_level;
     for (Node& n : levels.back()) {
       leaf_level.spheres.push_back(std::move(n.sphere));
       leaf_level.medial.push_back(std::move(n.medial));
     }
     leaf_level.parent = parent_of.back();
-    WorstSplitOptions split = options.worst_split;
+    WorstSplitOptions split = options.worst_split.options;
     split.deadline = std::min(split.deadline, deadline);
     out.worst_split = split_worst_leaves(coarse, dense, oracles, reduction, leaf_level,
                                          static_cast<int>(leaf_cap), leaf_parent_limit, split);
@@ -779,10 +788,10 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     parent_of.back() = std::move(leaf_level.parent);
     end_step("worst split");
   }
-  if (regroup || (options.regroup_parents && levels.size() > 2)) {
+  if (regroup || (options.allocation.regroup_parents && levels.size() > 2)) {
     out.num_regrouped = regroup_tree(
-        dense, oracles, reduction, options.protrusion_polish ? &options.protrusion : nullptr,
-        options.branching, options.regroup_parents, deadline, levels, parent_of);
+        dense, oracles, reduction, options.polish.enabled ? &options.polish.protrusion : nullptr,
+        options.branching, options.allocation.regroup_parents, deadline, levels, parent_of);
     end_step("regroup");
   }
 

@@ -42,8 +42,8 @@ SphereTreeOptions small_options() {
   SphereTreeOptions o;
   o.branching = 4;
   o.depth = 2;
-  o.cover_spacing = 1.0 / 80;
-  o.medial_spacing = 1.0 / 20;
+  o.sampling.cover_spacing = 1.0 / 80;
+  o.sampling.medial_spacing = 1.0 / 20;
   return o;
 }
 
@@ -213,7 +213,7 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
     for (int variant = 0; variant < 2; ++variant) {
       SCOPED_TRACE(c.name + (variant == 0 ? " small options" : " lossy options"));
       SphereTreeOptions o = variant == 0 ? small_options() : lossy_leaf_options();
-      o.joint_leaf_refinement = true;
+      o.reduction.joint_leaf_refinement = true;
       const SphereTreeBuild build = build_sphere_tree(c.mesh, o);
       const auto& tree = build.tree;
       EXPECT_NO_THROW(icd::collision::validate(tree));
@@ -232,13 +232,13 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
 SphereTreeOptions lossy_leaf_options() {
   SphereTreeOptions o = small_options();
   o.branching = 8;
-  o.medial_spacing = 1.0 / 6;
-  o.worst_split.measure_directions = 300;
-  o.worst_split.choice_directions = 100;
+  o.sampling.medial_spacing = 1.0 / 6;
+  o.worst_split.options.measure_directions = 300;
+  o.worst_split.options.choice_directions = 100;
   // The cases below were set up (to exercise splits and failed tries) with
   // the fixed-split leaf allocation.
-  o.leaf_worst_target = 0;
-  o.leaf_worst_factor = 0;
+  o.allocation.leaf_worst_target = 0;
+  o.allocation.leaf_worst_factor = 0;
   return o;
 }
 
@@ -285,7 +285,7 @@ void expect_worst_split_guarantees(const SphereTreeBuild& plain, const SphereTre
   expect_nodes_cover_and_children_divide(build);
   expect_every_level_covers(tree, mesh, seed);
   const MeshOracle oracle(mesh);
-  const icd::MatX3d dirs = spiral_directions(o.worst_split.measure_directions);
+  const icd::MatX3d dirs = spiral_directions(o.worst_split.options.measure_directions);
   const double before = leaf_worst_protrusion(plain.tree, oracle, dirs);
   const double after = leaf_worst_protrusion(tree, oracle, dirs);
   EXPECT_NEAR(r.worst_before, before, 1e-12);
@@ -306,9 +306,9 @@ TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst)
   // equals the reported one and is not above the start's.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
   SphereTreeOptions o = lossy_leaf_options();
-  o.split_worst = false;
+  o.worst_split.enabled = false;
   const SphereTreeBuild plain = build_sphere_tree(sphere, o);
-  o.split_worst = true;
+  o.worst_split.enabled = true;
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
   const auto& tree = build.tree;
   EXPECT_NO_THROW(icd::collision::validate(tree));
@@ -332,20 +332,20 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
   // levels: the starting mean, and sum_after <= sum_before + splits * mean.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
   SphereTreeOptions o = lossy_leaf_options();
-  o.worst_split.relief_fraction = 2.0;
+  o.worst_split.options.relief_fraction = 2.0;
   const SphereTreeBuild plain = [&] {
     SphereTreeOptions p = o;
-    p.split_worst = false;
+    p.worst_split.enabled = false;
     return build_sphere_tree(sphere, p);
   }();
-  o.split_worst = true;
+  o.worst_split.enabled = true;
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
   const auto& result = build.worst_split;
   EXPECT_GT(result.splits, 0) << "the case must exercise the split";
   EXPECT_EQ(result.merges, 0);
   const MeshOracle oracle(sphere);
-  const icd::MatX3d measure = spiral_directions(o.worst_split.measure_directions);
-  const icd::MatX3d choice = spiral_directions(o.worst_split.choice_directions);
+  const icd::MatX3d measure = spiral_directions(o.worst_split.options.measure_directions);
+  const icd::MatX3d choice = spiral_directions(o.worst_split.options.choice_directions);
   auto leaf_sum = [&](const icd::collision::SphereTree& tree, const icd::MatX3d& dirs) {
     const std::vector<double> e = leaf_protrusions(tree, oracle, dirs);
     return std::accumulate(e.begin(), e.end(), 0.0);
@@ -361,11 +361,11 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
 TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   SphereTreeOptions o = small_options();
-  o.split_worst = true;
-  o.worst_split.measure_directions = 0;
+  o.worst_split.enabled = true;
+  o.worst_split.options.measure_directions = 0;
   EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
-  o.worst_split.measure_directions = 10;
-  o.worst_split.max_tries = -1;
+  o.worst_split.options.measure_directions = 10;
+  o.worst_split.options.max_tries = -1;
   EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
 }
 
@@ -377,16 +377,16 @@ TEST(SphereTreeBuilder, ProtrusionPolishNeverRaisesANodesError) {
   // some protrude less.
   const Case torus = cases()[2];
   SphereTreeOptions o = small_options();
-  o.split_worst = false;  // the polish is then the last step
+  o.worst_split.enabled = false;  // the polish is then the last step
   const SphereTreeBuild polished = build_sphere_tree(torus.mesh, o);
-  o.protrusion_polish = false;
+  o.polish.enabled = false;
   const SphereTreeBuild plain = build_sphere_tree(torus.mesh, o);
   ASSERT_EQ(plain.tree.num_nodes(), polished.tree.num_nodes());
   EXPECT_EQ(plain.tree.level_offset, polished.tree.level_offset);
   EXPECT_EQ(plain.node_samples.front(), polished.node_samples.front());
   EXPECT_GT(polished.num_polished, 0);
   const MeshOracle oracle(torus.mesh);
-  const icd::MatX3d check = spiral_directions(o.protrusion.check_directions);
+  const icd::MatX3d check = spiral_directions(o.polish.protrusion.check_directions);
   double sum_plain = 0, sum_polished = 0;
   for (int i = 0; i < plain.tree.num_nodes(); ++i) {
     const auto& a = plain.tree.spheres[i];
@@ -466,10 +466,10 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   const icd::SurfaceMesh torus = icd::make_torus(1.0, 0.3, 24, 12);
   SphereTreeOptions o = small_options();
   o.max_spheres_per_level = {1, 4, 10};
-  o.split_worst = false;  // the steps after the allocation are tested elsewhere
-  o.protrusion_polish = false;
-  o.leaf_worst_target = 0;  // the fixed split
-  o.leaf_worst_factor = 0;
+  o.worst_split.enabled = false;  // the steps after the allocation are tested elsewhere
+  o.polish.enabled = false;
+  o.allocation.leaf_worst_target = 0;  // the fixed split
+  o.allocation.leaf_worst_factor = 0;
   const SphereTreeBuild plain = build_sphere_tree(torus, o);
   ASSERT_EQ(plain.allocated_worst_bound.size(), 2u);
   const double scale = (torus.V.colwise().maxCoeff() - torus.V.colwise().minCoeff()).maxCoeff();
@@ -477,7 +477,7 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   ASSERT_GT(target, 0);
   for (const double relative : {target / scale, 1e-9}) {
     SCOPED_TRACE(relative);
-    o.leaf_worst_target = relative;
+    o.allocation.leaf_worst_target = relative;
     const SphereTreeBuild build = build_sphere_tree(torus, o);
     const auto& tree = build.tree;
     EXPECT_NO_THROW(icd::collision::validate(tree));
@@ -493,16 +493,16 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
     expect_every_level_covers(tree, torus, 19);
   }
   // The same threshold as a factor on the fixed split's own bound.
-  o.leaf_worst_target = 0;
-  o.leaf_worst_factor = 1.2;
+  o.allocation.leaf_worst_target = 0;
+  o.allocation.leaf_worst_factor = 1.2;
   const SphereTreeBuild by_factor = build_sphere_tree(torus, o);
   ASSERT_EQ(by_factor.allocated_worst_bound.size(), 2u);
   EXPECT_LE(by_factor.allocated_worst_bound[1], target * (1 + 1e-12));
   expect_nodes_cover_and_children_divide(by_factor);
-  o.leaf_worst_factor = -1;
+  o.allocation.leaf_worst_factor = -1;
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
-  o.leaf_worst_factor = 0;
-  o.leaf_worst_target = -0.1;
+  o.allocation.leaf_worst_factor = 0;
+  o.allocation.leaf_worst_target = -0.1;
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
 }
 
@@ -518,7 +518,7 @@ TEST(SphereTreeBuilder, BuildBranchingRegroupsToTheBranchingAndKeepsEveryGuarant
   o.branching = 3;
   o.depth = 3;
   o.max_spheres_per_level = {1, 3, 7, 19};
-  o.build_branching = 8;
+  o.allocation.build_branching = 8;
   o.threads = 1;
   const SphereTreeBuild build = build_sphere_tree(torus, o);
   const auto& tree = build.tree;
@@ -534,7 +534,7 @@ TEST(SphereTreeBuilder, BuildBranchingRegroupsToTheBranchingAndKeepsEveryGuarant
   const SphereTreeBuild threaded = build_sphere_tree(torus, o);
   EXPECT_EQ(threaded.node_samples, build.node_samples);
   EXPECT_EQ(threaded.tree.child_count, tree.child_count);
-  o.build_branching = 2;  // below the branching
+  o.allocation.build_branching = 2;  // below the branching
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
 }
 
@@ -550,9 +550,9 @@ TEST(SphereTreeBuilder, RegroupParentsKeepsTheLeavesAndEveryGuarantee) {
   // joint pass moves leaves across parents.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
   SphereTreeOptions o = lossy_leaf_options();
-  o.joint_leaf_refinement = true;
+  o.reduction.joint_leaf_refinement = true;
   const SphereTreeBuild plain = build_sphere_tree(sphere, o);
-  o.regroup_parents = true;
+  o.allocation.regroup_parents = true;
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
   const auto& tree = build.tree;
   EXPECT_NO_THROW(icd::collision::validate(tree));
