@@ -74,19 +74,19 @@ void apply_sphere_fit(SphereFit fit, SphereTreeOptions& spheres) {
   o.time_limit = spheres.time_limit;
   switch (fit) {
     case SphereFit::light:
-      o.lloyd_iterations = 1;
-      o.refinement_iterations = 0;
-      o.medial_spacing = 1.0 / 80.0;
-      o.cover_spacing = 1.0 / 400.0;
+      o.reduction.lloyd_iterations = 1;
+      o.sampling.refinement_iterations = 0;
+      o.sampling.medial_spacing = 1.0 / 80.0;
+      o.sampling.cover_spacing = 1.0 / 400.0;
       break;
     case SphereFit::full:
       break;
     case SphereFit::shell:
-      o.joint_leaf_refinement = true;
-      o.regroup_parents = true;
-      o.worst_share = 1;
-      o.leaf_worst_target = 0;
-      o.leaf_worst_factor = 0;
+      o.reduction.joint_leaf_refinement = true;
+      o.allocation.regroup_parents = true;
+      o.allocation.worst_share = 1;
+      o.allocation.leaf_worst_target = 0;
+      o.allocation.leaf_worst_factor = 0;
       break;
   }
   spheres = std::move(o);

@@ -27,40 +27,45 @@ using Clock = std::chrono::steady_clock;
 void check_options(const SphereTreeOptions& o) {
   auto fail = [](const std::string& what) { throw ParameterError("SphereTreeOptions::" + what); };
   if (o.branching < 2) fail("branching must be >= 2, got " + std::to_string(o.branching));
-  if (o.build_branching != 0 && o.build_branching < o.branching) {
-    fail("build_branching must be 0 or >= branching, got " + std::to_string(o.build_branching));
+  if (o.allocation.build_branching != 0 && o.allocation.build_branching < o.branching) {
+    fail("allocation.build_branching must be 0 or >= branching, got " +
+         std::to_string(o.allocation.build_branching));
   }
   if (o.depth < 0 || o.depth > 8) fail("depth must be in [0, 8], got " + std::to_string(o.depth));
-  if (!(o.cover_spacing > 0) || !(o.medial_spacing >= o.cover_spacing)) {
-    fail("cover_spacing must be > 0 and medial_spacing >= cover_spacing");
+  const auto& sampling = o.sampling;
+  if (!(sampling.cover_spacing > 0) || !(sampling.medial_spacing >= sampling.cover_spacing)) {
+    fail("sampling: cover_spacing must be > 0 and medial_spacing >= cover_spacing");
   }
-  if (o.refinement_iterations < 0) fail("refinement_iterations must be >= 0");
-  if (!(o.refinement_tolerance > 0)) fail("refinement_tolerance must be > 0");
-  if (o.lloyd_iterations < 0) fail("lloyd_iterations must be >= 0");
-  if (o.merge_burst_lloyd_iterations < 0) fail("merge_burst_lloyd_iterations must be >= 0");
-  if (o.exchange_rounds < 0) fail("exchange_rounds must be >= 0");
-  if (o.relieve_moves < 0) fail("relieve_moves must be >= 0");
-  if (o.protrusion_exchange_rounds < 0) fail("protrusion_exchange_rounds must be >= 0");
-  if (o.sum_exchange_passes < 0 || !(o.sum_exchange_cap > 0 && o.sum_exchange_cap <= 1) ||
-      !(o.sum_exchange_max_share > 0)) {
-    fail("sum_exchange_passes must be >= 0, sum_exchange_cap in (0, 1], max_share > 0");
+  if (sampling.refinement_iterations < 0) fail("sampling.refinement_iterations must be >= 0");
+  if (!(sampling.refinement_tolerance > 0)) fail("sampling.refinement_tolerance must be > 0");
+  if (o.reduction.lloyd_iterations < 0) fail("reduction.lloyd_iterations must be >= 0");
+  const auto& exchange = o.exchange;
+  if (exchange.sibling_rounds < 0) fail("exchange.sibling_rounds must be >= 0");
+  if (exchange.relieve_moves < 0) fail("exchange.relieve_moves must be >= 0");
+  if (exchange.sum_passes < 0 || !(exchange.sum_cap > 0 && exchange.sum_cap <= 1) ||
+      !(exchange.sum_max_share > 0)) {
+    fail("exchange: sum_passes must be >= 0, sum_cap in (0, 1], sum_max_share > 0");
   }
-  if (!(o.worst_share >= 0 && o.worst_share <= 1)) fail("worst_share must be in [0, 1]");
-  if (!(o.leaf_worst_target >= 0) || !(o.leaf_worst_factor >= 0) || !(o.inner_worst_target >= 0))
-    fail("leaf_worst_target, leaf_worst_factor and inner_worst_target must be >= 0");
-  if (o.worst_split.measure_directions < 1 || o.worst_split.choice_directions < 1 ||
-      o.worst_split.max_tries < 0 || !(o.worst_split.relief_fraction >= 0) ||
-      !(o.worst_split.mean_rise_limit >= 0)) {
+  const auto& allocation = o.allocation;
+  if (!(allocation.worst_share >= 0 && allocation.worst_share <= 1))
+    fail("allocation.worst_share must be in [0, 1]");
+  if (!(allocation.leaf_worst_target >= 0) || !(allocation.leaf_worst_factor >= 0))
+    fail("allocation: leaf_worst_target and leaf_worst_factor must be >= 0");
+  const WorstSplitOptions& split = o.worst_split.options;
+  if (split.measure_directions < 1 || split.choice_directions < 1 || split.max_tries < 0 ||
+      !(split.relief_fraction >= 0) || !(split.mean_rise_limit >= 0)) {
     fail(
-        "worst_split: measure/choice directions must be >= 1, max_tries >= 0, "
+        "worst_split.options: measure/choice directions must be >= 1, max_tries >= 0, "
         "relief_fraction >= 0");
   }
   if (!(o.time_limit > 0)) fail("time_limit must be > 0 seconds");
   if (o.threads < 0) fail("threads must be >= 0, got " + std::to_string(o.threads));
-  if (o.protrusion.search_directions < 1 || o.protrusion.check_directions < 1 ||
-      o.protrusion.max_evaluations < 0 || !(o.protrusion.initial_step > 0) ||
-      !(o.protrusion.min_step > 0)) {
-    fail("protrusion: search/check directions must be >= 1, evaluations >= 0, steps > 0");
+  const ProtrusionPolishOptions& protrusion = o.polish.protrusion;
+  if (o.polish.exchange_rounds < 0) fail("polish.exchange_rounds must be >= 0");
+  if (protrusion.search_directions < 1 || protrusion.check_directions < 1 ||
+      protrusion.max_evaluations < 0 || !(protrusion.initial_step > 0) ||
+      !(protrusion.min_step > 0)) {
+    fail("polish.protrusion: search/check directions must be >= 1, evaluations >= 0, steps > 0");
   }
 }
 
@@ -84,13 +89,6 @@ struct ParentChoices {
     return worst;
   }
 };
-
-/// Worst error, then summed error: the order in which best_of_both compares configurations.
-bool better_config(const std::vector<FittedSphere>& a, const std::vector<FittedSphere>& b) {
-  const double wa = ParentChoices::worst_error(a), wb = ParentChoices::worst_error(b);
-  if (wa != wb) return wa < wb;
-  return ParentChoices::total_error(a) < ParentChoices::total_error(b);
-}
 
 /// The sphere cap of level l: branching^l, lowered by max_spheres_per_level[l] when positive.
 long long level_cap(const SphereTreeOptions& options, int l) {
@@ -340,140 +338,6 @@ void exchange_across_leaves(const ReductionProblem& dense,
   refit_inner_nodes(dense, levels, parent_of);
 }
 
-/// Removes the leaves that cover nothing alone: a leaf all of whose samples
-/// other leaves cover with margin, those leaves' ancestors too, is dropped
-/// and its samples go to them (the first such leaf, in level order). The
-/// boundary exchanges leave such leaves behind (stripped to one sample, the
-/// last one a sphere keeps, by neighbours that grew over their patch): they
-/// cost a leaf slot and cover nothing. Fewest samples first, so that of two
-/// leaves that cover each other's samples the larger stays. No radius grows;
-/// every sample stays covered with margin by a leaf and its ancestors, and
-/// the inner nodes' samples become the union of their children's again.
-/// Siblings stay contiguous. Returns the number of leaves removed.
-int prune_redundant_leaves(const ReductionProblem& dense, std::vector<std::vector<Node>>& levels,
-                           std::vector<std::vector<int>>& parent_of) {
-  if (levels.size() < 2) return 0;
-  const size_t last = levels.size() - 1;
-  std::vector<Node>& leaves = levels[last];
-  const size_t n = leaves.size();
-  // Leaves whose spheres meet: the only ones that can cover each other's samples.
-  std::vector<std::vector<size_t>> near(n);
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t j = 0; j < n; ++j) {
-      const FittedSphere &a = leaves[i].sphere, &b = leaves[j].sphere;
-      if (j != i && (a.center - b.center).norm() < a.radius + b.radius) near[i].push_back(j);
-    }
-  }
-  std::vector<size_t> order(n);
-  std::iota(order.begin(), order.end(), size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return leaves[a].sphere.members.size() < leaves[b].sphere.members.size();
-  });
-  std::vector<int> children(levels[last - 1].size(), 0);
-  for (int p : parent_of[last]) children[static_cast<size_t>(p)] += 1;
-  std::vector<char> gone(n, 0);
-  int removed = 0;
-  for (size_t i : order) {
-    // A parent keeps at least one child.
-    if (children[static_cast<size_t>(parent_of[last][i])] < 2) continue;
-    const std::vector<int>& members = leaves[i].sphere.members;
-    std::vector<size_t> to;
-    for (int s : members) {
-      size_t k = n;
-      for (size_t j : near[i]) {
-        if (!gone[j] && dense.reach(s, leaves[j].sphere) <= leaves[j].sphere.radius &&
-            ancestors_cover(dense, levels, parent_of, static_cast<int>(j), s)) {
-          k = j;
-          break;
-        }
-      }
-      if (k == n) break;
-      to.push_back(k);
-    }
-    if (to.size() != members.size()) continue;
-    for (size_t m = 0; m < to.size(); ++m) {
-      std::vector<int>& into = leaves[to[m]].sphere.members;
-      into.insert(std::upper_bound(into.begin(), into.end(), members[m]), members[m]);
-    }
-    gone[i] = 1;
-    children[static_cast<size_t>(parent_of[last][i])] -= 1;
-    ++removed;
-  }
-  if (removed == 0) return 0;
-  std::vector<Node> kept;
-  std::vector<int> kept_parent;
-  for (size_t i = 0; i < n; ++i) {
-    if (gone[i]) continue;
-    kept.push_back(std::move(leaves[i]));
-    kept_parent.push_back(parent_of[last][i]);
-  }
-  leaves = std::move(kept);
-  parent_of[last] = std::move(kept_parent);
-  refit_inner_nodes(dense, levels, parent_of);
-  return removed;
-}
-
-/// Spends leaf spheres that the top-down pass lost (a child of a chosen
-/// configuration that receives no coverage sample is dropped): while the leaf
-/// level holds fewer than `cap` spheres, the leaf with the largest error bound
-/// whose parent has fewer than `branching` children is split in two (the
-/// two-sphere configuration of its medial samples, its coverage samples
-/// divided between them, centres polished), if both halves have a smaller
-/// error bound than it. The halves divide the leaf's samples, so every
-/// ancestor still covers them, and they stay next to each other (siblings
-/// contiguous). Returns the number of splits.
-int fill_leaf_budget(const ReductionProblem& coarse, const ReductionProblem& dense,
-                     const MeshOracle& oracle, const ReductionOptions& reduction,
-                     std::vector<std::vector<Node>>& levels,
-                     std::vector<std::vector<int>>& parent_of, long long cap, int branching) {
-  if (levels.size() < 2) return 0;
-  std::vector<Node>& leaves = levels.back();
-  std::vector<int>& parent = parent_of.back();
-  std::vector<int> children(levels[levels.size() - 2].size(), 0);
-  for (int p : parent) children[static_cast<size_t>(p)] += 1;
-  std::vector<char> tried(leaves.size(), 0);
-  int splits = 0;
-  while (static_cast<long long>(leaves.size()) < cap) {
-    int pick = -1;
-    for (size_t i = 0; i < leaves.size(); ++i) {
-      if (tried[i] || children[static_cast<size_t>(parent[i])] >= branching) continue;
-      if (leaves[i].medial.size() < 2 || leaves[i].sphere.members.size() < 2) continue;
-      if (pick < 0 || leaves[i].sphere.error > leaves[static_cast<size_t>(pick)].sphere.error)
-        pick = static_cast<int>(i);
-    }
-    if (pick < 0) break;
-    tried[static_cast<size_t>(pick)] = 1;
-    const Node& leaf = leaves[static_cast<size_t>(pick)];
-    std::vector<FittedSphere> halves = reduce_to_spheres(coarse, leaf.medial, 2, reduction)[1];
-    if (halves.size() < 2) continue;
-    std::vector<std::vector<int>> medial;
-    for (size_t k = 0; k < halves.size(); ++k) {
-      halves[k].tag = static_cast<int>(k);
-      medial.push_back(halves[k].members);
-    }
-    assign_and_refit(dense, leaf.sphere.members, halves);
-    for (auto& h : halves) polish_sphere(dense, oracle, h);
-    assign_and_refit(dense, leaf.sphere.members, halves);
-    if (halves.size() < 2) continue;
-    shrink_by_exchange(dense, halves);
-    if (!(halves[0].error < leaf.sphere.error && halves[1].error < leaf.sphere.error)) continue;
-    Node a, b;
-    a.sphere = std::move(halves[0]);
-    b.sphere = std::move(halves[1]);
-    a.medial = a.sphere.tag >= 0 ? medial[static_cast<size_t>(a.sphere.tag)] : leaf.medial;
-    b.medial = b.sphere.tag >= 0 ? medial[static_cast<size_t>(b.sphere.tag)] : leaf.medial;
-    const int p = parent[static_cast<size_t>(pick)];
-    leaves[static_cast<size_t>(pick)] = std::move(a);
-    leaves.insert(leaves.begin() + pick + 1, std::move(b));
-    parent.insert(parent.begin() + pick + 1, p);
-    tried.insert(tried.begin() + pick + 1, 0);
-    tried[static_cast<size_t>(pick)] = 0;
-    children[static_cast<size_t>(p)] += 1;
-    ++splits;
-  }
-  return splits;
-}
-
 /// The protrusion polish of every node (polish_protrusion), leaves first;
 /// then `exchange_rounds` times the leaves hand boundary samples to
 /// neighbours whose ancestors all cover them (shrink_by_exchange) and the
@@ -715,13 +579,14 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   if (!(scale > 0)) throw InputError("build_sphere_tree: the mesh has a degenerate bounding box");
 
   // Samples: coverage (dense) on the input surface, medial (coarse) on the closed one.
-  out.samples = sample_surface(input.V, input.F, SamplingOptions{options.cover_spacing * scale});
+  const SphereTreeOptions::Sampling& sampling = options.sampling;
+  out.samples = sample_surface(input.V, input.F, SamplingOptions{sampling.cover_spacing * scale});
   const SurfaceSamples medial_samples =
-      sample_surface(closed.V, closed.F, SamplingOptions{options.medial_spacing * scale});
+      sample_surface(closed.V, closed.F, SamplingOptions{sampling.medial_spacing * scale});
   end_step("hole closing, oracle, sampling");
   MedialAxisOptions medial_options;
-  medial_options.refinement_iterations = options.refinement_iterations;
-  medial_options.error_tolerance = options.refinement_tolerance * scale;
+  medial_options.refinement_iterations = sampling.refinement_iterations;
+  medial_options.error_tolerance = sampling.refinement_tolerance * scale;
   const MedialSpheres medial = approximate_medial_axis(oracles, medial_samples, medial_options);
   out.num_medial_spheres = static_cast<int>(medial.radii.size());
   out.num_refinement_points = medial.num_inserted;
@@ -735,33 +600,9 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   const ReductionProblem coarse{medial_samples.points, medial_gap, medial, grid};
   const ReductionProblem dense{out.samples.points, out.samples.gap, medial, grid};
   ReductionOptions reduction;
-  reduction.lloyd_iterations = options.lloyd_iterations;
+  reduction.lloyd_iterations = options.reduction.lloyd_iterations;
   reduction.deadline = deadline;
-  MergeBurstOptions merge_burst;
-  merge_burst.neighbour_radius = 1.5 * options.medial_spacing * scale;
-  merge_burst.lloyd_iterations = options.merge_burst_lloyd_iterations;
-  std::vector<int> owners;
-  if (options.reduction != ReductionMethod::split_lloyd) {
-    owners = medial_owners(coarse, options.medial_spacing * scale);
-  }
-  const int build_branching = std::max(options.branching, options.build_branching);
-  // `threads` > 1 only where one node is reduced (the root's children).
-  auto reduce = [&](const std::vector<int>& members, int max_k, int threads) {
-    ReductionOptions split_options = reduction;
-    split_options.threads = threads;
-    if (options.reduction == ReductionMethod::split_lloyd) {
-      return reduce_to_spheres(coarse, members, max_k, split_options);
-    }
-    std::vector<std::vector<FittedSphere>> mb =
-        merge_burst_reduce(coarse, owners, members, max_k, reduction, merge_burst);
-    if (options.reduction == ReductionMethod::best_of_both) {
-      const auto split = reduce_to_spheres(coarse, members, max_k, split_options);
-      for (size_t k = 0; k < mb.size(); ++k) {
-        if (better_config(split[k], mb[k])) mb[k] = split[k];
-      }
-    }
-    return mb;
-  };
+  const int build_branching = std::max(options.branching, options.allocation.build_branching);
 
   // Root.
   Node root;
@@ -784,9 +625,11 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     const std::vector<Node>& parents = levels.back();
     std::vector<ParentChoices> choices(parents.size());
     const int max_k = l >= 2 ? build_branching : options.branching;
-    const int reduce_threads = parents.size() == 1 ? workers : 1;
+    // With one parent (the root) its reduction is spread over the workers instead.
+    ReductionOptions node_reduction = reduction;
+    node_reduction.threads = parents.size() == 1 ? workers : 1;
     parallel_for(parents.size(), workers, [&](size_t p, int) {
-      choices[p].configs = reduce(parents[p].medial, max_k, reduce_threads);
+      choices[p].configs = reduce_to_spheres(coarse, parents[p].medial, max_k, node_reduction);
     });
     long long cap =
         std::max<long long>(level_cap(options, l), static_cast<long long>(parents.size()));
@@ -797,8 +640,8 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       // A parent cannot use more children than it has coverage samples (a
       // child without one is dropped), whatever its medial samples allow.
       // Applied with build_branching only: on the default it changes the
-      // trees and measured no better (7 dragon builds: mean42 17.16 vs
-      // 16.88, worst42 <= 80 in 5 of 7; results README, "This session (6)").
+      // trees and measured no better (dragon: mean42 17.16 vs 16.88, worst42
+      // <= 80 in 5 of 7 builds).
       const size_t usable = build_branching > options.branching
                                 ? std::max<size_t>(1, parents[p].sphere.members.size())
                                 : choices[p].configs.size();
@@ -815,19 +658,18 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
         worst = std::max(worst, costs[p].worst[static_cast<size_t>(count[p] - 1)]);
       return worst;
     };
+    const SphereTreeOptions::Allocation& share = options.allocation;
     AllocationOptions allocation;
-    allocation.worst_share = options.worst_share;
-    if (l == options.depth && options.leaf_worst_factor > 0) {
+    allocation.worst_share = share.worst_share;
+    if (l == options.depth && share.leaf_worst_factor > 0) {
       allocation.worst_threshold =
-          options.leaf_worst_factor * chosen_worst(allocate_children(costs, cap, allocation));
-      if (options.leaf_worst_target > 0) {
+          share.leaf_worst_factor * chosen_worst(allocate_children(costs, cap, allocation));
+      if (share.leaf_worst_target > 0) {
         allocation.worst_threshold =
-            std::min(allocation.worst_threshold, options.leaf_worst_target * scale);
+            std::min(allocation.worst_threshold, share.leaf_worst_target * scale);
       }
     } else if (l == options.depth) {
-      allocation.worst_threshold = options.leaf_worst_target * scale;
-    } else if (l >= 2 && options.inner_worst_target > 0) {
-      allocation.worst_threshold = options.inner_worst_target * scale;
+      allocation.worst_threshold = share.leaf_worst_target * scale;
     }
     const std::vector<int> count = allocate_children(costs, cap, allocation);
     out.allocated_worst_bound.push_back(chosen_worst(count));
@@ -856,11 +698,11 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       assign_and_refit(dense, parents[p].sphere.members, fitted);
       ExchangeOptions exchange;
       exchange.rounds = 2;
-      for (int round = 0; round < options.exchange_rounds; ++round) {
+      for (int round = 0; round < options.exchange.sibling_rounds; ++round) {
         shrink_by_exchange(dense, fitted, exchange);
         polish_all(fitted);
       }
-      if (options.exchange_rounds > 0) shrink_by_exchange(dense, fitted, exchange);
+      if (options.exchange.sibling_rounds > 0) shrink_by_exchange(dense, fitted, exchange);
       for (auto& f : fitted) {
         Node n;
         n.sphere = std::move(f);
@@ -892,19 +734,15 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
                 static_cast<long long>(levels[levels.size() - 2].size()) * options.branching);
   const int leaf_parent_limit =
       regroup ? static_cast<int>(std::max<long long>(leaf_cap, 2)) : options.branching;
-  if (options.fill_leaf_budget && options.depth >= 1) {
-    out.num_budget_splits = fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
-                                             leaf_cap, leaf_parent_limit);
-    end_step("leaf budget");
-  }
-  if (options.joint_leaf_refinement && levels.size() > 2) {
+  if (options.reduction.joint_leaf_refinement && levels.size() > 2) {
     refine_leaves(coarse, dense, oracle, out.samples, input.F, reduction, levels, parent_of);
     assert(children_divide_samples(levels, parent_of));
   }
-  if (options.leaf_exchange && levels.size() > 1)
-    exchange_across_leaves(dense, oracles, levels, parent_of, 3, options.relieve_moves);
+  const SphereTreeOptions::Exchange& exchange = options.exchange;
+  if (exchange.across_leaves && levels.size() > 1)
+    exchange_across_leaves(dense, oracles, levels, parent_of, 3, exchange.relieve_moves);
   end_step("leaf exchange");
-  if (options.sum_exchange_passes > 0 && levels.size() > 1) {
+  if (exchange.sum_passes > 0 && levels.size() > 1) {
     const size_t last = levels.size() - 1;
     std::vector<FittedSphere> leaves;
     double worst = 0;
@@ -914,35 +752,29 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
       return ancestors_cover(dense, levels, parent_of, leaf, s);
     };
     SumExchangeOptions sum;
-    sum.passes = options.sum_exchange_passes;
-    sum.cap_fraction = options.sum_exchange_cap;
-    lower_error_sum(dense, leaves, options.sum_exchange_max_share * worst, sum, accepts);
+    sum.passes = exchange.sum_passes;
+    sum.cap_fraction = exchange.sum_cap;
+    lower_error_sum(dense, leaves, exchange.sum_max_share * worst, sum, accepts);
     for (size_t i = 0; i < leaves.size(); ++i) levels[last][i].sphere = std::move(leaves[i]);
     refit_inner_nodes(dense, levels, parent_of);
   }
   end_step("sum exchange");
-  if (options.prune_redundant_leaves && levels.size() > 1) {
-    out.num_pruned = prune_redundant_leaves(dense, levels, parent_of);
-    out.num_budget_splits += fill_leaf_budget(coarse, dense, oracle, reduction, levels, parent_of,
-                                              leaf_cap, leaf_parent_limit);
-    end_step("prune");
-  }
-  if (options.protrusion_polish) {
+  if (options.polish.enabled) {
     const auto polish_start = CpuClock::now();
     // With regrouping ahead, the inner nodes are polished after it.
-    out.num_polished = polish_tree(dense, oracles, levels, parent_of, options.protrusion,
-                                   options.protrusion_exchange_rounds, deadline, !regroup);
+    out.num_polished = polish_tree(dense, oracles, levels, parent_of, options.polish.protrusion,
+                                   options.polish.exchange_rounds, deadline, !regroup);
     out.polish_cpu_seconds = std::chrono::duration<double>(CpuClock::now() - polish_start).count();
   }
   end_step("protrusion polish");
-  if (options.split_worst && levels.size() > 1) {
+  if (options.worst_split.enabled && levels.size() > 1) {
     LeafLevel leaf_level;
     for (Node& n : levels.back()) {
       leaf_level.spheres.push_back(std::move(n.sphere));
       leaf_level.medial.push_back(std::move(n.medial));
     }
     leaf_level.parent = parent_of.back();
-    WorstSplitOptions split = options.worst_split;
+    WorstSplitOptions split = options.worst_split.options;
     split.deadline = std::min(split.deadline, deadline);
     out.worst_split = split_worst_leaves(coarse, dense, oracles, reduction, leaf_level,
                                          static_cast<int>(leaf_cap), leaf_parent_limit, split);
@@ -956,10 +788,10 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
     parent_of.back() = std::move(leaf_level.parent);
     end_step("worst split");
   }
-  if (regroup || (options.regroup_parents && levels.size() > 2)) {
+  if (regroup || (options.allocation.regroup_parents && levels.size() > 2)) {
     out.num_regrouped = regroup_tree(
-        dense, oracles, reduction, options.protrusion_polish ? &options.protrusion : nullptr,
-        options.branching, options.regroup_parents, deadline, levels, parent_of);
+        dense, oracles, reduction, options.polish.enabled ? &options.polish.protrusion : nullptr,
+        options.branching, options.allocation.regroup_parents, deadline, levels, parent_of);
     end_step("regroup");
   }
 

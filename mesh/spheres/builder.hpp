@@ -8,7 +8,6 @@
 #include <icd/collision/sphere_tree.hpp>
 #include <icd/mesh/core/types.hpp>
 #include <icd/mesh/spheres/exchange.hpp>
-#include <icd/mesh/spheres/merge_burst.hpp>
 #include <icd/mesh/spheres/protrusion.hpp>
 #include <icd/mesh/spheres/reduction.hpp>
 #include <icd/mesh/spheres/surface_sampling.hpp>
@@ -16,34 +15,162 @@
 
 namespace icd::mesh {
 
-/// How the medial spheres of a node are reduced to its children.
-enum class ReductionMethod {
-  split_lloyd,   ///< greedy splitting + Lloyd rounds (reduce_to_spheres)
-  merge_burst,   ///< merge/burst from the medial set + Lloyd rounds (merge_burst_reduce)
-  best_of_both,  ///< both; for each child count the configuration with the lower worst error
-};
-
-/// Options of build_sphere_tree(). Lengths are fractions of the longest side
-/// of the model's axis-aligned bounding box (so 0.001 is 2 units when that
-/// side is 2000), which makes the defaults independent of the model's scale.
+/// Options of build_sphere_tree(): the tree's shape, then one group per
+/// build stage in the order the stages run, then the budget. Lengths are
+/// fractions of the longest side of the model's axis-aligned bounding box (so
+/// 0.001 is 2 units when that side is 2000), which makes the defaults
+/// independent of the model's scale. Figures quoted below are medians over
+/// 7 builds of the mesh scaled by 1 + E (E ~ 1e-12: the build is sensitive
+/// to rounding) unless said otherwise, in units of a longest side of 2000,
+/// "mean42" / "worst42" the leaf level's mean / worst error on 42 probe
+/// directions
+/// (experiments/studies/spheretree/results/; switches that were removed:
+/// HISTORY-options.md there).
 struct SphereTreeOptions {
+  /// Surface samples and the medial axis the spheres are placed on.
+  struct Sampling {
+    /// Spacing of the coverage samples (relative); their gap (<= spacing /
+    /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere
+    /// adds.
+    double cover_spacing = 1.0 / 550.0;
+    /// Spacing of the samples whose Voronoi diagram gives the medial axis and
+    /// on which the spheres are placed (relative, >= cover_spacing).
+    double medial_spacing = 1.0 / 25.0;
+    int refinement_iterations = 2;  ///< adaptive medial-axis rounds (>= 0)
+    /// Medial sphere error that triggers refinement (relative).
+    double refinement_tolerance = 0.002;
+  };
+
+  /// The reduction of a node's medial samples to its children: greedy
+  /// splitting + Lloyd rounds (reduce_to_spheres), level by level.
+  struct Reduction {
+    int lloyd_iterations = 8;  ///< see ReductionOptions
+    /// After the top-down pass, optimise the leaves jointly (a leaf may take
+    /// samples of a neighbour of its parent) and refit the inner nodes
+    /// bottom-up so that each still covers the union of its children's
+    /// samples. With worst_share 1 and leaf_worst_target = leaf_worst_factor
+    /// = 0 (SphereFit::shell) it gives a leaf shell thinner than the
+    /// reference toolkit's (dragon: union volume outside the object per area
+    /// 33 -> 23.4, the toolkit's 24.1) at a higher per-sphere mean (mean42 16.9 ->
+    /// 19.5) and a thicker level 2; on the bunny it lowers both. Off: the
+    /// default is tuned for the per-sphere mean.
+    bool joint_leaf_refinement = false;
+  };
+
+  /// How each level's sphere cap is shared among the parents
+  /// (allocate_children), and which parent each node ends under.
+  struct Allocation {
+    /// The first (1 - worst_share) of the spheres beyond one per parent go
+    /// where the summed child error drops most (favours the mean error), the
+    /// rest to the parents with the worst child (favours the worst error).
+    /// In [0, 1]. Lower shares lower the dragon's leaf mean and raise its
+    /// worst above 80 (0.1: mean42 -5 %, worst42 <= 80 in 2 of 7 builds).
+    double worst_share = 0.2;
+    /// When > 0 (relative, like the spacings): the leaf level's cap is shared
+    /// by the threshold rule of allocate_children() instead of worst_share:
+    /// first each parent the fewest children whose worst error bound (on the
+    /// medial samples) is <= leaf_worst_target * longest side, then the rest
+    /// where the summed bound drops most. Upper levels keep worst_share.
+    /// 0 turns the rule off (with leaf_worst_factor 0 too). 0.045 with
+    /// leaf_worst_factor 1.05 lowers the dragon's mean42 17.68 -> 16.88
+    /// (worst42 <= 80 in 6 of 7 builds either way) and keeps the bunny's
+    /// worst within its spread.
+    double leaf_worst_target = 0.045;
+    /// When > 0: the threshold rule's threshold at the leaf level is this
+    /// factor times the largest worst bound of the configurations the fixed
+    /// split (worst_share) would choose there (so it follows the model instead
+    /// of its bounding box); the smaller of the two when leaf_worst_target > 0.
+    /// 0: off.
+    double leaf_worst_factor = 1.05;
+    /// After the leaves are final, choose every node's parent anew, levels
+    /// from the leaves up, to lower the sum of the parents' radii
+    /// (regroup_children; no parent gets more than `branching` children):
+    /// meant for joint_leaf_refinement, whose leaves have left the patches
+    /// their parents were fitted to. The leaves are unchanged. With the shell
+    /// settings (SphereFit::shell) a full traversal of two approaching copies
+    /// (one build, 400 poses) tests 13 % (dragon) / 16 % (bunny) fewer sphere
+    /// pairs; on the default tree no gain (+3 %), hence off.
+    bool regroup_parents = false;
+    /// Children a parent at level >= 1 may get while the tree is built (0:
+    /// branching; else >= branching). Above branching, levels 2 and below are
+    /// built as if their parents could take that many (so the allocation can
+    /// give some parents more children and others fewer; a parent gets no
+    /// more than it has coverage samples), and at the end each level is
+    /// regrouped under the level above with at most `branching` children per
+    /// node (regroup_children), leaves first: the leaves do not change, inner
+    /// nodes are refitted and polished around their new children. The tree
+    /// keeps its branching factor and caps. Off: for the per-sphere mean it
+    /// measured worse than the default (dragon, 12: mean42 -8 %, but worst42
+    /// <= 80 in 4 of 7 builds instead of 6, upper levels looser, most of the
+    /// gain leaves that cover nothing alone). With 16 and the worst-first
+    /// allocation (worst_share 1, leaf targets 0) one dragon build had the
+    /// thinnest leaf shell measured (20.8 against 23.4 for the shell preset),
+    /// at mean42 22.0; its upper levels and traversal cost were not measured.
+    int build_branching = 0;
+  };
+
+  /// Boundary exchanges: samples handed to neighbouring spheres that cover
+  /// them already (shrink_by_exchange, relieve_worst, lower_error_sum).
+  struct Exchange {
+    /// Rounds of boundary exchange among the children of each node, each
+    /// followed by a centre polish (see shrink_by_exchange, polish_sphere; >= 0).
+    int sibling_rounds = 2;
+    /// After the top-down pass, let the leaves exchange boundary samples across
+    /// parents too (a sample may move to a leaf of another parent when that
+    /// leaf and all its ancestors already cover it; no radius grows); inner
+    /// nodes are then refitted to the union of their children's samples.
+    bool across_leaves = true;
+    /// With across_leaves: at most this many single-sample moves that lower the
+    /// worst leaf error bound (see relieve_worst; 0 disables, >= 0). A receiving
+    /// leaf grows below the worst leaf error; its ancestors may grow, each within
+    /// its level's worst error bound before the moves.
+    int relieve_moves = 200000;
+    /// Passes of lower_error_sum over the leaves after the exchanges, which
+    /// lowers the mean leaf error bound: a leaf hands the cap of samples that
+    /// sets its radius to neighbours that grow less than it shrinks, whose
+    /// ancestors already cover them (0: off, >= 0).
+    int sum_passes = 4;
+    double sum_cap = 0.1;  ///< see SumExchangeOptions::cap_fraction
+    /// A receiving leaf's error bound stays below this share of the worst leaf
+    /// bound (> 0). Larger lets the mean drop more and the worst rise; with
+    /// WorstSplit relieving the worst, 0.9 measured best (dragon: mean on
+    /// 2562 directions 2 % below 0.8's, worst42 <= 80 in 6 of 7 builds either
+    /// way; 1.0: 3 % below, but only 5 of 7).
+    double sum_max_share = 0.9;
+  };
+
+  /// The protrusion polish of every node, after the exchanges (only
+  /// WorstSplit and the regrouping come later).
+  struct Polish {
+    /// Every node, leaves first, moves its centre to lower its true error
+    /// (how far its surface sticks out of the object, measured on points of
+    /// the sphere's surface; see polish_protrusion), its radius the smallest
+    /// that covers its samples with margin. Coverage is kept.
+    bool enabled = true;
+    /// Rounds in which the polished leaves hand boundary samples to
+    /// neighbours that already cover them (and whose ancestors do;
+    /// shrink_by_exchange), each followed by a new polish of the leaves that
+    /// changed (>= 0).
+    int exchange_rounds = 1;
+    ProtrusionPolishOptions protrusion;  ///< see polish_protrusion
+  };
+
+  /// The last step that changes leaves (split_worst_leaves): those with the largest
+  /// true error, measured on options.measure_directions (a set neither the
+  /// polish nor the evaluation uses), are split in two, in the leaf slots the
+  /// top-down pass lost, when both halves have a lower true error; near the
+  /// worst (options.relief_fraction) even when the mean rises and, in a full
+  /// parent, after merging two siblings; below it only when the mean does not
+  /// rise. Coverage is kept; the true worst never rises.
+  struct WorstSplit {
+    /// On by default: the dragon's worst42 is <= 80 in 6 of 7 builds instead
+    /// of 3 (median 80.2 -> 73.7), its mean unchanged within the spread, for
+    /// about 10 s CPU.
+    bool enabled = true;
+    WorstSplitOptions options;  ///< see split_worst_leaves (its deadline is time_limit's)
+  };
+
   int branching = 8;  ///< at most this many children per node (>= 2)
-  /// Children a parent at level >= 1 may get while the tree is built (0:
-  /// branching; else >= branching). Above branching, levels 2 and below are
-  /// built as if their parents could take that many (so the allocation can
-  /// give some parents more children and others fewer), and at the end each
-  /// level is regrouped under the level above with at most `branching`
-  /// children per node (regroup_children), leaves first: the leaves do not
-  /// change, inner nodes are refitted and polished around their new
-  /// children. The tree keeps its branching factor and caps. Measured with
-  /// 12 and inner_worst_target 0.085 (7 perturbed builds, medians): dragon
-  /// leaf mean42 16.88 -> 15.34 but worst42 <= 80 in 4 instead of 6 of 7,
-  /// bunny mean42 14.45 -> 12.79; upper levels looser; hence off
-  /// (experiments/spheretree/results/README.md, "This session (5)"). Most
-  /// of that gain is leaves that cover nothing alone (about 170 instead of
-  /// 110 on 4 dragon builds; LevelMetrics::num_redundant_spheres): the
-  /// union's shell is 10 % thicker than the default's ("This session (6)").
-  int build_branching = 0;
   /// Levels *below the root*: the tree has depth + 1 levels (the root is
   /// level 0), at most branching^l nodes on level l. depth 3 with branching 8
   /// is the paper's setting (1 + 8 + 64 + 512 nodes at most), as in the
@@ -51,132 +178,16 @@ struct SphereTreeOptions {
   int depth = 3;
   /// Optional cap on the number of spheres of each level (index = level; a
   /// missing or non-positive entry means branching^level). Extra spheres go
-  /// where they lower the error most.
+  /// where they lower the error most (see Allocation).
   std::vector<int> max_spheres_per_level;
-  /// How a cap is shared: the first (1 - worst_share) of the spheres beyond
-  /// one per parent go where the summed child error drops most (favours the
-  /// mean error), the rest to the parents with the worst child (favours the
-  /// worst error). In [0, 1].
-  double worst_share = 0.2;
-  /// When > 0 (relative, like the spacings): the leaf level's cap is shared
-  /// by the threshold rule of allocate_children() instead of worst_share:
-  /// first each parent the fewest children whose worst error bound (on the
-  /// medial samples) is <= leaf_worst_target * longest side, then the rest
-  /// where the summed bound drops most. Upper levels keep worst_share.
-  /// 0 turns the rule off (with leaf_worst_factor 0 too). Default 0.045
-  /// with leaf_worst_factor 1.05 (7 perturbed builds, medians: dragon mean42
-  /// 17.68 -> 16.88, mean2562 20.83 -> 19.93, worst42 <= 80 in 6 of 7 either
-  /// way; bunny mean42 14.62 -> 14.45, worst42 45.0 -> 49.4, all <= 80;
-  /// experiments/spheretree/results/README.md).
-  double leaf_worst_target = 0.045;
-  /// When > 0: the threshold rule's threshold at the leaf level is this
-  /// factor times the largest worst bound of the configurations the fixed
-  /// split (worst_share) would choose there (so it follows the model instead
-  /// of its bounding box); the smaller of the two when leaf_worst_target > 0.
-  /// 0: off.
-  double leaf_worst_factor = 1.05;
-  /// When > 0 (relative): the threshold rule (see leaf_worst_target) with
-  /// this threshold at the inner levels 2 .. depth - 1 instead of
-  /// worst_share. 0: off.
-  double inner_worst_target = 0;
-  /// Spacing of the coverage samples (relative); their gap (<= spacing /
-  /// sqrt(3) on well-shaped triangles) is the coverage margin every sphere adds.
-  double cover_spacing = 1.0 / 550.0;
-  /// Spacing of the samples whose Voronoi diagram gives the medial axis and
-  /// on which the spheres are placed (relative, >= cover_spacing).
-  double medial_spacing = 1.0 / 25.0;
-  int refinement_iterations = 2;        ///< adaptive medial-axis rounds (>= 0)
-  double refinement_tolerance = 0.002;  ///< medial sphere error that triggers refinement (relative)
-  int lloyd_iterations = 8;             ///< see ReductionOptions
-  ReductionMethod reduction =
-      ReductionMethod::split_lloyd;      ///< see ReductionMethod (split_lloyd measured best)
-  int merge_burst_lloyd_iterations = 4;  ///< see MergeBurstOptions::lloyd_iterations
-  /// Rounds of boundary exchange among the children of each node, each
-  /// followed by a centre polish (see shrink_by_exchange, polish_sphere; >= 0).
-  int exchange_rounds = 2;
-  /// After the top-down pass, let the leaves exchange boundary samples across
-  /// parents too (a sample may move to a leaf of another parent when that
-  /// leaf and all its ancestors already cover it; no radius grows); inner
-  /// nodes are then refitted to the union of their children's samples.
-  bool leaf_exchange = true;
-  /// With leaf_exchange: at most this many single-sample moves that lower the
-  /// worst leaf error bound (see relieve_worst; 0 disables, >= 0). A receiving
-  /// leaf grows below the worst leaf error; its ancestors may grow, each within
-  /// its level's worst error bound before the moves.
-  int relieve_moves = 200000;
-  /// After the top-down pass, spend the leaf spheres it lost (a child that
-  /// received no coverage sample is dropped, so the leaf level can hold fewer
-  /// than its cap): the leaf with the largest error bound whose parent has
-  /// room is split in two, while that lowers both halves' bound below it.
-  bool fill_leaf_budget = false;
-  /// After lower_error_sum: remove the leaves that cover nothing alone (all
-  /// their samples covered with margin by other leaves, and by those leaves'
-  /// ancestors; the boundary exchanges strip such leaves down to one sample)
-  /// and spend their slots as fill_leaf_budget does (the leaf with the
-  /// largest error bound whose parent has room split in two). Measured (7
-  /// perturbed builds per model, medians): the union's shell 33.25 -> 30.25
-  /// (dragon), 19.12 -> 17.70 (bunny), lower in every build, true worst
-  /// unchanged, but the plain mean42 rises (idle leaves with errors near 0
-  /// become working ones) and the dragon's worst42 is <= 80 in 4 of 7
-  /// builds instead of 6; hence off ("This session (6)").
-  bool prune_redundant_leaves = false;
-  /// After the top-down pass, optimise the leaves jointly (a leaf may take
-  /// samples of a neighbour of its parent) and refit the inner nodes
-  /// bottom-up so that each still covers the union of its children's samples.
-  /// With worst_share 1 and leaf_worst_target = leaf_worst_factor = 0 it
-  /// gives a leaf shell thinner than the reference toolkit's (7 perturbed
-  /// dragon builds, medians: union volume outside per area 33 -> 23.4, the
-  /// toolkit's 24.1; median reach beyond the surface 41 -> 23;
-  /// worst42 <= 80 in 7 of 7) at a higher per-sphere mean (mean42 16.9 ->
-  /// 19.5) and a thicker level 2; on the bunny it lowers both. Off because
-  /// the default is tuned for the per-sphere mean (experiments/spheretree/
-  /// results/README.md, "This session (10)").
-  bool joint_leaf_refinement = false;
-  /// After the leaves are final, choose every node's parent anew, levels
-  /// from the leaves up, to lower the sum of the parents' radii (as
-  /// build_branching's regrouping does, here with no parent over capacity):
-  /// meant for joint_leaf_refinement, whose leaves have left the patches
-  /// their parents were fitted to. The leaves are unchanged. Measured with
-  /// the shell settings (joint, worst_share 1, leaf targets 0; E = 0, 400
-  /// approach poses of contact_tightness): sphere tests of a full traversal
-  /// -13 % (dragon) / -16 % (bunny), level-2 pairs 13.9 -> 10.8 (dragon);
-  /// on the default tree no gain (tests +3 %), hence off.
-  bool regroup_parents = false;
-  /// Passes of lower_error_sum over the leaves after the exchanges, which
-  /// lowers the mean leaf error bound: a leaf hands the cap of samples that
-  /// sets its radius to neighbours that grow less than it shrinks, whose
-  /// ancestors already cover them (0: off, >= 0).
-  int sum_exchange_passes = 4;
-  double sum_exchange_cap = 0.1;  ///< see SumExchangeOptions::cap_fraction
-  /// A receiving leaf's error bound stays below this share of the worst leaf
-  /// bound (> 0). Larger lets the mean drop more and the worst rise; with
-  /// split_worst relieving the worst, 0.9 measured best (7 perturbed dragon
-  /// builds: median mean2562 21.22 -> 20.83 against 0.8, worst42 <= 80 in 6
-  /// of 7 either way; 1.0: 20.51 but only 5 of 7).
-  double sum_exchange_max_share = 0.9;
-  /// Last step: every node, leaves first, moves its centre to lower its true
-  /// error (how far its surface sticks out of the object, measured on points
-  /// of the sphere's surface; see polish_protrusion), its radius the smallest
-  /// that covers its samples with margin. Coverage is kept.
-  bool protrusion_polish = true;
-  /// With protrusion_polish: rounds in which the polished leaves hand
-  /// boundary samples to neighbours that already cover them (and whose
-  /// ancestors do; shrink_by_exchange), each followed by a new polish of the
-  /// leaves that changed (>= 0).
-  int protrusion_exchange_rounds = 1;
-  ProtrusionPolishOptions protrusion;  ///< see polish_protrusion
-  /// Very last step (split_worst_leaves): the leaves with the largest true
-  /// error, measured on worst_split.measure_directions (a set neither the
-  /// polish nor the evaluation uses), are split in two, in the leaf slots the
-  /// top-down pass lost, when both halves have a lower true error; near the
-  /// worst (worst_split.relief_fraction) even when the mean rises and, in a
-  /// full parent, after merging two siblings; below it only when the mean
-  /// does not rise. Coverage is kept; the true worst never rises. On by
-  /// default: over 7 perturbed dragon builds it took the leaf worst42 <= 80
-  /// in 6 instead of 3 (median 80.2 -> 73.7) with the mean unchanged within
-  /// the spread (median mean2562 21.07 -> 21.22), for about 10 s CPU.
-  bool split_worst = true;
-  WorstSplitOptions worst_split;  ///< see split_worst_leaves (its deadline is time_limit's)
+
+  Sampling sampling;
+  Reduction reduction;
+  Allocation allocation;
+  Exchange exchange;
+  Polish polish;
+  WorstSplit worst_split;
+
   /// Worker threads (0: std::thread::hardware_concurrency(); 1: none). The
   /// per-node steps (each level's reduction and fitting of a parent's
   /// children, the leaf polish between boundary exchanges, the protrusion
@@ -211,10 +222,8 @@ struct SphereTreeBuild {
   double polish_cpu_seconds = 0;   ///< CPU time of the protrusion polish
   int num_polished = 0;            ///< nodes whose centre the protrusion polish moved
   bool hit_time_limit = false;     ///< true when the optimisation was cut short
-  int num_budget_splits = 0;       ///< leaves split by fill_leaf_budget (and after pruning)
-  int num_pruned = 0;              ///< leaves removed by prune_redundant_leaves
-  int num_regrouped = 0;           ///< parent changes made by build_branching's regrouping
-  WorstSplitResult worst_split;    ///< what split_worst_leaves did (with split_worst)
+  int num_regrouped = 0;           ///< parent changes made by regroup_parents or build_branching
+  WorstSplitResult worst_split;    ///< what split_worst_leaves did (with WorstSplit::enabled)
   /// For each level l >= 1 (index l - 1): the largest worst child error bound
   /// (medial samples, model units) of the configurations the allocation chose.
   std::vector<double> allocated_worst_bound;

@@ -19,10 +19,10 @@ namespace {
 
 void check_arguments(const WorstSplitOptions& o, int cap, int branching) {
   if (o.measure_directions < 1 || o.choice_directions < 1 || o.max_tries < 0 ||
-      !(o.relief_fraction >= 0) || !(o.mean_rise_limit >= 0) || o.redivide_siblings < 0)
+      !(o.relief_fraction >= 0) || !(o.mean_rise_limit >= 0))
     throw ParameterError(
         "WorstSplitOptions: measure_directions and choice_directions must be >= 1, max_tries >= 0 "
-        "and relief_fraction, mean_rise_limit, redivide_siblings >= 0");
+        "and relief_fraction, mean_rise_limit >= 0");
   if (cap < 0 || branching < 2)
     throw ParameterError("split_worst_leaves: cap must be >= 0 and branching >= 2, got " +
                          std::to_string(cap) + " and " + std::to_string(branching));
@@ -301,43 +301,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     exact[at] = 1;
     tried[at] = 0;
   };
-  // Leaf i (true error `worst`) and one of its overlapping siblings, nearest
-  // centre first, re-divided into two spheres whose true errors are both
-  // below `worst`; true when a pair was replaced (indices unchanged).
-  auto redivide = [&](size_t i, double worst) {
-    const int p = level.parent[i];
-    std::vector<std::pair<double, size_t>> near;
-    for (size_t j = 0; j < level.spheres.size(); ++j) {
-      if (j == i || level.parent[j] != p) continue;
-      const double d = (level.spheres[j].center - level.spheres[i].center).norm();
-      if (d <= level.spheres[i].radius + level.spheres[j].radius) near.emplace_back(d, j);
-    }
-    std::sort(near.begin(), near.end());
-    if (near.size() > static_cast<size_t>(options.redivide_siblings))
-      near.resize(static_cast<size_t>(options.redivide_siblings));
-    for (const auto& [d, j] : near) {
-      FittedSphere joint;
-      joint.members = merged(level.spheres[i].members, level.spheres[j].members);
-      joint.tag = level.spheres[i].tag;
-      const std::vector<int> joint_medial = merged(level.medial[i], level.medial[j]);
-      Halves h =
-          split_in_two(coarse, dense, oracles, reduction, joint, joint_medial,
-                       7919u * static_cast<unsigned>(i) + 31u * static_cast<unsigned>(j) + 5u,
-                       options.polish, choice, directions);
-      if (h.spheres.size() != 2) continue;
-      result.measured += 2;
-      if (!(h.error[0] < worst && h.error[1] < worst)) continue;
-      h.spheres[1].tag = level.spheres[j].tag;
-      for (size_t k = 0; k < 2; ++k)
-        replace_leaf(k == 0 ? i : j, std::move(h.spheres[k]), std::move(h.medial[k]), h.error[k]);
-      ++result.redivisions;
-      return true;
-    }
-    return false;
-  };
-
-  constexpr double kNoRelief = std::numeric_limits<double>::infinity();
-  double relief_threshold = options.relief_fraction * result.worst_before;
+  const double relief_threshold = options.relief_fraction * result.worst_before;
   while (result.tries < options.max_tries && CpuClock::now() < options.deadline) {
     for (size_t i = 0; i < done.size(); ++i) done[i] = tried[i];
     const int pick = top();
@@ -360,26 +324,15 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
         split_in_two(coarse, dense, oracles, reduction, level.spheres[i], level.medial[i],
                      7919u * static_cast<unsigned>(i) + 17u, options.polish, choice, directions);
     const bool relief = worst >= relief_threshold;
-    // A relief try that found no split (`counter`: relief_no_split) or no
-    // room (relief_no_merge) first tries the re-division with a sibling; if
-    // that fails too it counts. Picks come largest true error first and
-    // splits leave smaller halves, so the first failure is at the level's
-    // worst leaf; with stop_relief_when_stuck the band closes there.
-    auto relief_stuck = [&](int& counter) {
-      if (!relief) return;
-      if (options.redivide_siblings > 0 && redivide(i, worst)) return;
-      ++counter;
-      if (options.stop_relief_when_stuck) relief_threshold = kNoRelief;
-    };
     if (halves.spheres.size() != 2) {
-      relief_stuck(result.relief_no_split);
+      if (relief) ++result.relief_no_split;  // a relief try without a split
       continue;
     }
     result.measured += 2;
     const double e0 = halves.error[0];
     const double e1 = halves.error[1];
     if (!(e0 < worst && e1 < worst)) {
-      relief_stuck(result.relief_no_split);
+      if (relief) ++result.relief_no_split;  // a relief try without a split
       continue;
     }
     // Below the relief band the level's mean error must not rise:
@@ -388,7 +341,7 @@ WorstSplitResult split_worst_leaves(const ReductionProblem& coarse, const Reduct
     if (!free_slot) {
       std::optional<Merge> merge = best_merge(i, worst);
       if (!merge) {
-        relief_stuck(result.relief_no_merge);
+        if (relief) ++result.relief_no_merge;  // ... or without room
         continue;
       }
       for (size_t j : {merge->first, merge->second}) {

@@ -41,22 +41,11 @@ struct WorstSplitOptions {
   /// cap) gets one by merging two of its siblings into one sphere, when that
   /// sphere's true error is below the leaf's too (>= 0; above 1: no band).
   double relief_fraction = 0.85;
-  /// Close the relief band at its first failed try (the level's worst leaf
-  /// then cannot be split or given room, so its true worst is final): saves
-  /// the tries that would only split near-worst leaves.
-  bool stop_relief_when_stuck = false;
   /// Below the relief band a split is kept only when it raises the summed
   /// true error by at most this multiple of the level's mean true error at
   /// the start (measured on choice_directions), so that with the default 1
   /// the level's mean error does not rise with its sphere count (>= 0).
   double mean_rise_limit = 1.0;
-  /// When a relief-band leaf cannot be split (no division with two better
-  /// halves, or no room and no merge), re-divide it together with one of its
-  /// overlapping siblings, nearest centre first, up to this many siblings:
-  /// the union of the two leaves' samples is divided in two new spheres (the
-  /// candidates of a split, on the union), kept when both true errors are
-  /// below the leaf's. The leaf count is unchanged (>= 0; 0: off).
-  int redivide_siblings = 0;
   ProtrusionPolishOptions polish;  ///< polish of the two halves (see polish_protrusion)
   /// Past this process CPU time no more leaf is tried (the level stays valid).
   CpuClock::time_point deadline = CpuClock::time_point::max();
@@ -78,7 +67,6 @@ struct WorstSplitResult {
   /// ... and because its parent (or the level) was full and no merge of two
   /// siblings gave a sphere below the leaf's true error.
   int relief_no_merge = 0;
-  int redivisions = 0;  ///< leaf pairs re-divided (redivide_siblings)
 };
 
 /// Repeatedly, the leaf with the largest true error E (sphere_protrusion on

@@ -2,7 +2,6 @@
 //                   [--cover-spacing REL] [--joint 0|1] [--regroup 0|1] [--lloyd N] [--octree 0|1]
 //                   [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]
 //                   [--coverage-spacing UNITS] [--shell-samples N]  (evaluation)
-//                   [--reduction split|merge|both]
 //                   [--diagnose N]   (print the N leaves with the largest 162-probe error)
 //                   [--exchange-rounds N] [--relieve-moves N]
 //                   [--polish 0|1] [--polish-rounds N] [--polish-evals N]
@@ -10,14 +9,11 @@
 //                   [--sum-passes N] [--sum-cap F] [--sum-share F]   (lower_error_sum)
 //                   [--fit-probes 0|1]  (also: the leaves re-polished against the 42
 //                                        evaluation directions, to show what that fit does)
-//                   [--fill 0|1]  (SphereTreeOptions::fill_leaf_budget)
-//                   [--prune 0|1]  (SphereTreeOptions::prune_redundant_leaves)
 //                   [--split-worst 0|1] [--split-tries N] [--split-relief F] [--split-mean-rise F]
-//                   [--split-stop-stuck 0|1] [--split-redivide N]  (split_worst)
+//                                 (SphereTreeOptions::WorstSplit)
 //                   [--caps 1,8,64,N[,M]]  (spheres allowed per level; depth = count - 1)
 //                   [--branching B]  (children per node at most; default 8)
-//                   [--build-branching B]  (SphereTreeOptions::build_branching)
-//                   [--inner-worst-target REL]  (SphereTreeOptions::inner_worst_target)
+//                   [--build-branching B]  (SphereTreeOptions::Allocation::build_branching)
 //                   [--threads N]  (worker threads of the build; 0 = all cores, the default)
 //                   [--flat N]  (diagnostic: one level of at most N spheres under the root,
 //                                every other step as usual: the cost of the nested partition)
@@ -163,63 +159,50 @@ int run(int argc, char** argv) {
   double perturb = 0;
   icd::mesh::EvaluationOptions evaluation;
   using icd::experiments::CommandLine;
-  CommandLine cli("sphere_tree_table",
-                  "  Builds and evaluates the trees, writes .sph and VTU files into RESULTS_DIR\n"
-                  "  (see the comment at the top of sphere_tree_table.cpp and\n"
-                  "  experiments/studies/spheretree/results/README.md). The builder checks the ranges.");
+  CommandLine cli(
+      "sphere_tree_table",
+      "  Builds and evaluates the trees, writes .sph and VTU files into RESULTS_DIR\n"
+      "  (see the comment at the top of sphere_tree_table.cpp and\n"
+      "  experiments/studies/spheretree/results/README.md). The builder checks the ranges.");
   cli.argument("RESULTS_DIR", results, "output folder (created)", true);
-  icd::mesh::WorstSplitOptions& split = options.worst_split;
-  icd::mesh::ProtrusionPolishOptions& polish = options.protrusion;
+  icd::mesh::SphereTreeOptions::Sampling& sampling = options.sampling;
+  icd::mesh::SphereTreeOptions::Allocation& allocation = options.allocation;
+  icd::mesh::SphereTreeOptions::Exchange& exchange = options.exchange;
+  icd::mesh::WorstSplitOptions& split = options.worst_split.options;
+  icd::mesh::ProtrusionPolishOptions& polish = options.polish.protrusion;
   cli.text("--models", models_arg, "bunny,dragon", "models to build")
       .real("--time-limit", options.time_limit, "S", "CPU budget of a build (s)")
-      .real("--medial-spacing", options.medial_spacing, "REL", "medial sample spacing")
-      .real("--cover-spacing", options.cover_spacing, "REL", "coverage sample spacing")
-      .boolean("--joint", options.joint_leaf_refinement, "joint leaf refinement")
-      .boolean("--regroup", options.regroup_parents, "choose the parents anew at the end")
-      .integer("--lloyd", options.lloyd_iterations, "N", "Lloyd rounds of the reduction")
+      .real("--medial-spacing", sampling.medial_spacing, "REL", "medial sample spacing")
+      .real("--cover-spacing", sampling.cover_spacing, "REL", "coverage sample spacing")
+      .boolean("--joint", options.reduction.joint_leaf_refinement, "joint leaf refinement")
+      .boolean("--regroup", allocation.regroup_parents, "choose the parents anew at the end")
+      .integer("--lloyd", options.reduction.lloyd_iterations, "N", "Lloyd rounds of the reduction")
       .boolean("--octree", with_octree, "also the octree baseline")
-      .real("--worst-share", options.worst_share, "F", "allocation: worst share")
-      .real("--leaf-worst-target", options.leaf_worst_target, "REL", "leaf worst bound target")
-      .real("--leaf-worst-factor", options.leaf_worst_factor, "F", "leaf worst bound factor")
+      .real("--worst-share", allocation.worst_share, "F", "allocation: worst share")
+      .real("--leaf-worst-target", allocation.leaf_worst_target, "REL", "leaf worst bound target")
+      .real("--leaf-worst-factor", allocation.leaf_worst_factor, "F", "leaf worst bound factor")
       .real("--coverage-spacing", evaluation.coverage_spacing, "UNITS",
             "evaluation: dense coverage spacing")
       .integer("--shell-samples", evaluation.shell_samples, "N", "evaluation: points per sphere")
-      .custom("--reduction", "split|merge|both", "reduction method",
-              [&](const std::string& v) {
-                if (v == "split")
-                  options.reduction = icd::mesh::ReductionMethod::split_lloyd;
-                else if (v == "merge")
-                  options.reduction = icd::mesh::ReductionMethod::merge_burst;
-                else if (v == "both")
-                  options.reduction = icd::mesh::ReductionMethod::best_of_both;
-                else
-                  throw std::invalid_argument("expects split, merge or both, got '" + v + "'");
-              })
       .integer("--diagnose", diagnose, "N", "print the N leaves of largest 162-probe error", 0)
-      .integer("--exchange-rounds", options.exchange_rounds, "N", "boundary exchange rounds")
-      .integer("--relieve-moves", options.relieve_moves, "N", "relieve_worst moves")
-      .boolean("--polish", options.protrusion_polish, "protrusion polish")
-      .integer("--polish-rounds", options.protrusion_exchange_rounds, "N",
+      .integer("--exchange-rounds", exchange.sibling_rounds, "N", "boundary exchange rounds")
+      .integer("--relieve-moves", exchange.relieve_moves, "N", "relieve_worst moves")
+      .boolean("--polish", options.polish.enabled, "protrusion polish")
+      .integer("--polish-rounds", options.polish.exchange_rounds, "N",
                "exchange rounds of the polish")
       .integer("--polish-evals", polish.max_evaluations, "N", "polish evaluations per sphere")
       .integer("--polish-search", polish.search_directions, "N", "polish search directions")
       .integer("--polish-check", polish.check_directions, "N", "polish check directions")
       .boolean("--fit-probes", fit_probes,
                "also the leaves re-polished against the 42 evaluation directions")
-      .integer("--sum-passes", options.sum_exchange_passes, "N", "lower_error_sum passes")
-      .real("--sum-cap", options.sum_exchange_cap, "F", "lower_error_sum cap fraction")
-      .real("--sum-share", options.sum_exchange_max_share, "F", "lower_error_sum receiver share")
+      .integer("--sum-passes", exchange.sum_passes, "N", "lower_error_sum passes")
+      .real("--sum-cap", exchange.sum_cap, "F", "lower_error_sum cap fraction")
+      .real("--sum-share", exchange.sum_max_share, "F", "lower_error_sum receiver share")
       .real("--perturb", perturb, "E", "build for the mesh scaled by 1 + E")
-      .boolean("--fill", options.fill_leaf_budget, "SphereTreeOptions::fill_leaf_budget")
-      .boolean("--prune", options.prune_redundant_leaves,
-               "SphereTreeOptions::prune_redundant_leaves")
-      .boolean("--split-worst", options.split_worst, "split_worst_leaves")
+      .boolean("--split-worst", options.worst_split.enabled, "split_worst_leaves")
       .integer("--split-tries", split.max_tries, "N", "split_worst: tries")
       .real("--split-relief", split.relief_fraction, "F", "split_worst: relief fraction")
       .real("--split-mean-rise", split.mean_rise_limit, "F", "split_worst: mean rise limit")
-      .boolean("--split-stop-stuck", split.stop_relief_when_stuck,
-               "split_worst: stop the relief when stuck")
-      .integer("--split-redivide", split.redivide_siblings, "N", "split_worst: siblings")
       .custom(
           "--caps", "1,8,64,N[,M]", "spheres allowed per level (depth = count - 1)",
           [&](const std::string& v) {
@@ -234,10 +217,8 @@ int run(int argc, char** argv) {
             options.max_spheres_per_level = caps;
           })
       .integer("--branching", options.branching, "B", "children per node at most")
-      .integer("--build-branching", options.build_branching, "B",
-               "SphereTreeOptions::build_branching")
-      .real("--inner-worst-target", options.inner_worst_target, "REL",
-            "SphereTreeOptions::inner_worst_target")
+      .integer("--build-branching", allocation.build_branching, "B",
+               "SphereTreeOptions::Allocation::build_branching")
       .integer("--threads", options.threads, "N", "worker threads (0: all cores)", 0)
       .custom("--flat", "N", "diagnostic: one level of at most N spheres under the root",
               [&](const std::string& v) {
@@ -302,21 +283,15 @@ int run(int argc, char** argv) {
         ours.num_polished, ours.hit_time_limit ? ", TIME LIMIT HIT" : "");
     // Model units -> the table's (longest bounding-box side 2000).
     const double to_2000 = icd::experiments::to_normalized_units(mesh);
-    if (options.prune_redundant_leaves || options.fill_leaf_budget) {
-      std::printf("# %s: %d redundant leaves pruned, %d leaves split to fill the budget\n",
-                  model.name.c_str(), ours.num_pruned, ours.num_budget_splits);
-    }
-    if (options.split_worst) {
+    if (options.worst_split.enabled) {
       const auto& w = ours.worst_split;
       std::printf(
           "# %s worst split: %d splits in %d tries (%d merges; %d worst leaves with a full parent; "
-          "relief band: %d without two better halves, %d without a merge; %d re-divided with a "
-          "sibling), %d spheres measured, true worst (%d dirs) %.1f -> %.1f, mean at the start (%d "
-          "dirs) %.2f\n",
+          "relief band: %d without two better halves, %d without a merge), %d spheres measured, "
+          "true worst (%d dirs) %.1f -> %.1f, mean at the start (%d dirs) %.2f\n",
           model.name.c_str(), w.splits, w.tries, w.merges, w.blocked_by_parent, w.relief_no_split,
-          w.relief_no_merge, w.redivisions, w.measured, options.worst_split.measure_directions,
-          to_2000 * w.worst_before, to_2000 * w.worst_after, options.worst_split.choice_directions,
-          to_2000 * w.mean_before);
+          w.relief_no_merge, w.measured, split.measure_directions, to_2000 * w.worst_before,
+          to_2000 * w.worst_after, split.choice_directions, to_2000 * w.mean_before);
     }
     std::printf("# %s allocation: largest worst child bound chosen per level (medial samples):",
                 model.name.c_str());

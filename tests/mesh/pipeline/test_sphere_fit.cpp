@@ -30,7 +30,7 @@ TEST(SphereFit, KeepsTheTreeShapeAndSetsTheFit) {
   shaped.max_spheres_per_level = {1, 4, 9};
   shaped.threads = 1;
   shaped.time_limit = 5;
-  shaped.lloyd_iterations = 3;  // a fitting option: each preset sets its own
+  shaped.reduction.lloyd_iterations = 3;  // a fitting option: each preset sets its own
   const SphereTreeOptions builder;
   for (SphereFit fit : {SphereFit::light, SphereFit::full, SphereFit::shell}) {
     SCOPED_TRACE(to_string(fit));
@@ -42,20 +42,20 @@ TEST(SphereFit, KeepsTheTreeShapeAndSetsTheFit) {
     EXPECT_EQ(o.threads, 1);
     EXPECT_EQ(o.time_limit, 5);
     const bool light = fit == SphereFit::light, shell = fit == SphereFit::shell;
-    EXPECT_EQ(o.lloyd_iterations, light ? 1 : builder.lloyd_iterations);
-    EXPECT_EQ(o.refinement_iterations, light ? 0 : builder.refinement_iterations);
-    EXPECT_EQ(o.joint_leaf_refinement, shell);
-    EXPECT_EQ(o.regroup_parents, shell);
-    EXPECT_EQ(o.worst_share, shell ? 1.0 : builder.worst_share);
-    EXPECT_EQ(o.leaf_worst_target, shell ? 0.0 : builder.leaf_worst_target);
+    EXPECT_EQ(o.reduction.lloyd_iterations, light ? 1 : builder.reduction.lloyd_iterations);
+    EXPECT_EQ(o.sampling.refinement_iterations, light ? 0 : builder.sampling.refinement_iterations);
+    EXPECT_EQ(o.reduction.joint_leaf_refinement, shell);
+    EXPECT_EQ(o.allocation.regroup_parents, shell);
+    EXPECT_EQ(o.allocation.worst_share, shell ? 1.0 : builder.allocation.worst_share);
+    EXPECT_EQ(o.allocation.leaf_worst_target, shell ? 0.0 : builder.allocation.leaf_worst_target);
   }
   // The preprocessing's default is the light fit with no time limit.
   const PreprocessOptions p;
   SphereTreeOptions light = p.spheres;
   apply_sphere_fit(SphereFit::light, light);
-  EXPECT_EQ(light.lloyd_iterations, p.spheres.lloyd_iterations);
-  EXPECT_EQ(light.medial_spacing, p.spheres.medial_spacing);
-  EXPECT_EQ(light.cover_spacing, p.spheres.cover_spacing);
+  EXPECT_EQ(light.reduction.lloyd_iterations, p.spheres.reduction.lloyd_iterations);
+  EXPECT_EQ(light.sampling.medial_spacing, p.spheres.sampling.medial_spacing);
+  EXPECT_EQ(light.sampling.cover_spacing, p.spheres.sampling.cover_spacing);
   EXPECT_GE(p.spheres.time_limit, 1e9);
 }
 

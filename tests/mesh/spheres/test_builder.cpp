@@ -38,31 +38,22 @@ std::vector<Case> cases() {
           {"torus", icd::make_torus(1.0, 0.3, 24, 12)}};
 }
 
-SphereTreeOptions small_options(ReductionMethod method = SphereTreeOptions{}.reduction);
-
-/// The reduction methods every tree-level guarantee is checked for.
-const std::vector<std::pair<std::string, ReductionMethod>> kMethods = {
-    {"split_lloyd", ReductionMethod::split_lloyd}, {"merge_burst", ReductionMethod::merge_burst}};
-
-/// The builds of cases(), made once per test program (each takes seconds).
-const SphereTreeBuild& cached_build(const Case& c,
-                                    ReductionMethod method = SphereTreeOptions{}.reduction) {
-  static std::map<std::pair<std::string, ReductionMethod>, SphereTreeBuild> builds;
-  const auto key = std::make_pair(c.name, method);
-  auto it = builds.find(key);
-  if (it == builds.end())
-    it = builds.emplace(key, build_sphere_tree(c.mesh, small_options(method))).first;
-  return it->second;
-}
-
-SphereTreeOptions small_options(ReductionMethod method) {
+SphereTreeOptions small_options() {
   SphereTreeOptions o;
   o.branching = 4;
   o.depth = 2;
-  o.cover_spacing = 1.0 / 80;
-  o.medial_spacing = 1.0 / 20;
-  o.reduction = method;
+  o.sampling.cover_spacing = 1.0 / 80;
+  o.sampling.medial_spacing = 1.0 / 20;
   return o;
+}
+
+/// The builds of cases(), made once per test program (each takes seconds).
+const SphereTreeBuild& cached_build(const Case& c) {
+  static std::map<std::string, SphereTreeBuild> builds;
+  auto it = builds.find(c.name);
+  if (it == builds.end())
+    it = builds.emplace(c.name, build_sphere_tree(c.mesh, small_options())).first;
+  return it->second;
 }
 
 /// Random surface points, uniform by area (independent of the builder's lattice).
@@ -166,52 +157,47 @@ TEST(SphereTreeBuilder, LayoutIsBreadthFirstWithContiguousChildren) {
 }
 
 TEST(SphereTreeBuilder, EveryNodeCoversItsSamplesWithMarginAndChildrenDivideThem) {
-  for (const auto& [method_name, method] : kMethods)
-    for (const auto& c : cases()) {
-      SCOPED_TRACE(c.name + " " + method_name);
-      const SphereTreeBuild& build = cached_build(c, method);
-      expect_nodes_cover_and_children_divide(build);
-      ASSERT_FALSE(build.node_samples.empty());
-      EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()),
-                build.samples.points.rows());
-    }
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    expect_nodes_cover_and_children_divide(build);
+    ASSERT_FALSE(build.node_samples.empty());
+    EXPECT_EQ(static_cast<Eigen::Index>(build.node_samples[0].size()), build.samples.points.rows());
+  }
 }
 
 TEST(SphereTreeBuilder, EveryLevelCoversAnIndependentDenseSampling) {
-  for (const auto& [method_name, method] : kMethods)
-    for (const auto& c : cases()) {
-      SCOPED_TRACE(c.name + " " + method_name);
-      const SphereTreeBuild& build = cached_build(c, method);
-      const auto& tree = build.tree;
-      const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
-      for (int l = 0; l < tree.num_levels(); ++l)
-        EXPECT_EQ(uncovered_on_level(tree, l, P), 0) << "level " << l;
-    }
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto& tree = build.tree;
+    const icd::MatX3d P = dense_random_points(c.mesh, 20000, 7);
+    for (int l = 0; l < tree.num_levels(); ++l)
+      EXPECT_EQ(uncovered_on_level(tree, l, P), 0) << "level " << l;
+  }
 }
 
 TEST(SphereTreeBuilder, ErrorDecreasesFromLevelToLevel) {
   EvaluationOptions eval;
   eval.coverage_spacing = 10.0;
-  for (const auto& [method_name, method] : kMethods)
-    for (const auto& c : cases()) {
-      SCOPED_TRACE(c.name + " " + method_name);
-      const SphereTreeBuild& build = cached_build(c, method);
-      const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
-      ASSERT_EQ(metrics.size(), 3u);
-      for (size_t l = 1; l < metrics.size(); ++l) {
-        // The sphere is already fitted exactly by its root (error = margin only).
-        const double slack = c.name == "icosphere" ? 0.01 * 2000 : 0.0;
-        EXPECT_LE(metrics[l].mean_error_162, metrics[l - 1].mean_error_162 + slack)
-            << "level " << l;
-        EXPECT_LE(metrics[l].worst_error_162, metrics[l - 1].worst_error_162 + slack)
-            << "level " << l;
-        if (c.name != "icosphere") {
-          EXPECT_LT(metrics[l].mean_error_162, 0.8 * metrics[l - 1].mean_error_162);
-        }
-        EXPECT_EQ(metrics[l].num_uncovered_samples, 0);
-        EXPECT_EQ(metrics[l].num_uncovered_vertices, 0);
+  for (const auto& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const SphereTreeBuild& build = cached_build(c);
+    const auto metrics = evaluate_sphere_tree(c.mesh, build.tree, eval);
+    ASSERT_EQ(metrics.size(), 3u);
+    for (size_t l = 1; l < metrics.size(); ++l) {
+      // The sphere is already fitted exactly by its root (error = margin only).
+      const double slack = c.name == "icosphere" ? 0.01 * 2000 : 0.0;
+      EXPECT_LE(metrics[l].mean_error_162, metrics[l - 1].mean_error_162 + slack) << "level " << l;
+      EXPECT_LE(metrics[l].worst_error_162, metrics[l - 1].worst_error_162 + slack)
+          << "level " << l;
+      if (c.name != "icosphere") {
+        EXPECT_LT(metrics[l].mean_error_162, 0.8 * metrics[l - 1].mean_error_162);
       }
+      EXPECT_EQ(metrics[l].num_uncovered_samples, 0);
+      EXPECT_EQ(metrics[l].num_uncovered_vertices, 0);
     }
+  }
 }
 
 SphereTreeOptions lossy_leaf_options();
@@ -226,9 +212,8 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
   for (const Case& c : cases()) {
     for (int variant = 0; variant < 2; ++variant) {
       SCOPED_TRACE(c.name + (variant == 0 ? " small options" : " lossy options"));
-      SphereTreeOptions o =
-          variant == 0 ? small_options(ReductionMethod::split_lloyd) : lossy_leaf_options();
-      o.joint_leaf_refinement = true;
+      SphereTreeOptions o = variant == 0 ? small_options() : lossy_leaf_options();
+      o.reduction.joint_leaf_refinement = true;
       const SphereTreeBuild build = build_sphere_tree(c.mesh, o);
       const auto& tree = build.tree;
       EXPECT_NO_THROW(icd::collision::validate(tree));
@@ -242,18 +227,18 @@ TEST(SphereTreeBuilder, JointLeafRefinementKeepsEveryGuarantee) {
 }
 
 /// Options of the leaf-budget tests: the icosphere's coarse medial samples
-/// with branching 8 make the top-down pass lose leaves, so the fill and the
-/// worst-leaf split have free slots to use.
+/// with branching 8 make the top-down pass lose leaves, so the worst-leaf
+/// split has free slots to use.
 SphereTreeOptions lossy_leaf_options() {
-  SphereTreeOptions o = small_options(ReductionMethod::split_lloyd);
+  SphereTreeOptions o = small_options();
   o.branching = 8;
-  o.medial_spacing = 1.0 / 6;
-  o.worst_split.measure_directions = 300;
-  o.worst_split.choice_directions = 100;
-  // The cases below were set up (to exercise fills, failed tries and
-  // re-divisions) with the fixed-split leaf allocation.
-  o.leaf_worst_target = 0;
-  o.leaf_worst_factor = 0;
+  o.sampling.medial_spacing = 1.0 / 6;
+  o.worst_split.options.measure_directions = 300;
+  o.worst_split.options.choice_directions = 100;
+  // The cases below were set up (to exercise splits and failed tries) with
+  // the fixed-split leaf allocation.
+  o.allocation.leaf_worst_target = 0;
+  o.allocation.leaf_worst_factor = 0;
   return o;
 }
 
@@ -300,130 +285,13 @@ void expect_worst_split_guarantees(const SphereTreeBuild& plain, const SphereTre
   expect_nodes_cover_and_children_divide(build);
   expect_every_level_covers(tree, mesh, seed);
   const MeshOracle oracle(mesh);
-  const icd::MatX3d dirs = spiral_directions(o.worst_split.measure_directions);
+  const icd::MatX3d dirs = spiral_directions(o.worst_split.options.measure_directions);
   const double before = leaf_worst_protrusion(plain.tree, oracle, dirs);
   const double after = leaf_worst_protrusion(tree, oracle, dirs);
   EXPECT_NEAR(r.worst_before, before, 1e-12);
   EXPECT_NEAR(r.worst_after, after, 1e-12);
   EXPECT_LE(after, before);
   EXPECT_LE(r.worst_after, r.worst_before);
-}
-
-TEST(SphereTreeBuilder, FillLeafBudgetKeepsEveryGuaranteeAndTheCap) {
-  // Splitting leaves to spend the lost budget. On this sphere (coarse medial
-  // samples, branching 8) the top-down pass loses leaves and the fill splits
-  // some: the leaf level never exceeds its cap nor a parent its branching,
-  // every node covers its samples with margin, children divide their
-  // parent's samples (so each parent covers the union of its children's
-  // patches), and every level covers a dense random sampling (brute force).
-  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = lossy_leaf_options();
-  o.split_worst = false;  // counts the fill's splits alone
-  const SphereTreeBuild plain = build_sphere_tree(sphere, o);
-  o.fill_leaf_budget = true;
-  const SphereTreeBuild build = build_sphere_tree(sphere, o);
-  const auto& tree = build.tree;
-  EXPECT_NO_THROW(icd::collision::validate(tree));
-  ASSERT_EQ(tree.num_levels(), 3);
-  EXPECT_GT(build.num_budget_splits, 0) << "the case must exercise the fill";
-  const int leaves = tree.level_offset[3] - tree.level_offset[2];
-  EXPECT_EQ(leaves,
-            plain.tree.level_offset[3] - plain.tree.level_offset[2] + build.num_budget_splits);
-  EXPECT_LE(leaves, 64);
-  expect_nodes_cover_and_children_divide(build);
-  for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-  expect_every_level_covers(tree, sphere, 13);
-}
-
-/// Leaves of `build` all of whose samples some other leaf covers with margin,
-/// that leaf's ancestors too (brute force over every leaf and ancestor).
-int leaves_covered_by_others(const SphereTreeBuild& build) {
-  const auto& tree = build.tree;
-  const auto& P = build.samples.points;
-  const int leaf_level = tree.num_levels() - 1;
-  std::vector<int> parent(static_cast<size_t>(tree.num_nodes()), -1);
-  for (int i = 0; i < tree.num_nodes(); ++i) {
-    for (int k = 0; k < tree.child_count[i]; ++k) parent[tree.first_child[i] + k] = i;
-  }
-  auto covers = [&](int node, int s) {
-    return (P.row(s).transpose() - tree.spheres[node].center()).norm() + build.samples.gap[s] <=
-           tree.spheres[node].r;
-  };
-  int count = 0;
-  for (int i = tree.level_offset[leaf_level]; i < tree.num_nodes(); ++i) {
-    bool all = true;
-    for (int s : build.node_samples[i]) {
-      bool found = false;
-      for (int j = tree.level_offset[leaf_level]; j < tree.num_nodes() && !found; ++j) {
-        if (j == i || !covers(j, s)) continue;
-        found = true;
-        for (int a = parent[j]; a >= 0 && found; a = parent[a]) found = covers(a, s);
-      }
-      if (!found) {
-        all = false;
-        break;
-      }
-    }
-    count += all ? 1 : 0;
-  }
-  return count;
-}
-
-TEST(SphereTreeBuilder, PruneRedundantLeavesRemovesOnlyThemAndKeepsEveryGuarantee) {
-  // With the protrusion polish and split_worst off, the pruning (and the fill
-  // of the slots it frees) is the last change to the leaves. Every leaf it
-  // removes was one whose samples other leaves (and their ancestors) cover
-  // with margin, counted by brute force on the same build without it; the
-  // independent evaluation finds fewer leaves that cover nothing alone; no
-  // inner node grows; and the tree keeps its caps, branching and coverage.
-  // On the torus (coarse medial samples, branching 8) the boundary exchanges
-  // leave 40 of 64 leaves covered by others; on the box with depth 3, 28 of
-  // 139, and 5 more covered by leaves whose ancestors do not cover the
-  // sample (which the pruning must not use).
-  struct PruneCase {
-    icd::SurfaceMesh mesh;
-    int depth;
-  };
-  const std::vector<PruneCase> prune_cases = {{icd::make_torus(1.0, 0.3, 24, 12), 2},
-                                              {icd::make_box_surface({0, 0, 0}, {2, 1, 0.6}), 3}};
-  for (const PruneCase& c : prune_cases) {
-    SCOPED_TRACE("depth " + std::to_string(c.depth));
-    SphereTreeOptions o = lossy_leaf_options();
-    o.depth = c.depth;
-    o.protrusion_polish = false;
-    o.split_worst = false;
-    const SphereTreeBuild plain = build_sphere_tree(c.mesh, o);
-    o.prune_redundant_leaves = true;
-    const SphereTreeBuild build = build_sphere_tree(c.mesh, o);
-    const auto& tree = build.tree;
-    const int redundant = leaves_covered_by_others(plain);
-    EXPECT_GT(build.num_pruned, 0) << "the case must exercise the pruning";
-    EXPECT_LE(build.num_pruned, redundant);
-    const int leaf_level = tree.num_levels() - 1;
-    EXPECT_EQ(tree.num_nodes() - tree.level_offset[leaf_level],
-              plain.tree.num_nodes() - plain.tree.level_offset[leaf_level] - build.num_pruned +
-                  build.num_budget_splits);
-    EXPECT_LT(leaves_covered_by_others(build), redundant);
-    // A sample moves only to a leaf whose ancestors cover it already: no inner
-    // node grows (the inner levels keep their nodes and centres).
-    ASSERT_EQ(tree.level_offset[leaf_level], plain.tree.level_offset[leaf_level]);
-    for (int i = 0; i < tree.level_offset[leaf_level]; ++i) {
-      EXPECT_EQ(tree.spheres[i].center(), plain.tree.spheres[i].center());
-      EXPECT_LE(tree.spheres[i].r, plain.tree.spheres[i].r) << "inner node " << i;
-    }
-    EvaluationOptions evaluation;
-    evaluation.coverage_spacing = 10;
-    evaluation.shell_samples = 0;
-    EXPECT_LT(evaluate_sphere_tree(c.mesh, tree, evaluation).back().num_redundant_spheres,
-              evaluate_sphere_tree(c.mesh, plain.tree, evaluation).back().num_redundant_spheres);
-    EXPECT_NO_THROW(icd::collision::validate(tree));
-    for (int i = 0; i < tree.num_nodes(); ++i) EXPECT_LE(tree.child_count[i], o.branching);
-    long long cap = 1;
-    for (int l = 0; l < c.depth; ++l) cap *= o.branching;
-    EXPECT_LE(tree.num_nodes() - tree.level_offset[leaf_level], cap);
-    expect_nodes_cover_and_children_divide(build);
-    expect_every_level_covers(tree, c.mesh, 29);
-  }
 }
 
 TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst) {
@@ -438,9 +306,9 @@ TEST(SphereTreeBuilder, SplitWorstKeepsEveryGuaranteeAndNeverRaisesTheTrueWorst)
   // equals the reported one and is not above the start's.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
   SphereTreeOptions o = lossy_leaf_options();
-  o.split_worst = false;
+  o.worst_split.enabled = false;
   const SphereTreeBuild plain = build_sphere_tree(sphere, o);
-  o.split_worst = true;
+  o.worst_split.enabled = true;
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
   const auto& tree = build.tree;
   EXPECT_NO_THROW(icd::collision::validate(tree));
@@ -464,20 +332,20 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
   // levels: the starting mean, and sum_after <= sum_before + splits * mean.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
   SphereTreeOptions o = lossy_leaf_options();
-  o.worst_split.relief_fraction = 2.0;
+  o.worst_split.options.relief_fraction = 2.0;
   const SphereTreeBuild plain = [&] {
     SphereTreeOptions p = o;
-    p.split_worst = false;
+    p.worst_split.enabled = false;
     return build_sphere_tree(sphere, p);
   }();
-  o.split_worst = true;
+  o.worst_split.enabled = true;
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
   const auto& result = build.worst_split;
   EXPECT_GT(result.splits, 0) << "the case must exercise the split";
   EXPECT_EQ(result.merges, 0);
   const MeshOracle oracle(sphere);
-  const icd::MatX3d measure = spiral_directions(o.worst_split.measure_directions);
-  const icd::MatX3d choice = spiral_directions(o.worst_split.choice_directions);
+  const icd::MatX3d measure = spiral_directions(o.worst_split.options.measure_directions);
+  const icd::MatX3d choice = spiral_directions(o.worst_split.options.choice_directions);
   auto leaf_sum = [&](const icd::collision::SphereTree& tree, const icd::MatX3d& dirs) {
     const std::vector<double> e = leaf_protrusions(tree, oracle, dirs);
     return std::accumulate(e.begin(), e.end(), 0.0);
@@ -490,66 +358,14 @@ TEST(SphereTreeBuilder, SplitWorstBelowTheReliefBandDoesNotRaiseTheMeanBeyondIts
   EXPECT_EQ(build.tree.num_nodes() - build.tree.level_offset[2], plain_leaves + result.splits);
 }
 
-TEST(SphereTreeBuilder, SplitWorstStopReliefWhenStuckClosesTheBandAtItsFirstFailure) {
-  // With stop_relief_when_stuck the relief band closes at its first failed
-  // try: at most one failure is counted, never more tries than without it,
-  // and every guarantee holds. The case must fail in the band at least twice
-  // without the option, so that the option has something to stop.
-  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = lossy_leaf_options();
-  o.max_spheres_per_level = {1, 8, 40};
-  o.worst_split.relief_fraction = 0.5;
-  const SphereTreeBuild open = build_sphere_tree(sphere, o);
-  const auto& a = open.worst_split;
-  ASSERT_GE(a.relief_no_split + a.relief_no_merge, 2) << "the case must fail in the band twice";
-  o.worst_split.stop_relief_when_stuck = true;
-  const SphereTreeBuild build = build_sphere_tree(sphere, o);
-  const auto& b = build.worst_split;
-  EXPECT_LE(b.relief_no_split + b.relief_no_merge, 1);
-  EXPECT_LE(b.tries, a.tries);
-  EXPECT_LE(b.worst_after, b.worst_before);
-  const auto& tree = build.tree;
-  EXPECT_NO_THROW(icd::collision::validate(tree));
-  EXPECT_LE(tree.num_nodes() - tree.level_offset[2], 40);
-  expect_nodes_cover_and_children_divide(build);
-  expect_every_level_covers(tree, sphere, 23);
-}
-
-TEST(SphereTreeBuilder, SplitWorstRedivideWithASiblingKeepsEveryGuarantee) {
-  // The case of the test above fails in the relief band: re-dividing the
-  // stuck leaf together with a sibling (redivide_siblings) must happen at
-  // least once and keep every guarantee: the leaf count bookkeeping (a
-  // re-division keeps it: plain + splits - merges), the cap and branching,
-  // the true worst on the measuring directions (recomputed here) equal to the
-  // reported one and not above the start's (recomputed on the build without
-  // the split), coverage with margin, children dividing their parent's
-  // samples, and every level covering a dense random sampling.
-  const icd::SurfaceMesh sphere = icd::make_icosphere(2);
-  SphereTreeOptions o = lossy_leaf_options();
-  o.max_spheres_per_level = {1, 8, 40};
-  o.worst_split.relief_fraction = 0.5;
-  o.worst_split.redivide_siblings = 3;
-  SphereTreeOptions p = o;
-  p.split_worst = false;
-  const SphereTreeBuild plain = build_sphere_tree(sphere, p);
-  const SphereTreeBuild build = build_sphere_tree(sphere, o);
-  const auto& r = build.worst_split;
-  EXPECT_GT(r.redivisions, 0) << "the case must exercise the re-division";
-  EXPECT_NO_THROW(icd::collision::validate(build.tree));
-  ASSERT_EQ(build.tree.num_levels(), 3);
-  expect_worst_split_guarantees(plain, build, sphere, o, 40, 29);
-  o.worst_split.redivide_siblings = -1;
-  EXPECT_THROW(build_sphere_tree(sphere, o), icd::ParameterError);
-}
-
 TEST(SphereTreeBuilder, SplitWorstRejectsBadOptions) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   SphereTreeOptions o = small_options();
-  o.split_worst = true;
-  o.worst_split.measure_directions = 0;
+  o.worst_split.enabled = true;
+  o.worst_split.options.measure_directions = 0;
   EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
-  o.worst_split.measure_directions = 10;
-  o.worst_split.max_tries = -1;
+  o.worst_split.options.measure_directions = 10;
+  o.worst_split.options.max_tries = -1;
   EXPECT_THROW(build_sphere_tree(box, o), icd::ParameterError);
 }
 
@@ -561,16 +377,16 @@ TEST(SphereTreeBuilder, ProtrusionPolishNeverRaisesANodesError) {
   // some protrude less.
   const Case torus = cases()[2];
   SphereTreeOptions o = small_options();
-  o.split_worst = false;  // the polish is then the last step
+  o.worst_split.enabled = false;  // the polish is then the last step
   const SphereTreeBuild polished = build_sphere_tree(torus.mesh, o);
-  o.protrusion_polish = false;
+  o.polish.enabled = false;
   const SphereTreeBuild plain = build_sphere_tree(torus.mesh, o);
   ASSERT_EQ(plain.tree.num_nodes(), polished.tree.num_nodes());
   EXPECT_EQ(plain.tree.level_offset, polished.tree.level_offset);
   EXPECT_EQ(plain.node_samples.front(), polished.node_samples.front());
   EXPECT_GT(polished.num_polished, 0);
   const MeshOracle oracle(torus.mesh);
-  const icd::MatX3d check = spiral_directions(o.protrusion.check_directions);
+  const icd::MatX3d check = spiral_directions(o.polish.protrusion.check_directions);
   double sum_plain = 0, sum_polished = 0;
   for (int i = 0; i < plain.tree.num_nodes(); ++i) {
     const auto& a = plain.tree.spheres[i];
@@ -650,10 +466,10 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   const icd::SurfaceMesh torus = icd::make_torus(1.0, 0.3, 24, 12);
   SphereTreeOptions o = small_options();
   o.max_spheres_per_level = {1, 4, 10};
-  o.split_worst = false;  // the steps after the allocation are tested elsewhere
-  o.protrusion_polish = false;
-  o.leaf_worst_target = 0;  // the fixed split
-  o.leaf_worst_factor = 0;
+  o.worst_split.enabled = false;  // the steps after the allocation are tested elsewhere
+  o.polish.enabled = false;
+  o.allocation.leaf_worst_target = 0;  // the fixed split
+  o.allocation.leaf_worst_factor = 0;
   const SphereTreeBuild plain = build_sphere_tree(torus, o);
   ASSERT_EQ(plain.allocated_worst_bound.size(), 2u);
   const double scale = (torus.V.colwise().maxCoeff() - torus.V.colwise().minCoeff()).maxCoeff();
@@ -661,7 +477,7 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
   ASSERT_GT(target, 0);
   for (const double relative : {target / scale, 1e-9}) {
     SCOPED_TRACE(relative);
-    o.leaf_worst_target = relative;
+    o.allocation.leaf_worst_target = relative;
     const SphereTreeBuild build = build_sphere_tree(torus, o);
     const auto& tree = build.tree;
     EXPECT_NO_THROW(icd::collision::validate(tree));
@@ -677,16 +493,16 @@ TEST(SphereTreeBuilder, LeafWorstTargetMeetsAFeasibleThresholdAndKeepsEveryGuara
     expect_every_level_covers(tree, torus, 19);
   }
   // The same threshold as a factor on the fixed split's own bound.
-  o.leaf_worst_target = 0;
-  o.leaf_worst_factor = 1.2;
+  o.allocation.leaf_worst_target = 0;
+  o.allocation.leaf_worst_factor = 1.2;
   const SphereTreeBuild by_factor = build_sphere_tree(torus, o);
   ASSERT_EQ(by_factor.allocated_worst_bound.size(), 2u);
   EXPECT_LE(by_factor.allocated_worst_bound[1], target * (1 + 1e-12));
   expect_nodes_cover_and_children_divide(by_factor);
-  o.leaf_worst_factor = -1;
+  o.allocation.leaf_worst_factor = -1;
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
-  o.leaf_worst_factor = 0;
-  o.leaf_worst_target = -0.1;
+  o.allocation.leaf_worst_factor = 0;
+  o.allocation.leaf_worst_target = -0.1;
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
 }
 
@@ -702,7 +518,7 @@ TEST(SphereTreeBuilder, BuildBranchingRegroupsToTheBranchingAndKeepsEveryGuarant
   o.branching = 3;
   o.depth = 3;
   o.max_spheres_per_level = {1, 3, 7, 19};
-  o.build_branching = 8;
+  o.allocation.build_branching = 8;
   o.threads = 1;
   const SphereTreeBuild build = build_sphere_tree(torus, o);
   const auto& tree = build.tree;
@@ -718,7 +534,7 @@ TEST(SphereTreeBuilder, BuildBranchingRegroupsToTheBranchingAndKeepsEveryGuarant
   const SphereTreeBuild threaded = build_sphere_tree(torus, o);
   EXPECT_EQ(threaded.node_samples, build.node_samples);
   EXPECT_EQ(threaded.tree.child_count, tree.child_count);
-  o.build_branching = 2;  // below the branching
+  o.allocation.build_branching = 2;  // below the branching
   EXPECT_THROW(build_sphere_tree(torus, o), icd::ParameterError);
 }
 
@@ -734,9 +550,9 @@ TEST(SphereTreeBuilder, RegroupParentsKeepsTheLeavesAndEveryGuarantee) {
   // joint pass moves leaves across parents.
   const icd::SurfaceMesh sphere = icd::make_icosphere(2);
   SphereTreeOptions o = lossy_leaf_options();
-  o.joint_leaf_refinement = true;
+  o.reduction.joint_leaf_refinement = true;
   const SphereTreeBuild plain = build_sphere_tree(sphere, o);
-  o.regroup_parents = true;
+  o.allocation.regroup_parents = true;
   const SphereTreeBuild build = build_sphere_tree(sphere, o);
   const auto& tree = build.tree;
   EXPECT_NO_THROW(icd::collision::validate(tree));
