@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/input_file.hpp>
 
 namespace icd::collision {
 namespace {
@@ -30,6 +31,7 @@ long long complete_count(int levels, int branch, long long cap) {
 bool next_content_line(std::istream& in, std::string& line, long long& line_no) {
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.starts_with(kUtf8Bom)) line.erase(0, kUtf8Bom.size());
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos) continue;
     if (line[first] == '#') continue;
@@ -139,6 +141,7 @@ SphereTree read_sph(std::istream& in, const std::string& name, const SphReadOpti
 }
 
 SphereTree read_sph(const std::string& path, const SphReadOptions& options) {
+  check_input_file(path, file_limits::kSph, "sphere tree");
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open file");
   return read_sph(in, path, options);

@@ -25,12 +25,14 @@ struct SphReadOptions {
 /// Throws icd::InputError for a malformed header, a count of node lines that
 /// differs from the header, non-numeric or non-finite values, an unused root,
 /// or a used node below an unused parent. Memory grows only with the lines
-/// actually read, never from the header count.
+/// actually read, never from the header count. A UTF-8 byte-order mark at the
+/// start is skipped.
 SphereTree read_sph(std::istream& in, const std::string& name = "<stream>",
                     const SphReadOptions& options = {});
 
 /// Reads a `.sph` file (see read_sph(std::istream&...)); throws icd::InputError
-/// if the file cannot be opened.
+/// if the file is missing, not a regular file, or larger than
+/// icd::file_limits::kSph, before reading it.
 SphereTree read_sph(const std::string& path, const SphReadOptions& options = {});
 
 /// Writes `tree` (its current spheres) as `.sph`: levels = tree.num_levels(),

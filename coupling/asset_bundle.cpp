@@ -4,16 +4,16 @@
 #include <array>
 #include <bit>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <icd/mesh/io/atomic_write.hpp>
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/input_file.hpp>
 #include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
 #include <icd/mesh/io/vtk_writer.hpp>
 #include <icd/mesh/io/vtu_reader.hpp>
 
@@ -217,15 +217,7 @@ std::vector<collision::Sphere> unflatten(const std::vector<double>& v) {
 }
 
 std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open the asset bundle file");
-  in.seekg(0, std::ios::end);
-  const auto size = static_cast<std::size_t>(in.tellg());
-  in.seekg(0);
-  std::string bytes(size, '\0');
-  in.read(bytes.data(), static_cast<std::streamsize>(size));
-  if (!in) throw InputError(path.string() + ": read error");
-  return bytes;
+  return read_input_file(path, file_limits::kBundle, "asset bundle file");
 }
 
 void check_consistent(const AssetBundle& b) {

@@ -32,7 +32,8 @@
 /// "asc_off", "asc_node" (int32), "asc_dist" (float64).
 ///
 /// Loading refuses, with an InputError naming the file and what is wrong, a
-/// missing file, a wrong magic or version, a truncated file (header or any
+/// missing file, a file that is not a regular file or above its size limit
+/// (icd::file_limits::kBundle, kVtu), a wrong magic or version, a truncated file (header or any
 /// section shorter than announced), a checksum mismatch, sections with
 /// unexpected names/types/lengths, VTU meshes whose fingerprints differ from
 /// the ones recorded (files mixed from different runs), and inconsistent

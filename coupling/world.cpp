@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include <icd/collision/aabb_tree.hpp>
 #include <icd/collision/sphere_update.hpp>
@@ -26,6 +28,33 @@ double mechanical_energy(fem::Simulator& sim, const Eigen::Vector3d& gravity) {
   const MatX3d& x = sim.positions();
   return model.kinetic_energy(sim.velocities()) + sim.model().elastic().energy(x) -
          (x.transpose() * model.mass()).dot(gravity);
+}
+
+// Runs `f` and returns its result; a failure it reports gets who() (e.g.
+// `object "left"`) in front of its message, keeping its type.
+template <class W, class F>
+auto prefixing_failures(W&& who, F&& f) {
+  try {
+    return f();
+  } catch (const NumericalError& e) {
+    throw NumericalError(who() + ": " + e.what());
+  } catch (const InputError& e) {
+    throw InputError(who() + ": " + e.what());
+  } catch (const ParameterError& e) {
+    throw ParameterError(who() + ": " + e.what());
+  }
+}
+
+// The failures of object `o` (FEM) and of the contact between `a` and `b`.
+template <class F>
+auto naming(const RuntimeObject& o, F&& f) {
+  return prefixing_failures([&] { return "object \"" + o.setup.name + "\""; }, std::forward<F>(f));
+}
+template <class F>
+auto naming(const RuntimeObject& a, const RuntimeObject& b, F&& f) {
+  return prefixing_failures(
+      [&] { return "objects \"" + a.setup.name + "\" and \"" + b.setup.name + "\""; },
+      std::forward<F>(f));
 }
 
 }  // namespace
@@ -58,7 +87,8 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
       fem::ModelOptions mo;
       mo.damping = o.setup.damping;
       mo.gravity = m_settings.gravity;
-      fem::Model model(o.rest, o.asset.coarse.T, o.setup.material, mo);
+      fem::Model model =
+          naming(o, [&] { return fem::Model(o.rest, o.asset.coarse.T, o.setup.material, mo); });
       for (int n : o.setup.fixed_nodes)
         if (n < 0 || n >= model.num_nodes())
           throw InputError("object \"" + o.setup.name + "\": fixed node " + std::to_string(n) +
@@ -70,7 +100,7 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
       so.max_step = 1.0 / m_settings.frame_rate;
       so.frequency_reuse_time = 1.0 / m_settings.frame_rate;  // one estimate per frame
       if (m_plan.response) so.frequency.contact_stiffness = cs.contact.stiffness;
-      o.sim = std::make_unique<fem::Simulator>(std::move(model), so);
+      o.sim = naming(o, [&] { return std::make_unique<fem::Simulator>(std::move(model), so); });
       MatX3d v(o.rest.rows(), 3);
       v.rowwise() = o.setup.velocity.transpose();
       for (int n : o.setup.fixed_nodes) v.row(n).setZero();
@@ -144,7 +174,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
         o.sim->set_external_forces(o.contact_forces);
       // The forces are constant over the cycle: their work is f . x1 - f . x0.
       if (track_work) m_contact_work -= o.contact_forces.cwiseProduct(o.positions).sum();
-      const fem::AdvanceReport rep = o.sim->advance(h);
+      const fem::AdvanceReport rep = naming(o, [&] { return o.sim->advance(h); });
       o.positions = o.sim->positions();
       if (track_work) m_contact_work += o.contact_forces.cwiseProduct(o.positions).sum();
       m.substeps += rep.substeps;
@@ -248,9 +278,10 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       if (previous && !reuse && m_complete_depth[p] > 0)
         co.max_untested_penetration = m_complete_depth[p];
       if (reuse) ++m.reused;
-      const ContactStats st = apply_contact_forces(
-          a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : r, co, a.contact_forces,
-          b.contact_forces);
+      const ContactStats st = naming(a, b, [&] {
+        return apply_contact_forces(a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : r, co,
+                                    a.contact_forces, b.contact_forces);
+      });
       if (!r.interrupted) m_complete_depth[p] = st.max_penetration;
       m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
       m_penalty_energy += st.penalty_energy;

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   cli.path("--out", out, "DIR", "results folder (default: results/main)")
       .path("--scene", scene_path, "FILE",
             "scene to run (default: experiments/scenes/bunny_dragon.json)")
-      .integer("--frames", frames, "N", "override the scene's frame count", 0);
+      .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     const icd::runner::Scene scene = icd::runner::load_scene(scene_path);

@@ -8,6 +8,7 @@
 #include <exception>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/core/mesh_stats.hpp>
@@ -50,17 +51,25 @@ void print_stats(const std::string& file, const icd::ReadReport& report, double 
   row("components", std::to_string(s.components));
   row("Euler characteristic", std::to_string(s.euler_characteristic));
   for (const std::string& note : report.notes) row("note", note);
+  for (const std::string& warning : report.warnings) row("warning", warning);
 }
 
 // A VTU file: its cells decide what it holds.
 void print_vtu(const std::string& file) {
   const auto t0 = std::chrono::steady_clock::now();
-  const icd::VtuData d = icd::read_vtu(file);
+  std::vector<uint8_t> types;
+  std::vector<std::string> point_data;  // (not the whole VtuData: the file is read again below)
+  {
+    icd::VtuData d = icd::read_vtu(file);
+    types = std::move(d.types);
+    for (const auto& a : d.point_data)
+      point_data.push_back(a.name + " (" + std::to_string(a.values.cols()) + " components)");
+  }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const auto all = [&](int type) {
-    return !d.types.empty() &&
-           std::all_of(d.types.begin(), d.types.end(), [&](uint8_t t) { return t == type; });
+    return !types.empty() &&
+           std::all_of(types.begin(), types.end(), [&](uint8_t t) { return t == type; });
   };
   icd::ReadReport report;
   report.format = "VTU";
@@ -84,8 +93,7 @@ void print_vtu(const std::string& file) {
   } else {
     throw icd::InputError(file + ": cells are not all tetrahedra, triangles or vertices");
   }
-  for (const auto& a : d.point_data)
-    row("point data", a.name + " (" + std::to_string(a.values.cols()) + " components)");
+  for (const std::string& a : point_data) row("point data", a);
 }
 
 }  // namespace

@@ -104,6 +104,7 @@ Cli parse(int argc, char** argv) {
   Cli c;
   auto& o = c.options;
   std::vector<std::string> args(argv + 1, argv + argc);
+  std::string faces_option, fit_option;  // for the contradiction checks below
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const auto value = [&]() -> const std::string& {
@@ -121,7 +122,13 @@ Cli parse(int argc, char** argv) {
       o.tetrahedralize.cell_size = to_double(a, value());
     } else if (a == "--simplify-faces") {
       o.simplify.target_faces = to_int(a, value());
+      if (faces_option == "--simplify-ratio")
+        usage_error("--simplify-faces and --simplify-ratio contradict each other: give one");
+      faces_option = a;
     } else if (a == "--simplify-ratio") {
+      if (faces_option == "--simplify-faces")
+        usage_error("--simplify-faces and --simplify-ratio contradict each other: give one");
+      faces_option = a;
       o.simplify.target_faces = 0;
       o.simplify.target_ratio = to_double(a, value());
     } else if (a == "--max-hole-edges") {
@@ -153,6 +160,7 @@ Cli parse(int argc, char** argv) {
     } else if (a == "--sphere-branching") {
       o.spheres.branching = to_int(a, value());
     } else if (a == "--sphere-fit") {
+      fit_option = a;
       const std::string& f = value();
       try {
         c.fit = icd::mesh::parse_sphere_fit(f, "--sphere-fit");
@@ -177,6 +185,11 @@ Cli parse(int argc, char** argv) {
       usage_error("more than one input file ('" + c.input + "', '" + a + "')");
     }
   }
+  if (!fit_option.empty() && o.sphere_builder != icd::mesh::SphereBuilder::medial_axis)
+    usage_error(std::string("--sphere-fit and ") +
+                (o.sphere_builder == icd::mesh::SphereBuilder::octree ? "--spheres octree"
+                                                                      : "--spheres none") +
+                " contradict each other: --sphere-fit optimises a medial tree");
   icd::mesh::apply_sphere_fit(c.fit, o.spheres);  // after the loop: keeps --sphere-depth etc.
   if (!c.sph.empty() && o.sphere_builder == icd::mesh::SphereBuilder::none)
     usage_error("--sph needs a sphere tree (not --spheres none)");
@@ -235,6 +248,8 @@ int main(int argc, char** argv) {
     const auto t0 = Clock::now();
     icd::ReadReport read_report;
     const icd::SurfaceMesh dense = icd::read_surface_mesh(cli.input, &read_report);
+    for (const std::string& w : read_report.warnings)  // even with --quiet
+      std::fprintf(stderr, "icd-preprocess: warning: %s: %s\n", cli.input.c_str(), w.c_str());
     if (!cli.quiet)
       std::printf("[read] %s: %s, %lld vertices, %lld triangles (%.2f s)\n", cli.input.c_str(),
                   read_report.format.c_str(), static_cast<long long>(read_report.vertices),

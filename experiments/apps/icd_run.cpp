@@ -5,18 +5,19 @@
 #include <filesystem>
 #include <string>
 
-#include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
+#include <icd/mesh/core/input_file.hpp>
+#include "experiments/runner/run.hpp"
 
 namespace {
 
 void usage() {
   std::printf(
       "usage: icd-run SCENE.json [--out DIR] [--frames N] [--target-fps F] [--dry-run] [--quiet]\n"
-      "  --out DIR    results folder (default: results/<scene name>)\n"
-      "  --frames N   override the scene's frame count\n"
+      "  --out DIR    results folder (default: results/<scene name as a file name>)\n"
+      "  --frames N   override the scene's frame count (1 to 100000000)\n"
       "  --target-fps F  real-time mode at F frames per second (0 = off; overrides the scene)\n"
-      "  --dry-run    print the stages the scene needs, run nothing\n"
+      "  --dry-run    print the stages the scene needs and check its input files, run nothing\n"
       "  --quiet      no progress bar\n");
 }
 
@@ -34,9 +35,9 @@ int main(int argc, char** argv) {
     } else if (a == "--frames" && i + 1 < argc) {
       char* end = nullptr;
       const long v = std::strtol(argv[++i], &end, 10);
-      if (*end != '\0' || v < 0 || v > 100000000) {
-        std::fprintf(stderr, "icd-run: --frames: expected a non-negative integer, got '%s'\n",
-                     argv[i]);
+      if (end == argv[i] || *end != '\0' || v < 1 || v > 100000000) {  // as the scene's "frames"
+        std::fprintf(stderr, "icd-run: --frames: must be in [1, 100000000], got '%s'\n",
+                     icd::escape_bytes(argv[i]).c_str());
         return 2;
       }
       frames = static_cast<int>(v);
@@ -45,7 +46,7 @@ int main(int argc, char** argv) {
       target_fps = std::strtod(argv[++i], &end);
       if (*end != '\0' || !(target_fps >= 0 && target_fps <= 1e5)) {
         std::fprintf(stderr, "icd-run: --target-fps: expected a number in [0, 1e5], got '%s'\n",
-                     argv[i]);
+                     icd::escape_bytes(argv[i]).c_str());
         return 2;
       }
     } else if (a == "--dry-run") {
@@ -58,7 +59,7 @@ int main(int argc, char** argv) {
     } else if (scene_path.empty() && !a.empty() && a[0] != '-') {
       scene_path = a;
     } else {
-      std::fprintf(stderr, "icd-run: unknown argument '%s'\n", a.c_str());
+      std::fprintf(stderr, "icd-run: unknown argument '%s'\n", icd::escape_bytes(a).c_str());
       usage();
       return 2;
     }
@@ -79,10 +80,16 @@ int main(int argc, char** argv) {
           "  real-time mode: %g frames per second; collision detection gets what is left of each "
           "frame\n",
           fps);
-    if (dry) return 0;
+    if (dry) {
+      icd::runner::check_scene_inputs(scene);
+      std::printf("  input files: all present and within their size limits\n");
+      return 0;
+    }
     icd::runner::RunOptions opt;
-    opt.out_dir =
-        out.empty() ? std::filesystem::path("results") / scene.name : std::filesystem::path(out);
+    // The scene's name is a label: results/<name as one file name>, never a path.
+    opt.out_dir = out.empty()
+                      ? std::filesystem::path("results") / icd::runner::file_name_from(scene.name)
+                      : std::filesystem::path(out);
     opt.cache_dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
     opt.tool_dir = std::filesystem::canonical("/proc/self/exe").parent_path();
     opt.frames = frames;

@@ -1,12 +1,14 @@
 #include "experiments/runner/json.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
+#include <limits>
+#include <string>
 
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/input_file.hpp>
 
 namespace icd::runner {
 
@@ -19,7 +21,8 @@ namespace {
 
 class Parser {
  public:
-  Parser(std::string_view text, const std::string& source) : m_text(text), m_source(source) {}
+  Parser(std::string_view text, const std::string& source)
+      : m_text(strip_utf8_bom(text)), m_source(source) {}
 
   Json parse_document() {
     skip_ws();
@@ -60,6 +63,8 @@ class Parser {
 
   Json parse_value(int depth) {
     if (depth > 64) fail("nesting deeper than 64 levels");
+    if (++m_values > kMaxValues)
+      fail("more than " + std::to_string(kMaxValues) + " values (not a scene file?)");
     if (m_pos >= m_text.size()) fail("unexpected end of input, expected a value");
     const char c = m_text[m_pos];
     if (c == '{') return parse_object(depth);
@@ -69,7 +74,7 @@ class Parser {
     if (consume("false")) return Json(false);
     if (consume("null")) return Json();
     if (c == '-' || (c >= '0' && c <= '9')) return Json(parse_number());
-    fail(std::string("unexpected character '") + c + "', expected a value");
+    fail("unexpected character '" + escape_bytes(std::string_view(&c, 1)) + "', expected a value");
   }
 
   Json parse_object(int depth) {
@@ -92,7 +97,7 @@ class Parser {
       Json v = parse_value(depth + 1);
       if (obj.count(key)) {
         m_pos = key_pos;
-        fail("duplicate key \"" + key + "\"");
+        fail("duplicate key \"" + escape_bytes(key) + "\"");
       }
       obj.emplace(std::move(key), std::move(v));
       skip_ws();
@@ -138,7 +143,19 @@ class Parser {
     while (m_pos < m_text.size()) {
       const char c = m_text[m_pos++];
       if (c == '"') return out;
-      if (static_cast<unsigned char>(c) < 0x20) fail("control character in string");
+      if (static_cast<unsigned char>(c) < 0x20) {
+        --m_pos;
+        fail("control character " + escape_bytes(std::string_view(&c, 1)) + " in string");
+      }
+      if (static_cast<unsigned char>(c) >= 0x80) {  // RFC 8259: strings are UTF-8
+        --m_pos;
+        const size_t n = utf8_sequence_length(m_text.substr(m_pos));
+        if (n == 0)
+          fail("invalid UTF-8 byte " + escape_bytes(m_text.substr(m_pos, 1)) + " in string");
+        out.append(m_text.substr(m_pos, n));
+        m_pos += n;
+        continue;
+      }
       if (c != '\\') {
         out.push_back(c);
         continue;
@@ -232,17 +249,69 @@ class Parser {
       if (digits() == 0) fail("malformed number: digits expected in exponent");
     }
     double v = 0.0;
-    const auto res = std::from_chars(m_text.data() + start, m_text.data() + m_pos, v);
+    const std::string_view token = m_text.substr(start, m_pos - start);
+    const auto res = std::from_chars(token.data(), token.data() + token.size(), v);
+    if (res.ec == std::errc::result_out_of_range) return out_of_range_value(token);
     if (res.ec != std::errc() || !std::isfinite(v)) {
       m_pos = start;
-      fail("number out of range");
+      fail("malformed number");
     }
     return v;
   }
 
+  // A valid number token beyond the double range: +-infinity when it
+  // overflows, +-0 when it underflows (decided by its decimal exponent), so
+  // that the reader of the field can name it ("young: must be finite").
+  static double out_of_range_value(std::string_view token) {
+    const bool negative = token.starts_with('-');
+    const size_t e = token.find_first_of("eE");
+    const std::string_view mantissa =
+        token.substr(negative ? 1 : 0, e == token.npos ? token.npos : e - (negative ? 1 : 0));
+    // Decimal exponent of the first non-zero digit of the mantissa.
+    const size_t dot = mantissa.find('.');
+    const size_t int_digits = dot == mantissa.npos ? mantissa.size() : dot;
+    const size_t first = mantissa.find_first_not_of("0.");
+    int64_t magnitude = first == mantissa.npos ? 0
+                        : first < int_digits   ? static_cast<int64_t>(int_digits - first)
+                                               : -static_cast<int64_t>(first - int_digits - 1);
+    if (e != token.npos) {
+      int64_t exponent = 0;
+      size_t k = e + 1;
+      const bool exp_negative = k < token.size() && token[k] == '-';
+      if (k < token.size() && (token[k] == '-' || token[k] == '+')) ++k;
+      for (; k < token.size(); ++k)
+        exponent = std::min<int64_t>(exponent * 10 + (token[k] - '0'), int64_t{1} << 40);
+      magnitude += exp_negative ? -exponent : exponent;
+    }
+    const double big = std::numeric_limits<double>::infinity();
+    return magnitude > 0 ? (negative ? -big : big) : (negative ? -0.0 : 0.0);
+  }
+
+  // Length of the UTF-8 sequence at the start of `s` (first byte >= 0x80),
+  // or 0 if it is not a valid, shortest-form encoding of a scalar value.
+  static size_t utf8_sequence_length(std::string_view s) {
+    const auto b = [&](size_t i) { return static_cast<unsigned char>(s[i]); };
+    const unsigned char c = b(0);
+    const size_t n = c >= 0xC2 && c <= 0xDF   ? 2
+                     : c >= 0xE0 && c <= 0xEF ? 3
+                     : c >= 0xF0 && c <= 0xF4 ? 4
+                                              : 0;
+    if (n == 0 || s.size() < n) return 0;
+    for (size_t i = 1; i < n; ++i)
+      if ((b(i) & 0xC0) != 0x80) return 0;
+    if (c == 0xE0 && b(1) < 0xA0) return 0;   // overlong
+    if (c == 0xED && b(1) >= 0xA0) return 0;  // surrogate
+    if (c == 0xF0 && b(1) < 0x90) return 0;   // overlong
+    if (c == 0xF4 && b(1) >= 0x90) return 0;  // above U+10FFFF
+    return n;
+  }
+
+  static constexpr int64_t kMaxValues = int64_t{1} << 20;
+
   std::string_view m_text;
   const std::string& m_source;
   size_t m_pos = 0;
+  int64_t m_values = 0;
 };
 
 }  // namespace
@@ -252,12 +321,7 @@ Json parse_json(std::string_view text, const std::string& source) {
 }
 
 Json read_json_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": read error");
-  return parse_json(ss.str(), path);
+  return parse_json(read_input_file(path, file_limits::kScene, "scene file"), path);
 }
 
 }  // namespace icd::runner

@@ -1,6 +1,7 @@
 #pragma once
 /// A small, strict JSON reader for scene files (RFC 8259 minus surrogate
-/// pairs in \u escapes). Errors name the source, line and column.
+/// pairs in \u escapes). Errors name the source, line and column, and show
+/// raw bytes of the input as \xNN escapes.
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -47,11 +48,17 @@ class Json {
       m_value;
 };
 
-/// Parses `text`. Throws icd::InputError "<source>:<line>:<col>: <what>" on
-/// malformed input, on nesting deeper than 64 and on duplicate object keys.
+/// Parses `text` (a leading UTF-8 byte-order mark is skipped). Throws
+/// icd::InputError "<source>:<line>:<col>: <what>" on malformed input,
+/// invalid UTF-8 in a string, nesting deeper than 64, more than 2^20 values
+/// and duplicate object keys. A number beyond the double range is kept as
+/// +-infinity (+-0 when it underflows), for the reader of the field to refuse
+/// with the field's name.
 Json parse_json(std::string_view text, const std::string& source);
 
-/// Reads and parses a file; InputError names the file when it cannot be read.
+/// Reads and parses a file; InputError names the file when it is missing,
+/// not a regular file (a folder, /dev/zero) or larger than
+/// icd::file_limits::kScene (checked before reading).
 Json read_json_file(const std::string& path);
 
 }  // namespace icd::runner

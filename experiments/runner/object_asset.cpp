@@ -1,12 +1,15 @@
 #include "experiments/runner/object_asset.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
-#include <sstream>
+#include <vector>
 
 #include <icd/coupling/primitive_asset.hpp>
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/input_file.hpp>
+
+#include "experiments/runner/child_process.hpp"
 
 namespace icd::runner {
 
@@ -19,26 +22,78 @@ void place_object(ObjectAsset& asset, const ObjectSpec& spec) {
 // bundles of an older pipeline are not reused.
 constexpr const char* kPreprocessVersion = " pipeline-5";
 
+namespace {
+
+std::string object_label(const ObjectSpec& spec) { return "object \"" + spec.name + "\": "; }
+
+// Runs `f`; an InputError it throws gets the object's name in front.
+template <class F>
+auto naming_object(const ObjectSpec& spec, F&& f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    throw InputError(object_label(spec) + e.what());
+  } catch (const ParameterError& e) {
+    throw ParameterError(object_label(spec) + e.what());
+  }
+}
+
+bool is_surface_mesh_extension(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".off" || ext == ".obj" || ext == ".ply" || ext == ".stl";
+}
+
+}  // namespace
+
+void check_object_inputs(const ObjectSpec& spec) {
+  naming_object(spec, [&] {
+    if (!spec.mesh.empty()) {
+      check_input_file(spec.mesh, file_limits::kSurfaceMesh, "mesh");
+      if (!is_surface_mesh_extension(spec.mesh))
+        throw InputError(
+            escape_bytes(spec.mesh.string(), 4096) + ": unknown mesh file extension '" +
+            escape_bytes(spec.mesh.extension().string()) + "' (supported: .off, .obj, .ply, .stl)");
+    }
+    if (!spec.asset.empty()) {
+      check_input_file(spec.asset / coupling::kBundleDataFile, file_limits::kBundle,
+                       "asset bundle file");
+      check_input_file(spec.asset / coupling::kDenseSurfaceFile, file_limits::kVtu, "VTU file");
+      check_input_file(spec.asset / coupling::kCoarseTetsFile, file_limits::kVtu, "VTU file");
+    }
+    return 0;
+  });
+}
+
 ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::path& cache_dir,
-                              const std::filesystem::path& tool_dir) {
+                              const std::filesystem::path& tool_dir, const ChildLimits& limits) {
   const PreprocessSpec& pre = spec.preprocess;
-  if (spec.primitive) return coupling::make_primitive_asset(*spec.primitive, pre.tree_depth);
-  if (!spec.asset.empty()) return coupling::read_asset_bundle(spec.asset);
+  if (spec.primitive)
+    return naming_object(
+        spec, [&] { return coupling::make_primitive_asset(*spec.primitive, pre.tree_depth); });
+  if (!spec.asset.empty())
+    return naming_object(spec, [&] { return coupling::read_asset_bundle(spec.asset); });
 
   // A raw mesh: preprocess it into the cache on first use. The cache folder is
   // named by a hash of the file's bytes, the options and the pipeline version,
   // so any change to these makes a new bundle.
-  std::ifstream in(spec.mesh, std::ios::binary);
-  if (!in) throw InputError("object \"" + spec.name + "\": cannot open mesh " + spec.mesh.string());
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
+  check_object_inputs(spec);
+  const std::string bytes = naming_object(
+      spec, [&] { return read_input_file(spec.mesh, file_limits::kSurfaceMesh, "mesh"); });
   const bool octree = pre.tree_builder == "octree";
-  std::ostringstream args;
-  args << " --coarse-tets " << pre.coarse_tets << " --sphere-depth " << pre.tree_depth
-       << " --sphere-branching " << pre.tree_branching << (octree ? " --no-spheres" : "");
+  std::vector<std::string> options = {"--coarse-tets",      std::to_string(pre.coarse_tets),
+                                      "--sphere-depth",     std::to_string(pre.tree_depth),
+                                      "--sphere-branching", std::to_string(pre.tree_branching)};
+  if (octree) options.push_back("--no-spheres");
   // (only when not the default, so that the cached light bundles stay valid)
-  if (!octree && pre.tree_fit != "light") args << " --sphere-fit " << pre.tree_fit;
-  const std::string key = bytes.str() + args.str() + kPreprocessVersion;
+  if (!octree && pre.tree_fit != "light") {
+    options.push_back("--sphere-fit");
+    options.push_back(pre.tree_fit);
+  }
+  std::string args;  // the options as they entered the cache key before (" --coarse-tets 1500 ...")
+  for (const std::string& o : options) args += " " + o;
+  const std::string key = bytes + args + kPreprocessVersion;
   char hash[17];
   std::snprintf(hash, sizeof hash, "%016llx",
                 static_cast<unsigned long long>(coupling::fnv1a64(key.data(), key.size())));
@@ -46,22 +101,26 @@ ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::pat
   if (!std::filesystem::exists(folder / coupling::kBundleDataFile)) {
     const std::filesystem::path tool = tool_dir / "icd-preprocess";
     if (!std::filesystem::exists(tool))
-      throw InputError("object \"" + spec.name + "\": " + spec.mesh.string() +
-                       " needs preprocessing but " + tool.string() +
+      throw InputError(object_label(spec) + escape_bytes(spec.mesh.string(), 4096) +
+                       " needs preprocessing but " + escape_bytes(tool.string(), 4096) +
                        " is missing (build the icd-preprocess target)");
     const std::filesystem::path tmp = folder.string() + ".part";
     std::filesystem::remove_all(tmp);
     std::filesystem::create_directories(cache_dir);
-    std::fprintf(stderr, "[icd] preprocessing %s (first use, cached in %s)\n", spec.mesh.c_str(),
-                 folder.c_str());
-    std::ostringstream command;  // (a stream: GCC 12 warns falsely on long string sums)
-    command << '"' << tool.string() << "\" \"" << spec.mesh.string() << "\" -o \"" << tmp.string()
-            << "\" -q" << args.str();
-    const std::string cmd = command.str();
-    if (std::system(cmd.c_str()) != 0) {
+    std::fprintf(stderr, "[icd] preprocessing %s (first use, cached in %s)\n",
+                 escape_bytes(spec.mesh.string(), 4096).c_str(),
+                 escape_bytes(folder.string(), 4096).c_str());
+    // No shell: the paths are arguments, never interpreted. Absolute, so that
+    // a path starting with '-' is not taken for an option.
+    std::vector<std::string> argv = {tool.string(), std::filesystem::absolute(spec.mesh).string(),
+                                     "-o", std::filesystem::absolute(tmp).string(), "-q"};
+    argv.insert(argv.end(), options.begin(), options.end());
+    const ChildResult result = run_child(argv, limits);
+    if (!result.ok()) {
       std::filesystem::remove_all(tmp);
-      throw InputError("object \"" + spec.name + "\": preprocessing " + spec.mesh.string() +
-                       " failed (command: " + cmd + ")");
+      throw InputError(object_label(spec) + "preprocessing " +
+                       escape_bytes(spec.mesh.string(), 4096) + " failed: icd-preprocess " +
+                       result.describe(limits) + " (command: " + display_command(argv) + ")");
     }
     std::filesystem::remove_all(folder);
     std::filesystem::rename(tmp, folder);

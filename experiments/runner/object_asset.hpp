@@ -6,8 +6,9 @@
 #include <filesystem>
 
 #include <icd/coupling/asset_bundle.hpp>
-#include "experiments/runner/scene.hpp"
 #include <icd/mesh/core/types.hpp>
+#include "experiments/runner/child_process.hpp"
+#include "experiments/runner/scene.hpp"
 
 namespace icd::runner {
 
@@ -18,10 +19,18 @@ using ObjectAsset = coupling::AssetBundle;
 
 /// Loads the asset of an object spec: generated primitive, bundle folder, or
 /// raw mesh preprocessed into `cache_dir` by the icd-preprocess tool found in
-/// `tool_dir` (so the runtime never links CGAL). Throws InputError naming the
-/// object and the file on failure.
+/// `tool_dir` (so the runtime never links CGAL). The tool runs without a
+/// shell (the paths are plain arguments) under `limits`. Throws InputError
+/// naming the object and the file on failure.
 ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::path& cache_dir,
-                              const std::filesystem::path& tool_dir);
+                              const std::filesystem::path& tool_dir,
+                              const ChildLimits& limits = {});
+
+/// Checks, without loading anything, that the object's input files exist, are
+/// regular files within their size limits (icd::file_limits) and, for a raw
+/// mesh, have a known extension. Throws InputError "object \"<name>\":
+/// <path>: <what>". Nothing to check for a primitive.
+void check_object_inputs(const ObjectSpec& spec);
 
 /// Scales (longest bounding-box side of the dense mesh -> spec.size, when > 0),
 /// rotates (XYZ Euler, degrees) about the dense bounding-box centre and moves

@@ -3,8 +3,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -16,22 +19,39 @@
 namespace icd::runner {
 namespace {
 
+// File-name stems of the objects' outputs: file_name_from(name), made unique
+// (names that differ only in unsafe characters would share files).
+std::vector<std::string> object_file_names(const World& world) {
+  std::vector<std::string> names;
+  std::set<std::string> used;
+  for (size_t i = 0; i < world.objects().size(); ++i) {
+    std::string n = file_name_from(world.objects()[i].setup.name);
+    for (int k = 2; used.count(n); ++k)
+      n = file_name_from(world.objects()[i].setup.name) + "_" + std::to_string(k);
+    used.insert(n);
+    names.push_back(n);
+  }
+  return names;
+}
+
 void write_frame_vtu(World& world, const Scene& scene, int frame, const std::filesystem::path& dir,
+                     const std::vector<std::string>& file_names,
                      std::vector<std::vector<PvdEntry>>& series) {
   const double t = frame / scene.world.frame_rate;
   auto& objects = world.objects();
   size_t s = 0;
   char suffix[32];
   std::snprintf(suffix, sizeof suffix, "_%06d.vtu", frame);
-  for (coupling::RuntimeObject& o : objects) {
+  for (size_t k = 0; k < objects.size(); ++k) {
+    coupling::RuntimeObject& o = objects[k];
     TetMesh coarse = o.asset.coarse;
     coarse.V = o.positions;
-    const std::string cname = o.setup.name + "_coarse" + suffix;
+    const std::string cname = file_names[k] + "_coarse" + suffix;
     write_vtu_tet_mesh(dir / cname, coarse);
     series[s++].push_back({t, cname});
     if (o.plan.dense_update && scene.output.dense) {
       SurfaceMesh dense{o.dense, o.asset.dense.F};
-      const std::string dname = o.setup.name + "_dense" + suffix;
+      const std::string dname = file_names[k] + "_dense" + suffix;
       write_vtu_surface_mesh(dir / dname, dense);
       series[s].push_back({t, dname});
     }
@@ -43,7 +63,7 @@ void write_frame_vtu(World& world, const Scene& scene, int frame, const std::fil
       const auto [i, j] = world.plan().pairs[p];
       for (int side = 0; side < 2; ++side) {
         const std::string name =
-            objects[side ? j : i].setup.name + "_contact_spheres_pair" + std::to_string(p) + suffix;
+            file_names[side ? j : i] + "_contact_spheres_pair" + std::to_string(p) + suffix;
         write_contact_spheres(world, p, side, dir / name);
         series[s].push_back({t, name});
         ++s;
@@ -77,18 +97,78 @@ std::vector<std::string> describe_plan(const Scene& scene) {
   return lines;
 }
 
+void check_scene_inputs(const Scene& scene) {
+  for (const ObjectSpec& spec : scene.objects) check_object_inputs(spec);
+}
+
 World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
-                 const std::filesystem::path& tool_dir) {
+                 const std::filesystem::path& tool_dir, const ChildLimits& limits) {
+  check_scene_inputs(scene);
   std::vector<coupling::WorldObject> objects;
   objects.reserve(scene.objects.size());
   for (const ObjectSpec& spec : scene.objects) {
     coupling::WorldObject o;
     o.setup = spec;
-    o.asset = load_object_asset(spec, cache_dir, tool_dir);
+    o.asset = load_object_asset(spec, cache_dir, tool_dir, limits);
     place_object(o.asset, spec);
     objects.push_back(std::move(o));
   }
+  for (const std::string& w : scale_warnings(objects))
+    std::fprintf(stderr, "[icd] warning: %s\n", w.c_str());
   return World(std::move(objects), world_settings(scene));
+}
+
+std::vector<std::string> scale_warnings(const std::vector<coupling::WorldObject>& objects) {
+  constexpr double kRatio = 100;
+  const auto fmt = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::string(buf);
+  };
+  std::vector<double> size;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const coupling::WorldObject& o : objects) {
+    const MatX3d& V = o.asset.dense.V;
+    if (V.rows() == 0) {
+      size.push_back(0);
+      continue;
+    }
+    const Eigen::Vector3d a = V.colwise().minCoeff(), b = V.colwise().maxCoeff();
+    size.push_back((b - a).norm());
+    lo = lo.cwiseMin(0.5 * (a + b));
+    hi = hi.cwiseMax(0.5 * (a + b));
+  }
+  const double span = objects.size() >= 2 ? (hi - lo).norm() : 0;
+  size_t smallest = 0;
+  for (size_t i = 0; i < size.size(); ++i)
+    if (size[i] > 0 && (size[smallest] <= 0 || size[i] < size[smallest])) smallest = i;
+  std::vector<std::string> out;
+  for (size_t i = 0; i < size.size(); ++i) {
+    const std::string name =
+        "object \"" + objects[i].setup.name + "\" is " + fmt(size[i]) + " m across";
+    const char* hint =
+        ": is its mesh or asset in other units (e.g. millimetres)? Give the object a \"size\" (m) "
+        "in the scene";
+    if (size[smallest] > 0 && size[i] > kRatio * size[smallest])
+      out.push_back(name + ", " + fmt(size[i] / size[smallest]) + " times the size of object \"" +
+                    objects[smallest].setup.name + "\" (" + fmt(size[smallest]) + " m)" + hint);
+    else if (span > 0 && size[i] > kRatio * span)
+      out.push_back(name + ", " + fmt(size[i] / span) +
+                    " times the distance spanned by the objects' positions (" + fmt(span) + " m)" +
+                    hint);
+  }
+  return out;
+}
+
+std::string file_name_from(const std::string& name) {
+  std::string out;
+  for (const char c : name.substr(0, 100))
+    out +=
+        std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' ? c : '_';
+  if (out.empty()) out = "_";
+  if (out[0] == '.') out[0] = '_';
+  return out;
 }
 
 void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path) {
@@ -139,6 +219,9 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   if (opt.out_dir.empty()) throw ParameterError("run_scene: an output folder is required");
   Scene scene = scene_in;
   if (opt.frames >= 0) scene.frames = opt.frames;
+  if (scene.frames < 1 || scene.frames > 100000000)  // as the scene file's "frames"
+    throw ParameterError("run_scene: frames must be in [1, 100000000], got " +
+                         std::to_string(scene.frames));
   if (opt.target_fps >= 0) scene.world.target_fps = opt.target_fps;
   std::filesystem::create_directories(opt.out_dir);
   // Remove a previous run's results first: nothing stale that looks complete.
@@ -148,7 +231,8 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   std::filesystem::remove_all(vtu_dir);
   std::filesystem::remove_all(vtu_tmp);
 
-  World world = make_world(scene, opt.cache_dir, opt.tool_dir);
+  World world = make_world(scene, opt.cache_dir, opt.tool_dir, opt.preprocess_limits);
+  const std::vector<std::string> file_names = object_file_names(world);
   const bool tty = opt.progress && isatty(fileno(stderr));
   std::vector<FrameMetrics> frames;
   frames.reserve(scene.frames);
@@ -170,7 +254,7 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
     FrameMetrics m = world.step();
     if (scene.output.vtu_every > 0 && (f % scene.output.vtu_every == 0 || f + 1 == scene.frames)) {
       const auto t0 = std::chrono::steady_clock::now();
-      write_frame_vtu(world, scene, f, vtu_tmp, series);
+      write_frame_vtu(world, scene, f, vtu_tmp, file_names, series);
       m.times.output = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     if (scene.world.target_fps > 0) {

@@ -9,6 +9,7 @@
 
 #include <icd/coupling/world.hpp>
 
+#include "experiments/runner/child_process.hpp"
 #include "experiments/runner/scene.hpp"
 
 namespace icd::runner {
@@ -26,18 +27,39 @@ coupling::StagePlan scene_plan(const Scene& scene);
 /// The scene's stages and what it outputs, one line each (icd-run --dry-run).
 std::vector<std::string> describe_plan(const Scene& scene);
 
+/// Checks every input path of the scene without loading anything
+/// (check_object_inputs of each object): what icd-run --dry-run checks.
+/// Throws InputError naming the object and the file.
+void check_scene_inputs(const Scene& scene);
+
 /// Loads every object of the scene (load_object_asset: primitive, bundle, or
 /// raw mesh preprocessed into `cache_dir` by the icd-preprocess tool in
-/// `tool_dir`), places it, and builds the World with world_settings(scene).
+/// `tool_dir`, run under `limits`), places it, prints scale_warnings() to
+/// stderr, and builds the World with world_settings(scene). Checks every
+/// input path first (check_scene_inputs), so that a missing file is reported
+/// before any preprocessing.
 World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
-                 const std::filesystem::path& tool_dir);
+                 const std::filesystem::path& tool_dir, const ChildLimits& limits = {});
+
+/// Warnings, one sentence each naming the object, when the placed objects'
+/// sizes suggest a unit mismatch (an asset left in millimetres beside objects
+/// in metres): an object more than 100 times larger or smaller than another
+/// (sizes: bounding-box diagonals of the dense meshes), or more than 100
+/// times larger than the distance spanned by the objects' positions.
+std::vector<std::string> scale_warnings(const std::vector<coupling::WorldObject>& objects);
+
+/// `name` made safe as one file-name component: every byte but [A-Za-z0-9._-]
+/// becomes '_', a leading '.' becomes '_' (no "..", no hidden file), at most
+/// 100 bytes, never empty. A scene or object name is a label, not a path.
+std::string file_name_from(const std::string& name);
 
 /// Options of run_scene().
 struct RunOptions {
   std::filesystem::path out_dir;    ///< results folder (created); required
   std::filesystem::path cache_dir;  ///< preprocessed assets cache
   std::filesystem::path tool_dir;   ///< where icd-preprocess lives
-  int frames = -1;                  ///< override the scene's frame count (-1 = keep)
+  ChildLimits preprocess_limits;    ///< CPU, wall-clock and memory limits of icd-preprocess
+  int frames = -1;                  ///< override the scene's frame count (-1 = keep; else >= 1)
   double target_fps = -1;           ///< override the scene's real-time target (-1 = keep, 0 = off)
   bool progress = true;             ///< progress bar on stderr
   int summary_ranges = 4;           ///< summary lines (frame ranges) printed at the end
@@ -45,9 +67,11 @@ struct RunOptions {
 };
 
 /// Runs the scene and writes `<out_dir>/frames.csv` (and the VTU/PVD series
-/// if asked). Files are written under temporary names and renamed at the
-/// end, so an interrupted run leaves no complete-looking output. Returns the
-/// metrics of every frame. Throws on any error (after removing partial files).
+/// if asked; their file names are file_name_from(object name), made unique).
+/// Files are written under temporary names and renamed at the end, so an
+/// interrupted run leaves no complete-looking output. Returns the metrics of
+/// every frame. Throws ParameterError for a frame count below 1 (as the scene
+/// file refuses), and on any error (after removing partial files).
 std::vector<FrameMetrics> run_scene(const Scene& scene, const RunOptions& options);
 
 /// Writes, as a VTU sphere set at `path`, the spheres of one side of

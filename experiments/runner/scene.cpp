@@ -6,6 +6,7 @@
 
 #include <icd/config.hpp>
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/input_file.hpp>
 
 namespace icd::runner {
 namespace {
@@ -38,6 +39,8 @@ class Fields {
     if (!j) return def;
     if (!j->is_number()) fail(path(key), std::string("must be a number, got ") + j->type_name());
     const double v = j->as_number();
+    if (!std::isfinite(v))
+      fail(path(key), "must be a finite number, got one beyond the double range (about 1.8e308)");
     if (v < lo || v > hi || (lo_open && v == lo))
       fail(path(key), "must be in " + std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) +
                           "], got " + fmt(v));
@@ -67,8 +70,16 @@ class Fields {
         ok |= a == s;
         list += (list.empty() ? "" : ", ") + ('"' + a + '"');
       }
-      if (!ok) fail(path(key), "must be one of " + list + ", got \"" + s + "\"");
+      if (!ok) fail(path(key), "must be one of " + list + ", got \"" + escape_bytes(s) + "\"");
     }
+    return s;
+  }
+  /// A name (of the scene or an object): any text without control characters.
+  std::string name(const std::string& key, const std::string& def) {
+    const std::string s = string(key, def);
+    for (const char c : s)
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+        fail(path(key), "must not contain control characters, got \"" + escape_bytes(s) + "\"");
     return s;
   }
   Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& def, double limit) {
@@ -81,7 +92,7 @@ class Fields {
       const Json& e = j->as_array()[k];
       if (!e.is_number()) fail(path(key) + "[" + std::to_string(k) + "]", "must be a number");
       v[k] = e.as_number();
-      if (std::abs(v[k]) > limit)
+      if (!(std::abs(v[k]) <= limit))
         fail(path(key) + "[" + std::to_string(k) + "]", "magnitude above " + fmt(limit));
     }
     return v;
@@ -89,7 +100,7 @@ class Fields {
 
   void finish() const {
     for (const auto& [key, value] : *m_obj)
-      if (!m_used.count(key)) fail(path(key), "unknown field");
+      if (!m_used.count(key)) fail(path(escape_bytes(key)), "unknown field");
   }
 
   static std::string fmt(double v) {
@@ -126,7 +137,7 @@ fem::Material parse_material(Fields& f) {
 ObjectSpec parse_object(const Json& j, const std::string& path, const std::string& source) {
   Fields f(j, path, source);
   ObjectSpec o;
-  o.name = f.string("name", path);
+  o.name = f.name("name", path);
   const std::string mesh = f.string("mesh", ""), asset = f.string("asset", "");
   const Json* prim = f.get("primitive");
   const int sources = !mesh.empty() + !asset.empty() + (prim != nullptr);
@@ -209,8 +220,10 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   CollisionSpec c;  // fields left out keep CollisionSpec's defaults
   collision::CollisionRequest& q = c.query;
   const bool has_seconds = f.get("budget_seconds") != nullptr;
+  const bool has_tests = f.get("budget_tests") != nullptr;
   q.budget_seconds = f.number("budget_seconds", q.budget_seconds, 0, 1e3, true);
-  if (f.boolean("unlimited", false)) q.budget_seconds = kInf;
+  const bool unlimited = f.boolean("unlimited", false);
+  if (unlimited) q.budget_seconds = kInf;
   const double tests = f.number("budget_tests", -1, -1, 1e15);
   if (tests != -1 && (tests < 0 || tests != std::floor(tests)))
     f.fail("collision.budget_tests", "must be a positive integer or -1");
@@ -220,6 +233,17 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
            "objects assumed colliding); give a positive count, or -1 for no limit");
   q.budget_tests = static_cast<int64_t>(tests);
   if (q.budget_tests >= 0 && !has_seconds) q.budget_seconds = kInf;
+  // One budget per scene: a second one would silently override the first
+  // (budget_tests -1 is "no test budget").
+  const bool test_budget = has_tests && tests != -1;
+  if (test_budget && has_seconds)
+    f.fail("collision.budget_tests and collision.budget_seconds",
+           "contradict each other: give one budget (sphere tests for reproducible runs, or "
+           "seconds), not both");
+  if (unlimited && (test_budget || has_seconds))
+    f.fail(std::string("collision.unlimited and collision.") +
+               (has_seconds ? "budget_seconds" : "budget_tests"),
+           "contradict each other: \"unlimited\": true means no budget");
   const std::string mode =
       f.string("mode", "fifo", {"fifo", "fifo_literal", "depth_first", "priority"});
   q.mode = mode == "depth_first"    ? collision::TraversalMode::DepthFirst
@@ -279,7 +303,7 @@ Scene parse_scene(const Json& json, const std::string& source,
   Fields f(json, "", source);
   Scene s;
   s.base_dir = base_dir;
-  s.name = f.string("name", "scene");
+  s.name = f.name("name", "scene");
   s.frames = f.integer("frames", s.frames, 1, 100000000);
   s.world.frame_rate = f.number("frame_rate", s.world.frame_rate, 0, 1e5, true);
   s.world.gravity = f.vec3("gravity", s.world.gravity, 1e4);
@@ -294,7 +318,7 @@ Scene parse_scene(const Json& json, const std::string& source,
   for (size_t i = 0; i < s.objects.size(); ++i)
     if (!names.insert(s.objects[i].name).second)
       f.fail("objects[" + std::to_string(i) + "].name",
-             "duplicate object name \"" + s.objects[i].name + "\"");
+             "duplicate object name \"" + escape_bytes(s.objects[i].name) + "\"");
   if (const Json* c = f.get("collision")) s.world.collision = parse_collision(*c, source);
   if (const Json* o = f.get("output")) {
     Fields out(*o, "output", source);

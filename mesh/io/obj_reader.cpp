@@ -1,10 +1,12 @@
 // OBJ reader: "v x y z [w]" and "f c1 c2 c3 ..." lines, each corner written
 // i, i/t, i/t/n or i//n with 1-based (or negative, relative) vertex indices.
 // '#' starts a comment; other keywords (vt, vn, g, o, s, usemtl...) are ignored.
+// A UTF-8 byte-order mark is skipped.
 #include <map>
 #include <string>
 #include <vector>
 
+#include <icd/mesh/core/input_file.hpp>
 #include <icd/mesh/io/detail/input_error.hpp>
 #include <icd/mesh/io/detail/surface_builder.hpp>
 #include <icd/mesh/io/detail/text_scan.hpp>
@@ -29,7 +31,7 @@ bool is_known_ignored(std::string_view keyword) {
 }  // namespace
 
 SurfaceMesh parse_obj(std::string_view bytes, std::string_view source, ReadReport* report) {
-  detail::LineReader lines(bytes);
+  detail::LineReader lines(strip_utf8_bom(bytes));
   detail::SurfaceBuilder builder(source);
   std::string_view raw, tok;
   std::vector<int64_t> corners;

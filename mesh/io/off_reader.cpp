@@ -1,10 +1,13 @@
 // OFF reader: "[ST][C][N]OFF" header, counts "#V #F #E", #V vertex lines
 // (x y z, then optional normal/colour/texture data for the N/C/ST variants),
-// #F face lines "n i1 ... in [colour]". '#' starts a comment.
+// #F face lines "n i1 ... in [colour]". '#' starts a comment. A UTF-8
+// byte-order mark is skipped; content after the last announced face is an
+// error (the header's face count is wrong).
 #include <limits>
 #include <string>
 #include <vector>
 
+#include <icd/mesh/core/input_file.hpp>
 #include <icd/mesh/io/detail/input_error.hpp>
 #include <icd/mesh/io/detail/surface_builder.hpp>
 #include <icd/mesh/io/detail/text_scan.hpp>
@@ -52,7 +55,7 @@ int64_t parse_count(std::string_view source, int64_t line, std::string_view toke
 }  // namespace
 
 SurfaceMesh parse_off(std::string_view bytes, std::string_view source, ReadReport* report) {
-  detail::LineReader lines(bytes);
+  detail::LineReader lines(strip_utf8_bom(bytes));
   std::string_view line;
   if (!next_content_line(lines, line))
     throw_input_error(source, "truncated file: no OFF header (the file is empty)");
@@ -160,6 +163,12 @@ SurfaceMesh parse_off(std::string_view bytes, std::string_view source, ReadRepor
     // Anything after the indices is a face colour, which we ignore.
     builder.add_polygon(corners, lines.line_number());
   }
+  if (next_content_line(lines, line))
+    throw_input_error(source, lines.line_number(),
+                      "the header announces " + std::to_string(nv) + " vertices and " +
+                          std::to_string(nf) + (nf == 1 ? " face" : " faces") +
+                          ", but more data follows the last face: " + detail::quote(line) +
+                          " (wrong face count in the header?)");
   return builder.finish(keyword, report);
 }
 

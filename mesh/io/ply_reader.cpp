@@ -1,12 +1,15 @@
 // PLY reader (ascii, binary_little_endian, binary_big_endian). The header
 // declares elements, each with scalar or list properties; we read x, y, z of
 // `vertex` and the index list of `face`, and skip everything else by size.
+// A UTF-8 byte-order mark before the header is skipped; data after the last
+// element is ignored with a warning (a header count is probably wrong).
 #include <bit>
 #include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include <icd/mesh/core/input_file.hpp>
 #include <icd/mesh/io/detail/input_error.hpp>
 #include <icd/mesh/io/detail/surface_builder.hpp>
 #include <icd/mesh/io/detail/text_scan.hpp>
@@ -306,7 +309,8 @@ void read_binary(std::string_view data, const Header& h, const Roles& r, std::st
     }
   }
   if (cur.bytes_left() > 0)
-    builder.note("ignored " + std::to_string(cur.bytes_left()) + " bytes after the last element");
+    builder.warn("ignored " + std::to_string(cur.bytes_left()) +
+                 " bytes after the last element announced by the header");
 }
 
 void read_ascii(std::string_view data, const Header& h, const Roles& r, std::string_view source,
@@ -373,13 +377,14 @@ void read_ascii(std::string_view data, const Header& h, const Roles& r, std::str
     }
   }
   if (ts.next(tok))
-    builder.note("ignored data after the last element (line " + std::to_string(ts.line_number()) +
-                 ")");
+    builder.warn("ignored data after the last element announced by the header (from line " +
+                 std::to_string(ts.line_number()) + ")");
 }
 
 }  // namespace
 
-SurfaceMesh parse_ply(std::string_view bytes, std::string_view source, ReadReport* report) {
+SurfaceMesh parse_ply(std::string_view bytes_in, std::string_view source, ReadReport* report) {
+  const std::string_view bytes = strip_utf8_bom(bytes_in);
   const Header h = parse_header(bytes, source);
   const Roles roles = find_roles(h, source);
   const std::string_view data = bytes.substr(h.data_offset);

@@ -7,8 +7,8 @@
 namespace icd {
 
 /// Filled by the surface readers when a pointer is passed: the detected
-/// format, counts, and notes on every silent-looking change (triangulation,
-/// welding, ignored data).
+/// format, counts, notes on every silent-looking change (triangulation,
+/// welding, ignored keywords) and warnings on counts that disagree with the data.
 struct ReadReport {
   std::string format;                 ///< e.g. "OFF", "PLY binary_big_endian", "STL ascii"
   int64_t vertices = 0;               ///< rows of the returned V
@@ -17,6 +17,10 @@ struct ReadReport {
   int64_t polygons_triangulated = 0;  ///< polygons with > 3 corners, fan-triangulated
   int64_t corners_welded = 0;         ///< STL: triangle corners merged into shared vertices
   std::vector<std::string> notes;     ///< one human-readable sentence each
+  /// Data the file holds beyond what its header announces (ignored, but the
+  /// header count is probably wrong): one sentence each. The programs print
+  /// them as warnings.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace icd

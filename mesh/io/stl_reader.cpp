@@ -1,13 +1,16 @@
 // STL reader. Binary: 80-byte header, uint32 triangle count, then per
 // triangle 12 little-endian floats (normal, 3 corners) and a uint16. ASCII:
 // "solid name / facet normal ... / outer loop / vertex x y z (x3) / endloop /
-// endfacet / endsolid". Corners with identical coordinates are welded.
+// endfacet / endsolid", optionally after a UTF-8 byte-order mark. A file is
+// binary exactly when its size is 84 + 50 * count; otherwise it must be ASCII.
+// Corners with identical coordinates are welded.
 #include <bit>
 #include <cstring>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
+#include <icd/mesh/core/input_file.hpp>
 #include <icd/mesh/io/detail/input_error.hpp>
 #include <icd/mesh/io/detail/surface_builder.hpp>
 #include <icd/mesh/io/detail/text_scan.hpp>
@@ -81,12 +84,21 @@ void read_binary(std::string_view bytes, std::string_view source, detail::Surfac
   const auto size = static_cast<int64_t>(bytes.size());
   if (84 + 50 * n > size)
     throw_input_error(source, "truncated binary STL: header announces " + std::to_string(n) +
-                                  " triangles (" + std::to_string(84 + 50 * n) +
-                                  " bytes) but the file has " + std::to_string(size) + " bytes");
-  if (84 + 50 * n < size)
-    builder.note("ignored " + std::to_string(size - 84 - 50 * n) +
-                 " bytes after the last triangle");
-  welder.reserve(static_cast<size_t>(n / 2 + 3));
+                                  " triangles (84 + 50 * " + std::to_string(n) + " = " +
+                                  std::to_string(84 + 50 * n) + " bytes) but the file has " +
+                                  std::to_string(size) + " bytes");
+  if (84 + 50 * n < size) {
+    const int64_t extra = size - 84 - 50 * n;
+    throw_input_error(
+        source,
+        "binary STL: header announces " + std::to_string(n) + " triangles (84 + 50 * " +
+            std::to_string(n) + " = " + std::to_string(84 + 50 * n) + " bytes) but the file has " +
+            std::to_string(size) + " bytes" +
+            (extra % 50 == 0 ? " (" + std::to_string(n + extra / 50) + " triangles' worth)" : "") +
+            ": wrong triangle count in the header, or data after the last triangle");
+  }
+  // Room for every corner distinct (the worst case): no rehash while welding.
+  welder.reserve(static_cast<size_t>(3 * n));
   builder.reserve(n / 2 + 3, n);
   int64_t corners[3];
   for (int64_t t = 0; t < n; ++t) {
@@ -176,10 +188,11 @@ SurfaceMesh parse_stl(std::string_view bytes, std::string_view source, ReadRepor
   const bool sized_as_binary =
       bytes.size() >= 84 && 84 + 50 * static_cast<int64_t>(load_le_u32(bytes.data() + 80)) ==
                                 static_cast<int64_t>(bytes.size());
-  const bool starts_solid = detail::trim(bytes.substr(0, 80)).starts_with("solid");
+  const std::string_view text = strip_utf8_bom(bytes);
+  const bool starts_solid = detail::trim(text.substr(0, 80)).starts_with("solid");
   std::string format;
   if (!sized_as_binary && starts_solid) {
-    read_ascii(bytes, source, builder, welder);
+    read_ascii(text, source, builder, welder);
     format = "STL ascii";
   } else if (bytes.size() >= 84) {
     read_binary(bytes, source, builder, welder);

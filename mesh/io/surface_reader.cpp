@@ -11,7 +11,7 @@ namespace icd {
 
 SurfaceMesh read_surface_mesh(const std::filesystem::path& path, ReadReport* report) {
   const std::string name = path.string();
-  detail::check_regular_file(path);
+  detail::check_regular_file(path, file_limits::kSurfaceMesh, "mesh");
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -28,7 +28,7 @@ SurfaceMesh read_surface_mesh(const std::filesystem::path& path, ReadReport* rep
   else
     detail::throw_input_error(
         name, "unknown mesh file extension '" + ext + "' (supported: .off, .obj, .ply, .stl)");
-  const std::string bytes = detail::read_file_bytes(path);
+  const std::string bytes = detail::read_file_bytes(path, file_limits::kSurfaceMesh, "mesh");
   return parser(bytes, name, report);
 }
 

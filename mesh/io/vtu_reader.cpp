@@ -67,7 +67,17 @@ Array read_data_array(XmlScanner& xml, const Tag& tag) {
   const std::string_view text = xml.text();
   const size_t close = text.find("</DataArray>", tag.end);
   if (close == std::string_view::npos) xml.fail(tag.begin, label + " is not closed");
-  detail::TokenStream ts(text.substr(tag.end, close - tag.end), xml.line_at(tag.end));
+  const std::string_view body = text.substr(tag.end, close - tag.end);
+  {  // Reserve exactly (no growth by doubling): count the tokens first.
+    size_t count = 0;
+    for (size_t i = 0; i < body.size(); ++i)
+      count += !detail::is_space(body[i]) && (i == 0 || detail::is_space(body[i - 1]));
+    if (a.is_float)
+      a.reals.reserve(count);
+    else
+      a.ints.reserve(count);
+  }
+  detail::TokenStream ts(body, xml.line_at(tag.end));
   std::string_view tok;
   while (ts.next(tok)) {
     if (a.is_float) {
@@ -97,11 +107,11 @@ Array read_data_array(XmlScanner& xml, const Tag& tag) {
 }  // namespace
 
 VtuData read_vtu(const std::filesystem::path& path) {
-  return parse_vtu(detail::read_file_bytes(path), path.string());
+  return parse_vtu(detail::read_file_bytes(path, file_limits::kVtu, "VTU file"), path.string());
 }
 
 VtuData parse_vtu(std::string_view bytes, std::string_view source) {
-  XmlScanner xml(bytes, source);
+  XmlScanner xml(strip_utf8_bom(bytes), source);  // XML may start with a byte-order mark
   Tag tag;
   if (!xml.next(tag) || tag.name != "VTKFile")
     throw_input_error(source, "not a VTK XML file: no <VTKFile> element");
@@ -176,10 +186,11 @@ VtuData parse_vtu(std::string_view bytes, std::string_view source) {
                                   std::to_string(num_points) + " rows (found " +
                                   std::to_string(points.size()) + " values)");
   out.points = Eigen::Map<const MatX3d>(points.reals.data(), num_points, 3);
-  const Array* conn = nullptr;
-  const Array* offs = nullptr;
-  const Array* types = nullptr;
-  for (const Array& a : cell_arrays) {
+  std::vector<double>().swap(points.reals);  // (peak memory: free each array once copied)
+  Array* conn = nullptr;
+  Array* offs = nullptr;
+  Array* types = nullptr;
+  for (Array& a : cell_arrays) {
     if (a.name == "connectivity") conn = &a;
     if (a.name == "offsets") offs = &a;
     if (a.name == "types") types = &a;
@@ -221,8 +232,8 @@ VtuData parse_vtu(std::string_view bytes, std::string_view source) {
                                     std::to_string(v) + " is out of range (the file has " +
                                     std::to_string(num_points) + " points)");
   }
-  out.connectivity = conn->ints;
-  out.offsets = offs->ints;
+  out.connectivity = std::move(conn->ints);
+  out.offsets = std::move(offs->ints);
   for (Array& a : point_arrays) {
     if (a.name.empty()) throw_input_error(source, "a PointData DataArray has no Name");
     if (!a.is_float) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 
 #include "experiments/runner/json.hpp"
@@ -34,7 +35,9 @@ TEST(Json, MalformedInputsGiveLocatedErrors) {
       {"1.", "digits expected after '.'"},
       {"{\"a\":1, \"a\":2}", "duplicate key"},
       {"nul", "unexpected character"},
-      {"1e999", "out of range"},
+      {"{\"a\": \"\xC3\"}", "invalid UTF-8 byte \\xc3"},
+      {"\"\xED\xA0\x80\"", "invalid UTF-8"},
+      {"\"\xC0\xAF\"", "invalid UTF-8"},
       {"", "unexpected end of input"},
       {"\n\n  ]", "t:3:3"},
   };
@@ -47,6 +50,33 @@ TEST(Json, MalformedInputsGiveLocatedErrors) {
           << c.text << " -> " << e.what();
       EXPECT_EQ(std::string(e.what()).rfind("t:", 0), 0u) << e.what();
     }
+  }
+}
+
+// Beyond the double range: +-infinity (overflow) or +-0 (underflow), for the
+// scene reader to refuse naming the field.
+TEST(Json, NumbersBeyondTheDoubleRangeBecomeInfinityOrZero) {
+  const Json j = parse_json("[1e999, -1e400, 1e-999, -1e-400, 0.0000e99999, 123456789e301]", "t");
+  const auto& a = j.as_array();
+  EXPECT_EQ(a[0].as_number(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(a[1].as_number(), -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(a[2].as_number(), 0.0);
+  EXPECT_EQ(a[3].as_number(), 0.0);
+  EXPECT_EQ(a[4].as_number(), 0.0);
+  EXPECT_EQ(a[5].as_number(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(parse_json("\"\xC3\xA9\xF0\x9F\x98\x80\"", "t").as_string(),
+            "\xC3\xA9\xF0\x9F\x98\x80");
+}
+
+TEST(Json, TooManyValuesAreRefused) {
+  std::string many = "[0";
+  for (int i = 0; i < (1 << 20); ++i) many += ",0";
+  many += "]";
+  try {
+    parse_json(many, "many");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("more than 1048576 values"), std::string::npos);
   }
 }
 

@@ -3,6 +3,7 @@
 // points as the fuzz targets. Oracle: the documented contract of each reader
 // -- a valid result (postconditions checked) or icd::InputError /
 // icd::ParameterError; any other exception fails, a crash fails the run.
+#include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -114,11 +115,28 @@ Counts replay_folder(const fs::path& root) {
   return c;
 }
 
-TEST(FuzzRegressions, EveryKeptInputGivesAResultOrADocumentedError) {
-  const Counts c = replay_folder(fs::path(ICD_FUZZ_DIR) / "regressions");
-  RecordProperty("files", c.files);
+// Replays the kept inputs under `root` (one folder per fuzz target); a
+// missing or empty folder is a failure (the check would pass on nothing).
+void check_kept_inputs(const fs::path& root) {
+  if (!fs::is_directory(root)) {
+    ADD_FAILURE() << root << " does not exist: no kept input was replayed";
+    return;
+  }
+  const Counts c = replay_folder(root);
+  EXPECT_GE(c.files, 1) << root << " holds no kept input";
+  ::testing::Test::RecordProperty("files", c.files);
   std::cout << "regressions: " << c.files << " files, " << c.accepted << " accepted, " << c.refused
             << " refused\n";
+}
+
+TEST(FuzzRegressions, EveryKeptInputGivesAResultOrADocumentedError) {
+  check_kept_inputs(fs::path(ICD_FUZZ_DIR) / "regressions");
+}
+
+// The check must not pass on nothing: a missing (or empty) folder fails.
+TEST(FuzzRegressions, AMissingFolderFailsTheCheck) {
+  EXPECT_NONFATAL_FAILURE(check_kept_inputs("/nonexistent/icd_fuzz/regressions"),
+                          "/nonexistent/icd_fuzz/regressions");
 }
 
 TEST(FuzzRegressions, EverySeedIsAcceptedOrRefusedCleanly) {

@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
       fs::create_directories(out / dir);
       std::string objects, spheres;
       for (RuntimeObject& o : world.objects()) {
-        const std::string name = o.setup.name + "_dense.vtu";
+        const std::string name = runner::file_name_from(o.setup.name) + "_dense.vtu";
         write_vtu_surface_mesh(out / dir / name,
                                SurfaceMesh{experiments::dense_positions(o), o.asset.dense.F});
         objects += (objects.empty() ? "" : ";") + name;
@@ -111,7 +111,8 @@ int main(int argc, char** argv) {
       // The first pair only (the paper's scenes have one).
       for (int side = 0; side < 2; ++side) {
         const auto [i, j] = world.plan().pairs[0];
-        const std::string name = world.objects()[side ? j : i].setup.name + "_contact_spheres.vtu";
+        const std::string name = runner::file_name_from(world.objects()[side ? j : i].setup.name) +
+                                 "_contact_spheres.vtu";
         write_contact_spheres(world, 0, side, out / dir / name);
         spheres += (spheres.empty() ? "" : ";") + name;
       }

@@ -84,6 +84,7 @@ SurfaceMesh SurfaceBuilder::finish(std::string format, ReadReport* report) {
     report->polygons_triangulated = m_triangulated;
     report->corners_welded = m_welded;
     report->notes = std::move(m_notes);
+    report->warnings = std::move(m_warnings);
   }
   return mesh;
 }

@@ -32,6 +32,8 @@ class SurfaceBuilder {
   int64_t num_polygons() const { return m_polygons; }
   /// Adds a note to the report.
   void note(std::string text) { m_notes.push_back(std::move(text)); }
+  /// Adds a warning to the report (data beyond the header's counts).
+  void warn(std::string text) { m_warnings.push_back(std::move(text)); }
   /// Counts welded corners (STL).
   void add_welded(int64_t n) { m_welded += n; }
 
@@ -50,6 +52,7 @@ class SurfaceBuilder {
   int64_t m_triangulated = 0;
   int64_t m_welded = 0;
   std::vector<std::string> m_notes;
+  std::vector<std::string> m_warnings;
 };
 
 }  // namespace icd::detail

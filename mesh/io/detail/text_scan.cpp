@@ -3,6 +3,8 @@
 #include <charconv>
 #include <system_error>
 
+#include <icd/mesh/core/input_file.hpp>
+
 namespace icd::detail {
 
 bool LineReader::next(std::string_view& line) {
@@ -95,21 +97,9 @@ NumberStatus parse_int64(std::string_view token, int64_t& out) {
 }
 
 std::string quote(std::string_view token) {
-  static constexpr char hex[] = "0123456789abcdef";
-  constexpr size_t max_chars = 40;
-  std::string q = "'";
-  for (size_t i = 0; i < token.size() && i < max_chars; ++i) {
-    const auto c = static_cast<unsigned char>(token[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      q += static_cast<char>(c);
-    } else {
-      q += "\\x";
-      q += hex[c >> 4];
-      q += hex[c & 15];
-    }
-  }
-  if (token.size() > max_chars) q += "...";
-  q += "'";
+  std::string q = "'";  // (appends: GCC 12 warns falsely on "'" + string + "'")
+  q += escape_bytes(token, 40);
+  q += '\'';
   return q;
 }
 

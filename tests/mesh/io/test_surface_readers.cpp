@@ -352,7 +352,7 @@ TEST(SurfaceReaders, NotesForIgnoredData) {
   ASSERT_EQ(report.notes.size(), 1u);
   EXPECT_NE(report.notes[0].find("ignored 2 lines with unknown keyword 'foo'"), std::string::npos)
       << report.notes[0];
-  // PLY: elements in any order (faces before vertices), trailing data noted.
+  // PLY: elements in any order (faces before vertices), trailing data warned about.
   const std::string ply =
       "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
       "element vertex 3\nproperty double x\nproperty double y\nproperty double z\nend_header\n"
@@ -361,8 +361,9 @@ TEST(SurfaceReaders, NotesForIgnoredData) {
   ASSERT_EQ(m.F.rows(), 1);
   EXPECT_EQ(m.F.row(0), Eigen::RowVector3i(2, 1, 0));
   EXPECT_EQ(m.V.row(1), Eigen::RowVector3d(1, 0, 0));
-  ASSERT_EQ(report.notes.size(), 1u);
-  EXPECT_NE(report.notes[0].find("ignored data after the last element"), std::string::npos);
+  EXPECT_TRUE(report.notes.empty());
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("ignored data after the last element"), std::string::npos);
   // OFF: trailing comments and a comment-only line between vertices.
   const SurfaceMesh off = read_surface_mesh(write_bytes(
       dir / "c.off", "OFF # header\n3 1 0\n0 0 0 # v0\n# between\n1 0 0\n0 1 0\n3 0 1 2 # f\n"));

@@ -2,7 +2,8 @@
 // bundle's tree as .sph (read back equal to the bundle's, covering every
 // vertex at every level; the octree builder, as a medial build of even a
 // small sphere takes over 10 s at the fits' sample spacings), and
-// --sphere-fit refuses an unknown fit before any work.
+// --sphere-fit refuses an unknown fit, and contradictory options are refused,
+// before any work.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -79,6 +80,27 @@ TEST(PreprocessCli, RefusesAnUnknownFitBeforeAnyWork) {
                      dir);
   EXPECT_EQ(none.status, 2) << none.output;
   EXPECT_NE(none.output.find("--sph needs a sphere tree"), std::string::npos) << none.output;
+  fs::remove_all(dir);
+}
+
+// Options that contradict each other are refused naming both, before any work
+// (before, the later of --simplify-faces / --simplify-ratio silently won).
+TEST(PreprocessCli, RefusesContradictoryOptionsNamingBoth) {
+  const fs::path dir = fs::temp_directory_path() / "icd_test_preprocess_cli_contradict";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  icd::write_off(dir / "sphere.off", icd::make_icosphere(1));
+  for (const std::string& options :
+       {"--simplify-faces 100 --simplify-ratio 0.5", "--simplify-ratio 0.5 --simplify-faces 100",
+        "--spheres octree --sphere-fit full", "--sphere-fit shell --no-spheres"}) {
+    const ProgramRun run = run_preprocess(
+        (dir / "sphere.off").string() + " -o " + (dir / "bundle").string() + " " + options, dir);
+    EXPECT_EQ(run.status, 2) << options << ": " << run.output;
+    EXPECT_NE(run.output.find("contradict each other"), std::string::npos) << run.output;
+    const std::string first = options.substr(0, options.find(' '));
+    EXPECT_NE(run.output.find(first), std::string::npos) << run.output;
+    EXPECT_FALSE(fs::exists(dir / "bundle")) << options;
+  }
   fs::remove_all(dir);
 }
 #endif
