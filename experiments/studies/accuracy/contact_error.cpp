@@ -252,14 +252,14 @@ int main(int argc, char** argv) {
     const CollisionSpec& cs = scene.world.collision;
     auto base = [&] {
       CollisionRequest r;
-      r.clock_check_interval = cs.clock_check_interval;
+      r.clock_check_interval = cs.query.clock_check_interval;
       return r;
     };
     modes.push_back({"fifo", base()});
     modes.push_back({"fifo_paper_literal", CollisionRequest::paper_reference(1)});
     CollisionRequest pr = base();
     pr.mode = collision::TraversalMode::Priority;
-    pr.max_list_size = cs.max_list_size;
+    pr.max_list_size = cs.query.max_list_size;
     modes.push_back({"priority", pr});
     pr.max_list_size = 256;
     modes.push_back({"priority_cap256", pr});

@@ -6,6 +6,8 @@
 #include <icd/collision/sphere_tree.hpp>
 #include <icd/mesh/core/types.hpp>
 
+#include "experiments/common/timing.hpp"
+
 namespace icd::collision::experiments {
 
 /// One deformable object: dense surface, coarse nodes (a vertex subsample
