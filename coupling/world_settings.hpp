@@ -87,6 +87,20 @@ struct CollisionSpec {
   /// cycle, rolled back and re-run in full cycles if its closing query finds
   /// a contact (see World::step). false: every frame runs all its cycles.
   bool single_cycle_when_apart = true;
+  /// Continuous detection (not in the paper): each cycle first queries the
+  /// swept trees (every sphere grown to enclose its positions at the cycle's
+  /// start and end, collision/swept_spheres.hpp), so two objects that cross
+  /// each other between two queries are still found. A pair whose swept trees
+  /// are apart skips its end-of-cycle query. A cycle that starts contact-free
+  /// and ends in a contact deeper than the penetrating leaf's radius, or whose
+  /// sweep touched while its end did not after a motion larger than a leaf, is
+  /// rolled back and re-run in shorter cycles (FrameMetrics::subdivided).
+  bool swept = true;
+  /// Largest motion of a pair relative to each other per cycle, as a fraction
+  /// of the smaller of their median leaf radii, when frames are cut into
+  /// cycles by motion (in contact, or after a frame tried as one cycle found
+  /// a contact). Bounds the depth at which a contact is first seen.
+  double cycle_motion = 0.5;
   /// Detect at the coarse positions predicted for the middle of the next
   /// cycle (x + h v / 2), during which the resulting forces act, instead of
   /// at its start: the staggered penalty then engages and releases half a

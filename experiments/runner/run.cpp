@@ -123,7 +123,7 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
   csv << "frame,time,wall,fem,links,sphere_update,collision,response,budget,pair_list,"
          "collision_list,tests,interrupted,completed_level,active_pairs,max_penetration,"
          "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened,"
-         "limited\n";
+         "limited,subdivided,deep_pairs,depth_ratio\n";
   for (const FrameMetrics& m : frames)
     csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
         << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
@@ -131,7 +131,8 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
         << m.interrupted << ',' << m.completed_level << ',' << m.active_pairs << ','
         << m.max_penetration << ',' << m.contact_force << ',' << m.cycles << ',' << m.substeps
         << ',' << m.min_step << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback
-        << ',' << m.reused << ',' << m.softened << ',' << m.limited << '\n';
+        << ',' << m.reused << ',' << m.softened << ',' << m.limited << ',' << m.subdivided << ','
+        << m.deep_pairs << ',' << m.depth_ratio << '\n';
   return csv.str();
 }
 
@@ -227,6 +228,24 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
                    100 * sum.response / wall, pl / n, cl / n, intr, reused, cycles / n);
     }
   }
+
+  // Never silent: surfaces that went through each other deeper than the
+  // spheres resolve (a contact too fast or a penalty too soft for the load).
+  int deep_frames = 0, first_deep = -1;
+  double deepest = 0;
+  for (const FrameMetrics& m : frames)
+    if (m.deep_pairs > 0) {
+      ++deep_frames;
+      if (first_deep < 0) first_deep = m.frame;
+      deepest = std::max(deepest, m.depth_ratio);
+    }
+  if (deep_frames > 0)
+    std::fprintf(opt.log ? opt.log : stderr,
+                 "warning: %d frame(s) with a penetration deeper than the penetrating leaf "
+                 "sphere's radius (first at frame %d, deepest %.2f radii; frames.csv columns "
+                 "deep_pairs, depth_ratio): the objects partly passed through each other (penalty "
+                 "too soft for the speed or load: raise collision.stiffness)\n",
+                 deep_frames, first_deep, deepest);
 
   if (opt.log && scene.world.target_fps > 0) {
     const double el =

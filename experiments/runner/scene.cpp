@@ -241,6 +241,8 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
            "filter; use \"fifo\"");
   c.layered = f.boolean("layered", c.layered);
   c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", c.single_cycle_when_apart);
+  c.swept = f.boolean("swept", c.swept);
+  c.cycle_motion = f.number("cycle_motion", c.cycle_motion, 0, 1e3, true);
   c.midpoint = f.boolean("midpoint", c.midpoint);
   c.passive = f.boolean("passive", c.passive);
   const bool paper_update = c.update.mode == collision::SphereUpdateMode::PaperRatio;
