@@ -97,6 +97,24 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
   m_complete_time.assign(m_plan.pairs.size(), -std::numeric_limits<double>::infinity());
   m_complete_depth.assign(m_plan.pairs.size(), 0.0);
   m_swept_hit.assign(m_plan.pairs.size(), 0);
+  for (size_t k = 0; k < m_settings.obstacles.size(); ++k)
+    validate(m_settings.obstacles[k], ("obstacles[" + std::to_string(k) + "]").c_str());
+  if (!m_settings.obstacles.empty())
+    for (RuntimeObject& o : m_objects) {
+      if (!o.sim) continue;  // static and kinematic objects move as they are told
+      if (o.links.num_links() == 0) o.links = LinkEvaluator(o.asset.links);
+      o.max_link = o.asset.links.coeffs.rows() ? o.asset.links.coeffs.rowwise().norm().maxCoeff() : 0;
+      std::vector<double> leaves;
+      const collision::SphereTree& t = o.asset.spheres;
+      for (int i = 0; i < t.num_nodes(); ++i)
+        if (t.is_leaf(i)) leaves.push_back(t.rest_spheres[i].r);
+      if (!leaves.empty()) {
+        std::nth_element(leaves.begin(), leaves.begin() + leaves.size() / 2, leaves.end());
+        o.obstacle_scale = leaves[leaves.size() / 2];
+      } else {
+        o.obstacle_scale = 0.05 * (o.rest.colwise().maxCoeff() - o.rest.colwise().minCoeff()).norm();
+      }
+    }
   for (RuntimeObject& o : m_objects) {
     if (!o.plan.sphere_tree) continue;
     std::vector<double> leaves;
@@ -122,8 +140,22 @@ void World::reset_sweep_start() {
 }
 
 int World::motion_cycles(double dt) const {
-  if (!m_settings.collision.swept) return 1;
   double cycles = 1;
+  if (m_obstacle_near) {
+    // Near an obstacle: each object moves at most cycle_motion of its scale
+    // (and of half the thinnest box) per cycle, gravity included.
+    double thin = std::numeric_limits<double>::infinity();
+    for (const Obstacle& ob : m_settings.obstacles) thin = std::min(thin, 0.5 * ob.thickness());
+    for (const RuntimeObject& o : m_objects) {
+      if (!o.sim || o.obstacle_scale <= 0) continue;
+      const double v = o.sim->velocities().rowwise().norm().maxCoeff();
+      const double motion = v * dt + 0.5 * m_settings.gravity.norm() * dt * dt;
+      const double step =
+          std::min(m_settings.collision.cycle_motion * std::min(o.obstacle_scale, thin), kObstacleStep);
+      cycles = std::max(cycles, std::ceil(motion / step));
+    }
+  }
+  if (!m_settings.collision.swept) return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
   for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
     const auto [i, j] = m_plan.pairs[p];
     const double motion = (m_objects[i].speed + m_objects[j].speed) * dt;
@@ -155,9 +187,17 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
                   FrameMetrics& m) {
   Clock::time_point t0 = Clock::now();
   // 1. Deformation: FEM for deformable objects (with last frame's contact
-  //    forces), rigid motion for kinematic ones.
+  //    forces), rigid motion for kinematic ones; then out of the obstacles.
+  const bool obstacles = !m_settings.obstacles.empty();
+  if (obstacles) m_obstacle_near = false;
+  if (last) m.obstacle_vertices = 0;
   for (RuntimeObject& o : m_objects) {
     if (o.plan.fem) {
+      Eigen::Vector3d lo, hi;
+      if (obstacles) {
+        lo = o.positions.colwise().minCoeff().transpose();
+        hi = o.positions.colwise().maxCoeff().transpose();
+      }
       const bool track_work =
           m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
       if (m_plan.response) o.sim->set_external_forces(o.contact_forces);
@@ -168,6 +208,11 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       if (track_work) m_contact_work += o.contact_forces.cwiseProduct(o.positions).sum();
       m.substeps += rep.substeps;
       m.min_step = std::min(m.min_step, rep.step);
+      if (obstacles) {
+        lo = lo.cwiseMin(o.positions.colwise().minCoeff().transpose());
+        hi = hi.cwiseMax(o.positions.colwise().maxCoeff().transpose());
+        resolve_obstacles(o, lo, hi, last, m);
+      }
     } else if (o.plan.kinematic) {
       o.positions.rowwise() += (h * o.setup.velocity).transpose();
     }
@@ -411,7 +456,69 @@ void World::limit_contact_work(double h, FrameMetrics& m) {
   ++m.limited;
 }
 
+void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
+                              const Eigen::Vector3d& hi_in, bool last, FrameMetrics& m) {
+  // Within reach? The dense surface lies within max_link of the coarse
+  // nodes' convex hull (a link origin is a convex combination of three
+  // nodes; the link keeps its length), which lies in [lo, hi].
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(o.max_link);
+  const Eigen::Vector3d lo = lo_in - pad, hi = hi_in + pad;
+  bool near = false;
+  for (const Obstacle& ob : m_settings.obstacles) near = near || ob.lower_bound(lo, hi) <= 0;
+  if (!near) return;
+  m_obstacle_near = true;
+  const int n = static_cast<int>(o.positions.rows());
+  MatX3d corr(n, 3), dir = MatX3d::Zero(n, 3);
+  o.obstacle_dense.resize(o.asset.links.num_links(), 3);
+  const auto& nodes = o.asset.links.nodes;
+  // A few passes: a vertex whose three nodes moved by different amounts
+  // moves by their weighted mean plus a small rotation of its link.
+  constexpr int kPasses = 6;
+  constexpr double kTolerance = 1e-6;  // m
+  bool moved = false;
+  for (int pass = 0; pass < kPasses; ++pass) {
+    o.links.apply(o.positions, o.obstacle_dense);
+    corr.setZero();
+    bool inside = false;
+    for (int v = 0; v < o.obstacle_dense.rows(); ++v) {
+      const Eigen::Vector3d p = o.obstacle_dense.row(v).transpose();
+      for (const Obstacle& ob : m_settings.obstacles) {
+        Eigen::Vector3d nrm;
+        const double d = ob.signed_distance(p, &nrm);
+        if (!(d < -kTolerance)) continue;
+        inside = true;
+        if (pass == 0) {
+          m.obstacle_depth = std::max(m.obstacle_depth, -d);
+          if (last) ++m.obstacle_vertices;
+        }
+        const Eigen::Vector3d need = -d * nrm;
+        for (int k = 0; k < 3; ++k) {
+          const int j = nodes(v, k);
+          if (need.squaredNorm() > corr.row(j).squaredNorm()) corr.row(j) = need.transpose();
+        }
+      }
+    }
+    if (!inside) break;
+    for (int j = 0; j < n; ++j)
+      if (corr.row(j).squaredNorm() > 0) {
+        o.positions.row(j) += corr.row(j);
+        dir.row(j) = corr.row(j).normalized();
+      }
+    moved = true;
+  }
+  if (!moved) return;
+  // Inelastic: the moved nodes lose their velocity into the obstacle.
+  MatX3d vel = o.sim->velocities();
+  for (int j = 0; j < n; ++j) {
+    const double vn = vel.row(j).dot(dir.row(j));
+    if (vn < 0) vel.row(j) -= vn * dir.row(j);
+  }
+  o.sim->set_positions(o.positions);
+  o.sim->set_velocities(vel);
+}
+
 bool World::contact_free() const {
+  if (m_obstacle_near) return false;
   for (const collision::CollisionResult& r : m_results)
     if (!r.colliding.empty() || !r.untested.empty()) return false;
   return true;

@@ -66,6 +66,12 @@ struct FrameMetrics {
   /// contact first seen deeper than a leaf radius, or a sweep that touched
   /// while the cycle's end was apart after a motion larger than a leaf.
   int subdivided = 0;
+  /// Dense vertices found inside a static obstacle (and projected out) in
+  /// the frame's last cycle.
+  int obstacle_vertices = 0;
+  /// Deepest a dense vertex was found inside an obstacle before its
+  /// projection, over the frame's cycles, m.
+  double obstacle_depth = 0;
   /// Largest number of colliding leaf pairs deeper than the smaller of their
   /// radii in one cycle of the frame (ContactStats::deep_pairs): the surfaces
   /// have passed through each other by more than the spheres resolve.
@@ -96,6 +102,11 @@ struct RuntimeObject {
   double motion = 0;       ///< largest sphere motion in the last cycle, m
   double speed = 0;        ///< motion / cycle length of the last cycle, m/s
   double leaf_radius = 0;  ///< median rest leaf radius, m (scale of the motion per cycle)
+  /// Obstacles: the longest rigid link (m), the object's motion scale (its
+  /// median leaf radius, m), and scratch dense positions.
+  double max_link = 0;
+  double obstacle_scale = 0;
+  MatX3d obstacle_dense;
 };
 
 /// A simulation: objects, the plan of the stages they need, and the frame loop.
@@ -147,6 +158,13 @@ class World {
   int motion_cycles(double dt) const;
   /// Spheres at the current (actual) positions: start of the next sweep.
   void reset_sweep_start();
+  /// Projects object o's dense surface out of the static obstacles (see
+  /// coupling/obstacle.hpp); [lo, hi] bounds its coarse nodes over the
+  /// cycle. Sets m_obstacle_near when it came within reach of one.
+  void resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                         bool last, FrameMetrics& m);
+  /// Some object came within reach of an obstacle in the last cycle.
+  bool m_obstacle_near = false;
   /// Detection/response cycles a frame of dt needs for a stable penalty.
   int contact_cycles(double dt) const;
   /// True when the last queries reported no pair at all (every pair pruned:
@@ -172,6 +190,10 @@ class World {
   static constexpr int kMaxMotionCycles = 1024;
   static constexpr int kMaxSplitDepth = 4;
   static constexpr int kMaxSplit = 64;
+  /// Largest motion per cycle of an object near an obstacle, m: each cycle's
+  /// projection moves surface nodes at most about this far (an instantaneous
+  /// position change stores elastic energy that comes back as a bounce).
+  static constexpr double kObstacleStep = 1e-3;
   /// Smallest per-query budget in real-time mode when the frame is already
   /// over (the query then answers with the root pair), s.
   static constexpr double kMinRealTimeBudget = 1e-6;

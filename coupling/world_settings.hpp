@@ -12,6 +12,7 @@
 #include <icd/collision/traversal.hpp>
 #include <icd/coupling/asset_bundle.hpp>
 #include <icd/coupling/contact_response.hpp>
+#include <icd/coupling/obstacle.hpp>
 #include <icd/fem/integrators.hpp>
 #include <icd/fem/material.hpp>
 #include <icd/fem/model.hpp>
@@ -35,6 +36,9 @@ struct ObjectSetup {
   std::vector<int> fixed_nodes;  ///< coarse node indices held fixed
   /// Initial velocity of a deformable object, constant velocity of a rigid one, m/s.
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  /// false: the object takes no part in sphere-tree collisions (e.g. a static
+  /// box that collides as an analytic obstacle, WorldSettings::obstacles).
+  bool sphere_collisions = true;
 };
 
 /// One object ready to simulate: its setup and its geometry (dense surface,
@@ -133,6 +137,9 @@ struct WorldSettings {
   /// getting what is left of each frame (0 = off).
   double target_fps = 0;
   CollisionSpec collision;
+  /// Static analytic obstacles (planes, boxes) that deformable objects are
+  /// kept out of by projection (coupling/obstacle.hpp).
+  std::vector<Obstacle> obstacles;
   /// Keep the dense meshes of moving objects up to date every frame (the
   /// rigid links; for output). Without it they are evaluated only where the
   /// exact reference needs them.

@@ -60,8 +60,17 @@ std::string format_duration(double s) {
 
 }  // namespace
 
+// A static box collides as an analytic box obstacle (see make_world).
+static bool analytic_box(const ObjectSpec& spec) {
+  return spec.kind == ObjectKind::Static && spec.primitive && spec.primitive->type == "box" &&
+         spec.analytic_collider;
+}
+
 std::vector<coupling::ObjectSetup> object_setups(const Scene& scene) {
-  return {scene.objects.begin(), scene.objects.end()};  // (each ObjectSpec is an ObjectSetup)
+  std::vector<coupling::ObjectSetup> setups(scene.objects.begin(), scene.objects.end());
+  for (size_t i = 0; i < setups.size(); ++i)
+    if (analytic_box(scene.objects[i])) setups[i].sphere_collisions = false;
+  return setups;
 }
 
 coupling::StagePlan scene_plan(const Scene& scene) {
@@ -72,6 +81,12 @@ std::vector<std::string> describe_plan(const Scene& scene) {
   const std::vector<coupling::ObjectSetup> setups = object_setups(scene);
   const coupling::WorldSettings settings = world_settings(scene);
   std::vector<std::string> lines = coupling::make_plan(setups, settings).describe(setups, settings);
+  int boxes = 0;
+  for (const ObjectSpec& o : scene.objects) boxes += analytic_box(o);
+  if (!scene.world.obstacles.empty() || boxes > 0)
+    lines.push_back("obstacles: " + std::to_string(scene.world.obstacles.size() + boxes) +
+                    " static plane/box obstacle(s) (" + std::to_string(boxes) +
+                    " from static box objects), deformable surfaces projected out of them");
   lines.push_back(std::string("output: ") + (scene.output.csv ? "frames.csv" : "no csv") +
                   (scene.output.vtu_every > 0 ? ", VTU/PVD series" : ""));
   return lines;
@@ -81,14 +96,27 @@ World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
                  const std::filesystem::path& tool_dir) {
   std::vector<coupling::WorldObject> objects;
   objects.reserve(scene.objects.size());
+  coupling::WorldSettings settings = world_settings(scene);
   for (const ObjectSpec& spec : scene.objects) {
     coupling::WorldObject o;
     o.setup = spec;
     o.asset = load_object_asset(spec, cache_dir, tool_dir);
     place_object(o.asset, spec);
+    if (analytic_box(spec)) {
+      // A static box collides as what it is, an analytic box obstacle, not
+      // through its sphere tree (whose leaves stand out of its faces).
+      coupling::Obstacle box;
+      box.type = coupling::Obstacle::Type::Box;
+      box.point = spec.position;
+      box.axes = coupling::rotation_matrix(spec.rotation_deg);
+      const MatX3d local = (o.asset.dense.V.rowwise() - spec.position.transpose()) * box.axes;
+      box.half_extents = local.cwiseAbs().colwise().maxCoeff().transpose();
+      settings.obstacles.push_back(box);
+      o.setup.sphere_collisions = false;
+    }
     objects.push_back(std::move(o));
   }
-  return World(std::move(objects), world_settings(scene));
+  return World(std::move(objects), settings);
 }
 
 void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path) {
@@ -123,7 +151,7 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
   csv << "frame,time,wall,fem,links,sphere_update,collision,response,budget,pair_list,"
          "collision_list,tests,interrupted,completed_level,active_pairs,max_penetration,"
          "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened,"
-         "limited,subdivided,deep_pairs,depth_ratio\n";
+         "limited,subdivided,deep_pairs,depth_ratio,obstacle_vertices,obstacle_depth\n";
   for (const FrameMetrics& m : frames)
     csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
         << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
@@ -132,7 +160,8 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
         << m.max_penetration << ',' << m.contact_force << ',' << m.cycles << ',' << m.substeps
         << ',' << m.min_step << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback
         << ',' << m.reused << ',' << m.softened << ',' << m.limited << ',' << m.subdivided << ','
-        << m.deep_pairs << ',' << m.depth_ratio << '\n';
+        << m.deep_pairs << ',' << m.depth_ratio << ',' << m.obstacle_vertices << ','
+        << m.obstacle_depth << '\n';
   return csv.str();
 }
 
