@@ -1,5 +1,6 @@
 #include <icd/coupling/contact_response.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -135,7 +136,7 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
       acc_b(forces_b, b, options.distribution, options.mass_b);
   ContactStats stats;
   const double k = options.stiffness;
-  auto respond = [&](const NodePair& p, double cap) {
+  auto respond = [&](const NodePair& p, double cap, bool leaf) {
     const collision::Sphere& sa = a.spheres[p.a];
     const collision::Sphere& sb = b.spheres[p.b];
     const Eigen::Vector3d d = sb.center() - sa.center();
@@ -153,13 +154,18 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     ++stats.active_pairs;
     stats.max_penetration = std::max(stats.max_penetration, delta);
     stats.penalty_energy += 0.5 * k * delta * delta;
+    if (leaf) {
+      const double ratio = delta / std::max(std::min(sa.r, sb.r), 1e-300);
+      stats.max_depth_ratio = std::max(stats.max_depth_ratio, ratio);
+      stats.deep_pairs += ratio > 1.0;
+    }
   };
   if (!(options.max_untested_penetration > 0.0))
     throw ParameterError("contact response: max_untested_penetration must be positive (got " +
                          std::to_string(options.max_untested_penetration) + ")");
-  for (const NodePair& p : result.colliding) respond(p, std::numeric_limits<double>::infinity());
+  for (const NodePair& p : result.colliding) respond(p, std::numeric_limits<double>::infinity(), true);
   if (options.use_untested)
-    for (const NodePair& p : result.untested) respond(p, options.max_untested_penetration);
+    for (const NodePair& p : result.untested) respond(p, options.max_untested_penetration, false);
   if (options.distribution == ContactDistribution::PaperAverage) {
     stats.total_force_a = acc_a.finish();
     stats.total_force_b = acc_b.finish();

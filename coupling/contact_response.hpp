@@ -61,6 +61,14 @@ struct ContactOptions {
 struct ContactStats {
   int active_pairs = 0;        ///< pairs with positive penetration
   double max_penetration = 0;  ///< largest delta (model units)
+  /// Colliding leaf pairs deeper than the smaller of their two radii
+  /// (delta > min(r_a, r_b)): the surfaces have passed through each other by
+  /// more than the spheres resolve (a contact found too late, or a penalty
+  /// too soft for the load). Untested pairs are not counted.
+  int deep_pairs = 0;
+  /// Largest delta / min(r_a, r_b) over the colliding leaf pairs (> 1 when
+  /// deep_pairs > 0).
+  double max_depth_ratio = 0;
   /// Energy stored in the penalty springs, sum of k delta^2 / 2 over the
   /// active pairs (J when lengths are in m).
   double penalty_energy = 0;

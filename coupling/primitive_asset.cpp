@@ -119,17 +119,20 @@ AssetBundle make_primitive_asset(const PrimitiveSpec& spec, int depth) {
   return a;
 }
 
+Eigen::Matrix3d rotation_matrix(const Eigen::Vector3d& rotation_deg) {
+  const double d2r = std::numbers::pi / 180.0;
+  return (Eigen::AngleAxisd(rotation_deg.z() * d2r, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(rotation_deg.y() * d2r, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rotation_deg.x() * d2r, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
 void place_asset(AssetBundle& a, const Placement& spec) {
   const Eigen::RowVector3d lo = a.dense.V.colwise().minCoeff(), hi = a.dense.V.colwise().maxCoeff();
   const Eigen::RowVector3d centre = (lo + hi) / 2;
   const double longest = (hi - lo).maxCoeff();
   const double s = spec.size > 0 ? spec.size / longest : 1.0;
-  const double d2r = std::numbers::pi / 180.0;
-  const Eigen::Matrix3d R =
-      (Eigen::AngleAxisd(spec.rotation_deg.z() * d2r, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(spec.rotation_deg.y() * d2r, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(spec.rotation_deg.x() * d2r, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d R = rotation_matrix(spec.rotation_deg);
   const Eigen::RowVector3d pos = spec.position.transpose();
   auto map_points = [&](MatX3d& P) {
     P = (((P.rowwise() - centre) * s) * R.transpose()).rowwise() + pos;

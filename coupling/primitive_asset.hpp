@@ -32,6 +32,9 @@ struct Placement {
   Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();  ///< XYZ Euler angles, degrees
 };
 
+/// The rotation of place_asset(): XYZ Euler angles in degrees, R = Rz Ry Rx.
+Eigen::Matrix3d rotation_matrix(const Eigen::Vector3d& rotation_deg);
+
 /// Scales (longest bounding-box side of the dense mesh -> placement.size,
 /// when > 0), rotates (XYZ Euler, degrees) about the dense bounding-box
 /// centre and moves that centre to placement.position: dense, coarse,

@@ -24,7 +24,8 @@ StagePlan make_plan(std::span<const ObjectSetup> objects, const WorldSettings& s
     for (int j = i + 1; j < n; ++j) {
       const bool moves_i = objects[i].kind != ObjectKind::Static;
       const bool moves_j = objects[j].kind != ObjectKind::Static;
-      if (moves_i || moves_j) plan.pairs.emplace_back(i, j);
+      if ((moves_i || moves_j) && objects[i].sphere_collisions && objects[j].sphere_collisions)
+        plan.pairs.emplace_back(i, j);
     }
   for (const auto& [i, j] : plan.pairs)
     for (int k : {i, j}) {

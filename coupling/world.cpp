@@ -9,6 +9,7 @@
 
 #include <icd/collision/aabb_tree.hpp>
 #include <icd/collision/sphere_update.hpp>
+#include <icd/collision/swept_spheres.hpp>
 #include <icd/coupling/contact_response.hpp>
 #include <icd/mesh/core/error.hpp>
 
@@ -125,6 +126,73 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
   m_complete.resize(m_plan.pairs.size());
   m_complete_time.assign(m_plan.pairs.size(), -std::numeric_limits<double>::infinity());
   m_complete_depth.assign(m_plan.pairs.size(), 0.0);
+  m_swept_hit.assign(m_plan.pairs.size(), 0);
+  for (size_t k = 0; k < m_settings.obstacles.size(); ++k)
+    validate(m_settings.obstacles[k], ("obstacles[" + std::to_string(k) + "]").c_str());
+  if (!m_settings.obstacles.empty())
+    for (RuntimeObject& o : m_objects) {
+      if (!o.sim) continue;  // static and kinematic objects move as they are told
+      if (o.links.num_links() == 0) o.links = LinkEvaluator(o.asset.links);
+      o.max_link = o.asset.links.coeffs.rows() ? o.asset.links.coeffs.rowwise().norm().maxCoeff() : 0;
+      std::vector<double> leaves;
+      const collision::SphereTree& t = o.asset.spheres;
+      for (int i = 0; i < t.num_nodes(); ++i)
+        if (t.is_leaf(i)) leaves.push_back(t.rest_spheres[i].r);
+      if (!leaves.empty()) {
+        std::nth_element(leaves.begin(), leaves.begin() + leaves.size() / 2, leaves.end());
+        o.obstacle_scale = leaves[leaves.size() / 2];
+      } else {
+        o.obstacle_scale = 0.05 * (o.rest.colwise().maxCoeff() - o.rest.colwise().minCoeff()).norm();
+      }
+    }
+  for (RuntimeObject& o : m_objects) {
+    if (!o.plan.sphere_tree) continue;
+    std::vector<double> leaves;
+    const collision::SphereTree& t = o.asset.spheres;
+    for (int i = 0; i < t.num_nodes(); ++i)
+      if (t.is_leaf(i)) leaves.push_back(t.rest_spheres[i].r);
+    std::nth_element(leaves.begin(), leaves.begin() + leaves.size() / 2, leaves.end());
+    o.leaf_radius = leaves[leaves.size() / 2];
+  }
+  for (const auto& [i, j] : m_plan.pairs)
+    m_pair_leaf.push_back(std::min(m_objects[i].leaf_radius, m_objects[j].leaf_radius));
+  reset_sweep_start();
+}
+
+void World::reset_sweep_start() {
+  if (!m_settings.collision.swept) return;
+  for (RuntimeObject& o : m_objects)
+    if (o.plan.sphere_update) {
+      collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+      if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
+      o.start_spheres = o.asset.spheres.spheres;
+    }
+}
+
+int World::motion_cycles(double dt) const {
+  double cycles = 1;
+  if (m_obstacle_near) {
+    // Near an obstacle: each object moves at most cycle_motion of its scale
+    // (and of half the thinnest box) per cycle, gravity included.
+    double thin = std::numeric_limits<double>::infinity();
+    for (const Obstacle& ob : m_settings.obstacles) thin = std::min(thin, 0.5 * ob.thickness());
+    for (const RuntimeObject& o : m_objects) {
+      if (!o.sim || o.obstacle_scale <= 0) continue;
+      const double v = o.sim->velocities().rowwise().norm().maxCoeff();
+      const double motion = v * dt + 0.5 * m_settings.gravity.norm() * dt * dt;
+      const double step =
+          std::min(m_settings.collision.cycle_motion * std::min(o.obstacle_scale, thin), kObstacleStep);
+      cycles = std::max(cycles, std::ceil(motion / step));
+    }
+  }
+  if (!m_settings.collision.swept) return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
+  for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+    const auto [i, j] = m_plan.pairs[p];
+    const double motion = (m_objects[i].speed + m_objects[j].speed) * dt;
+    const double step = m_settings.collision.cycle_motion * m_pair_leaf[p];
+    if (step > 0) cycles = std::max(cycles, std::ceil(motion / step));
+  }
+  return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
 }
 
 void World::set_external_forces(int i, const MatX3d& forces) {
@@ -159,12 +227,21 @@ void World::update_dense(RuntimeObject& o) {
   o.links.apply(o.positions, o.dense);
 }
 
-void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics& m) {
+void World::cycle(double h, double t_end, double budget, bool last, bool start_free,
+                  FrameMetrics& m) {
   Clock::time_point t0 = Clock::now();
   // 1. Deformation: FEM for deformable objects (with last frame's contact
-  //    forces), rigid motion for kinematic ones.
+  //    forces), rigid motion for kinematic ones; then out of the obstacles.
+  const bool obstacles = !m_settings.obstacles.empty();
+  if (obstacles) m_obstacle_near = false;
+  if (last) m.obstacle_vertices = 0;
   for (RuntimeObject& o : m_objects) {
     if (o.plan.fem) {
+      Eigen::Vector3d lo, hi;
+      if (obstacles) {
+        lo = o.positions.colwise().minCoeff().transpose();
+        hi = o.positions.colwise().maxCoeff().transpose();
+      }
       const bool track_work =
           m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
       if (o.external_forces.size() > 0)
@@ -179,7 +256,11 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       if (track_work) m_contact_work += o.contact_forces.cwiseProduct(o.positions).sum();
       m.substeps += rep.substeps;
       m.min_step = std::min(m.min_step, rep.step);
-      if (last) m.energy += mechanical_energy(*o.sim, m_settings.gravity);
+      if (obstacles) {
+        lo = lo.cwiseMin(o.positions.colwise().minCoeff().transpose());
+        hi = hi.cwiseMax(o.positions.colwise().maxCoeff().transpose());
+        resolve_obstacles(o, lo, hi, last, m);
+      }
     } else if (o.plan.kinematic) {
       o.positions.rowwise() += (h * o.setup.velocity).transpose();
     }
@@ -196,26 +277,49 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
 
   // 3. Sphere trees follow the coarse nodes (paper 4.4).
   t0 = Clock::now();
+  const CollisionSpec& cs = m_settings.collision;
   for (RuntimeObject& o : m_objects)
     if (o.plan.sphere_update) {
+      if (cs.swept) {  // the spheres at the end of the cycle (actual positions)
+        collision::update_spheres(o.asset.spheres, o.rest, o.positions, cs.update);
+        if (cs.layered) collision::enclose_children(o.asset.spheres);
+        o.end_spheres = o.asset.spheres.spheres;
+      }
       if (m_settings.collision.midpoint && o.sim && m_plan.response) {
         // Midpoint sampling: the forces of this query act during the next
         // cycle, so detect at the positions predicted for its middle.
         o.predicted = o.positions + (0.5 * h) * o.sim->velocities();
         collision::update_spheres(o.asset.spheres, o.rest, o.predicted, m_settings.collision.update);
+        if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
+        // The sweep runs from the start to the prediction, via the end.
+        if (cs.swept)
+          o.motion = collision::sweep_spheres(o.start_spheres, o.asset.spheres.spheres, o.swept,
+                                              o.end_spheres);
+      } else if (cs.swept) {
+        o.motion = collision::sweep_spheres(o.start_spheres, o.end_spheres, o.swept);
       } else {
         collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+        if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
       }
-      if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
+      if (cs.swept) {
+        o.speed = o.motion / h;
+        std::swap(o.start_spheres, o.end_spheres);  // the next cycle starts at this end
+      }
     }
+  // Objects that do not move sweep nothing.
+  if (cs.swept)
+    for (RuntimeObject& o : m_objects)
+      if (o.plan.sphere_tree && !o.plan.sphere_update && o.swept.empty())
+        collision::still_spheres(o.asset.spheres.spheres, o.swept);
   m.times.sphere_update += seconds_since(t0);
 
   // 4. Interruptible collision queries, one per candidate pair.
   t0 = Clock::now();
-  const CollisionSpec& cs = m_settings.collision;
   if (last) {
     m.pair_list = m.collision_list = 0;
     m.completed_level = std::numeric_limits<int>::max();
+    m.active_pairs = 0;
+    m.contact_force = 0;
   }
   for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
     const auto [i, j] = m_plan.pairs[p];
@@ -225,13 +329,58 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     req.record_front = cs.temporal_coherence;
     if (cs.temporal_coherence && !m_fronts[p].empty()) req.start_front = &m_fronts[p];
     collision::CollisionResult& r = m_results[p];
-    if (m_plan.broad_phase && !collision::overlap(m_objects[i].asset.spheres.spheres[0],
-                                                  m_objects[j].asset.spheres.spheres[0])) {
+    const RuntimeObject& oa = m_objects[i];
+    const RuntimeObject& ob = m_objects[j];
+    if (cs.swept) {
+      // Continuous detection: were the surfaces apart during the whole cycle?
+      // (The sweep answers yes or no, stopping at the first touching leaf
+      // pair. It shares the query's time budget, running out answers yes; a
+      // budget in tests bounds the query's refinement only: the sweep is a
+      // safety check, and a test budget small enough to stop it would cycle
+      // every frame.)
+      collision::SweptRequest sreq;
+      sreq.budget_seconds = req.budget_seconds;
+      const collision::SweptResult sw = collision::swept_contact(
+          oa.asset.spheres, oa.swept, ob.asset.spheres, ob.swept, sreq, m_sweep_stack);
+      m.tests += sw.tests;
+      const bool hit = sw.touched;
+      m_swept_hit[p] = hit;
+      if (!hit) {  // apart during the whole cycle: so are the end spheres
+        r.colliding.clear();
+        r.untested.clear();
+        r.front.clear();
+        r.interrupted = false;
+        r.stop_reason = collision::StopReason::Completed;
+        r.tests = 0;
+        if (cs.temporal_coherence) m_fronts[p].clear();
+        if (cs.on_interrupt == InterruptedResponse::Previous) {
+          m_complete[p].colliding.clear();
+          m_complete[p].untested.clear();
+          m_complete_time[p] = t_end;
+        }
+        continue;
+      }
+    }
+    if (m_plan.broad_phase && !collision::overlap(oa.asset.spheres.spheres[0],
+                                                  ob.asset.spheres.spheres[0])) {
       // Broad phase: root spheres apart, nothing to refine.
       r = collision::CollisionResult{};
+      if (cs.swept && start_free && oa.motion + ob.motion > cs.cycle_motion * m_pair_leaf[p]) {
+        m_split = true;  // the sweep touched, the end is apart: crossed within the cycle?
+        m_split_factor = std::max(
+            m_split_factor,
+            static_cast<int>(std::ceil((oa.motion + ob.motion) / (cs.cycle_motion * m_pair_leaf[p]))));
+      }
       continue;
     }
-    collision::collide(m_objects[i].asset.spheres, m_objects[j].asset.spheres, req, r);
+    collision::collide(oa.asset.spheres, ob.asset.spheres, req, r);
+    if (cs.swept && start_free && r.colliding.empty() && r.untested.empty() &&
+        oa.motion + ob.motion > cs.cycle_motion * m_pair_leaf[p]) {
+      m_split = true;  // the sweep touched, the end is apart: crossed within the cycle?
+      m_split_factor = std::max(
+          m_split_factor,
+          static_cast<int>(std::ceil((oa.motion + ob.motion) / (cs.cycle_motion * m_pair_leaf[p]))));
+    }
     if (cs.temporal_coherence) m_fronts[p] = r.front;
     if (!r.interrupted && cs.on_interrupt == InterruptedResponse::Previous) {
       m_complete[p].colliding = r.colliding;  // copies into reused storage
@@ -286,6 +435,17 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
       m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
       m_penalty_energy += st.penalty_energy;
       m.max_penetration = std::max(m.max_penetration, st.max_penetration);
+      m.deep_pairs = std::max(m.deep_pairs, st.deep_pairs);
+      m.depth_ratio = std::max(m.depth_ratio, st.max_depth_ratio);
+      const double step = cs.cycle_motion * m_pair_leaf[p];
+      if (cs.swept && start_free && st.deep_pairs > 0 && a.motion + b.motion > step) {
+        // First seen already deeper than a leaf after a motion longer than
+        // the cycle should allow: re-run the cycle shorter. (Objects that
+        // start overlapping are not split: no shorter cycle would help.)
+        m_split = true;
+        m_split_factor = std::max(
+            m_split_factor, static_cast<int>(std::ceil((a.motion + b.motion) / std::max(step, 1e-300))));
+      }
       if (last) {
         m.active_pairs += st.active_pairs;
         m.contact_force += st.total_force_a.norm();
@@ -312,10 +472,7 @@ void World::cycle(double h, double t_end, double budget, bool last, FrameMetrics
     if (m_settings.collision.passive) limit_contact_work(h, m);
   }
   m.times.response += seconds_since(t0);
-  if (last) {
-    m.energy += m_penalty_energy;
-    m.penalty_energy = m_penalty_energy;
-  }
+  if (last) m.penalty_energy = m_penalty_energy;
 }
 
 void World::limit_contact_work(double h, FrameMetrics& m) {
@@ -348,7 +505,69 @@ void World::limit_contact_work(double h, FrameMetrics& m) {
   ++m.limited;
 }
 
+void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
+                              const Eigen::Vector3d& hi_in, bool last, FrameMetrics& m) {
+  // Within reach? The dense surface lies within max_link of the coarse
+  // nodes' convex hull (a link origin is a convex combination of three
+  // nodes; the link keeps its length), which lies in [lo, hi].
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(o.max_link);
+  const Eigen::Vector3d lo = lo_in - pad, hi = hi_in + pad;
+  bool near = false;
+  for (const Obstacle& ob : m_settings.obstacles) near = near || ob.lower_bound(lo, hi) <= 0;
+  if (!near) return;
+  m_obstacle_near = true;
+  const int n = static_cast<int>(o.positions.rows());
+  MatX3d corr(n, 3), dir = MatX3d::Zero(n, 3);
+  o.obstacle_dense.resize(o.asset.links.num_links(), 3);
+  const auto& nodes = o.asset.links.nodes;
+  // A few passes: a vertex whose three nodes moved by different amounts
+  // moves by their weighted mean plus a small rotation of its link.
+  constexpr int kPasses = 6;
+  constexpr double kTolerance = 1e-6;  // m
+  bool moved = false;
+  for (int pass = 0; pass < kPasses; ++pass) {
+    o.links.apply(o.positions, o.obstacle_dense);
+    corr.setZero();
+    bool inside = false;
+    for (int v = 0; v < o.obstacle_dense.rows(); ++v) {
+      const Eigen::Vector3d p = o.obstacle_dense.row(v).transpose();
+      for (const Obstacle& ob : m_settings.obstacles) {
+        Eigen::Vector3d nrm;
+        const double d = ob.signed_distance(p, &nrm);
+        if (!(d < -kTolerance)) continue;
+        inside = true;
+        if (pass == 0) {
+          m.obstacle_depth = std::max(m.obstacle_depth, -d);
+          if (last) ++m.obstacle_vertices;
+        }
+        const Eigen::Vector3d need = -d * nrm;
+        for (int k = 0; k < 3; ++k) {
+          const int j = nodes(v, k);
+          if (need.squaredNorm() > corr.row(j).squaredNorm()) corr.row(j) = need.transpose();
+        }
+      }
+    }
+    if (!inside) break;
+    for (int j = 0; j < n; ++j)
+      if (corr.row(j).squaredNorm() > 0) {
+        o.positions.row(j) += corr.row(j);
+        dir.row(j) = corr.row(j).normalized();
+      }
+    moved = true;
+  }
+  if (!moved) return;
+  // Inelastic: the moved nodes lose their velocity into the obstacle.
+  MatX3d vel = o.sim->velocities();
+  for (int j = 0; j < n; ++j) {
+    const double vn = vel.row(j).dot(dir.row(j));
+    if (vn < 0) vel.row(j) -= vn * dir.row(j);
+  }
+  o.sim->set_positions(o.positions);
+  o.sim->set_velocities(vel);
+}
+
 bool World::contact_free() const {
+  if (m_obstacle_near) return false;
   for (const collision::CollisionResult& r : m_results)
     if (!r.colliding.empty() || !r.untested.empty()) return false;
   return true;
@@ -370,6 +589,8 @@ void World::save(Snapshot& s) const {
   s.contact_scale = m_contact_scale;
   s.contact_work = m_contact_work;
   s.passive_allowance = m_passive_allowance;
+  s.start_spheres.resize(m_objects.size());
+  for (size_t i = 0; i < m_objects.size(); ++i) s.start_spheres[i] = m_objects[i].start_spheres;
 }
 
 void World::restore(const Snapshot& s) {
@@ -391,6 +612,12 @@ void World::restore(const Snapshot& s) {
   m_contact_work = s.contact_work;
   m_passive_allowance = s.passive_allowance;
   m_penalty_energy = 0;  // the trial started contact-free
+  for (size_t i = 0; i < m_objects.size(); ++i) m_objects[i].start_spheres = s.start_spheres[i];
+  // The rolled-back interval started contact-free: so do its queries.
+  for (collision::CollisionResult& r : m_results) {
+    r.colliding.clear();
+    r.untested.clear();
+  }
 }
 
 FrameMetrics World::step() { return advance(std::nullopt); }
@@ -422,41 +649,89 @@ FrameMetrics World::advance(std::optional<double> budget) {
   // at omega = sqrt(k / m), stable only if the query interval h obeys
   // omega h <= kContactOmegaStep (under the explicit limit 2). So a frame runs as
   // many detection/response cycles as that needs; FEM sub-steps inside each.
-  const int cycles = contact_cycles(dt);
-  m.cycles = cycles;
+  // With collision.swept, also as many as keep each pair's relative motion
+  // per cycle under collision.cycle_motion leaf radii (motion_cycles()).
+  const int stiff_cycles = contact_cycles(dt);
+  int cycles = std::max(stiff_cycles, contact_free() ? 1 : motion_cycles(dt));
+  m.cycles = 0;
 
   // While the objects are apart, no force acts and one cycle per frame gives
   // the same motion. So a frame that starts contact-free is first tried as a
-  // single cycle; if its closing query finds a contact, the frame is rolled
-  // back and re-run in `cycles` cycles, so contact forces start from the
-  // cycle in which the contact begins, as if every frame had been cycled.
-  // (A contact that begins and ends inside one trial frame is missed: it
-  // would need the objects to cross a whole contact within 1 / frame_rate.)
-  if (cycles > 1 && m_settings.collision.single_cycle_when_apart && contact_free()) {
+  // single cycle; if its closing query finds a contact (with collision.swept:
+  // if the sweep of the frame touches anywhere), the frame is rolled back and
+  // re-run in full cycles, so contact forces start from the cycle in which the
+  // contact begins, as if every frame had been cycled. (Without the sweep, a
+  // contact that begins and ends inside one trial frame is missed.)
+  const bool swept = m_settings.collision.swept;
+  if ((cycles > 1 || swept) && m_settings.collision.single_cycle_when_apart && contact_free()) {
     save(m_snapshot);
     FrameMetrics trial = m;
     trial.cycles = 1;
     trial.budget = budget_at(1.0);
-    cycle(dt, m_time + dt, trial.budget, true, trial);
-    if (contact_free()) {
+    m_split = false;
+    cycle(dt, m_time + dt, trial.budget, true, true, trial);
+    bool touched = !contact_free();
+    if (swept)
+      for (char hit : m_swept_hit) touched = touched || hit;
+    if (!touched) {
       m = trial;
       return finish_frame(m, frame_start);
     }
     restore(m_snapshot);
     m.rollback = 1;
     m.times = trial.times;  // the rolled-back work is part of the frame's cost
+    m.tests = trial.tests;
+    // The trial measured each object's motion over the frame.
+    cycles = std::max({stiff_cycles, motion_cycles(dt), 1});
   }
-
-  const double h = dt / cycles;
-  for (int c = 0; c < cycles; ++c) {
-    const bool last = c + 1 == cycles;
-    m.budget = budget_at((c + 1) / static_cast<double>(cycles));
-    cycle(h, m_time + (c + 1) * h, m.budget, last, m);
-  }
+  run_cycles(m_time, dt, cycles, 0, true, budget_at, m);
   return finish_frame(m, frame_start);
 }
 
+void World::run_cycles(double t0, double length, int n, int depth, bool ends_frame,
+                       const std::function<double(double)>& budget_at, FrameMetrics& m) {
+  const double dt = 1.0 / m_settings.frame_rate;
+  const double h = length / n;
+  if (m_split_snapshots.size() <= static_cast<size_t>(depth)) m_split_snapshots.resize(depth + 1);
+  for (int c = 0; c < n; ++c) {
+    const bool last = ends_frame && c + 1 == n;
+    const double t_end = c + 1 == n ? t0 + length : t0 + (c + 1) * h;
+    const bool start_free = contact_free();
+    const bool can_split = m_settings.collision.swept && start_free && depth < kMaxSplitDepth;
+    FrameMetrics before;
+    if (can_split) {
+      save(m_split_snapshots[depth]);
+      before = m;
+    }
+    m_split = false;
+    m_split_factor = 2;
+    m.budget = budget_at((t_end - m_time) / dt);
+    cycle(h, t_end, m.budget, last, start_free, m);
+    ++m.cycles;
+    if (can_split && m_split) {
+      // Rolled back: the work done stays counted, its contact results do not.
+      restore(m_split_snapshots[depth]);
+      const StageTimes times = m.times;
+      const int64_t tests = m.tests;
+      const int cycles = m.cycles, substeps = m.substeps;
+      const double min_step = m.min_step;
+      m = before;
+      m.times = times;
+      m.tests = tests;
+      m.cycles = cycles;
+      m.substeps = substeps;
+      m.min_step = min_step;
+      ++m.subdivided;
+      run_cycles(t_end - h, h, std::clamp(m_split_factor, 2, kMaxSplit), depth + 1, last, budget_at,
+                 m);
+    }
+  }
+}
+
 FrameMetrics World::finish_frame(FrameMetrics& m, Clock::time_point frame_start) {
+  m.energy = m_penalty_energy;
+  for (RuntimeObject& o : m_objects)
+    if (o.sim) m.energy += mechanical_energy(*o.sim, m_settings.gravity);
   // Exact reference: intersecting dense triangles (for accuracy studies).
   if (m_plan.exact_reference) {
     m.exact_contacts = 0;

@@ -4,10 +4,12 @@
 /// response, rigid links, each stage only where the plan needs it. A library
 /// type: it takes loaded objects and does no file I/O.
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
 
+#include <icd/collision/swept_spheres.hpp>
 #include <icd/collision/traversal.hpp>
 #include <icd/coupling/link_evaluator.hpp>
 #include <icd/coupling/stage_plan.hpp>
@@ -60,6 +62,23 @@ struct FrameMetrics {
   /// (for an interrupted query, springs between coarse spheres assumed colliding).
   double penalty_energy = 0;
   int exact_contacts = -1;  ///< exact intersecting dense triangle pairs (-1: not computed)
+  /// Cycles rolled back and re-run in shorter cycles (collision.swept): a
+  /// contact first seen deeper than a leaf radius, or a sweep that touched
+  /// while the cycle's end was apart after a motion larger than a leaf.
+  int subdivided = 0;
+  /// Dense vertices found inside a static obstacle (and projected out) in
+  /// the frame's last cycle.
+  int obstacle_vertices = 0;
+  /// Deepest a dense vertex was found inside an obstacle before its
+  /// projection, over the frame's cycles, m.
+  double obstacle_depth = 0;
+  /// Largest number of colliding leaf pairs deeper than the smaller of their
+  /// radii in one cycle of the frame (ContactStats::deep_pairs): the surfaces
+  /// have passed through each other by more than the spheres resolve.
+  int deep_pairs = 0;
+  /// Largest penetration / smaller leaf radius of a colliding leaf pair in
+  /// the frame (> 1 with deep_pairs).
+  double depth_ratio = 0;
 };
 
 /// One object at run time.
@@ -79,6 +98,19 @@ struct RuntimeObject {
   LinkEvaluator links;            ///< the rigid links, grouped by node triple (when dense_update)
   MatX3d predicted;               ///< coarse positions half a cycle ahead (collision.midpoint)
   Eigen::VectorXd node_mass;      ///< lumped coarse node masses (kg); huge for objects without FEM
+  /// collision.swept: the spheres at the start of the cycle (actual
+  /// positions, not the midpoint prediction), at its end, and swept from the
+  /// start to the end (or to the midpoint prediction, via the end).
+  std::vector<collision::Sphere> start_spheres, end_spheres;
+  std::vector<collision::SweptSphere> swept;
+  double motion = 0;       ///< largest sphere motion in the last cycle, m
+  double speed = 0;        ///< motion / cycle length of the last cycle, m/s
+  double leaf_radius = 0;  ///< median rest leaf radius, m (scale of the motion per cycle)
+  /// Obstacles: the longest rigid link (m), the object's motion scale (its
+  /// median leaf radius, m), and scratch dense positions.
+  double max_link = 0;
+  double obstacle_scale = 0;
+  MatX3d obstacle_dense;
 };
 
 /// A simulation: objects, the plan of the stages they need, and the frame loop.
@@ -123,7 +155,25 @@ class World {
   FrameMetrics finish_frame(FrameMetrics& m, Clock::time_point frame_start);
   /// One detection/response cycle of length h (s) inside a frame, ending at
   /// simulated time t_end.
-  void cycle(double h, double t_end, double budget, bool last, FrameMetrics& m);
+  void cycle(double h, double t_end, double budget, bool last, bool start_free, FrameMetrics& m);
+  /// Runs `n` cycles over [t0, t0 + length]; with collision.swept, a cycle
+  /// that starts contact-free and asks to be split (m_split) is rolled back
+  /// and re-run as shorter cycles (recursively, `depth` deep).
+  void run_cycles(double t0, double length, int n, int depth, bool ends_frame,
+                  const std::function<double(double)>& budget_at, FrameMetrics& m);
+  /// Cycles a frame of dt needs so that no pair moves more than
+  /// collision.cycle_motion leaf radii relative to each other per cycle,
+  /// from each object's last measured sphere speed.
+  int motion_cycles(double dt) const;
+  /// Spheres at the current (actual) positions: start of the next sweep.
+  void reset_sweep_start();
+  /// Projects object o's dense surface out of the static obstacles (see
+  /// coupling/obstacle.hpp); [lo, hi] bounds its coarse nodes over the
+  /// cycle. Sets m_obstacle_near when it came within reach of one.
+  void resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                         bool last, FrameMetrics& m);
+  /// Some object came within reach of an obstacle in the last cycle.
+  bool m_obstacle_near = false;
   /// Detection/response cycles a frame of dt needs for a stable penalty.
   int contact_cycles(double dt) const;
   /// True when the last queries reported no pair at all (every pair pruned:
@@ -138,11 +188,21 @@ class World {
     double node_stiffness = 0;
     double contact_scale = 1;
     double contact_work = 0, passive_allowance = -1;
+    std::vector<std::vector<collision::Sphere>> start_spheres;
   };
   void save(Snapshot& s) const;
   void restore(const Snapshot& s);
 
   static constexpr int kMaxContactCycles = 64;
+  /// Most cycles a frame is cut into for motion (fast objects), and deepest
+  /// recursive split of a cycle (each split at most kMaxSplit cycles).
+  static constexpr int kMaxMotionCycles = 1024;
+  static constexpr int kMaxSplitDepth = 4;
+  static constexpr int kMaxSplit = 64;
+  /// Largest motion per cycle of an object near an obstacle, m: each cycle's
+  /// projection moves surface nodes at most about this far (an instantaneous
+  /// position change stores elastic energy that comes back as a bounce).
+  static constexpr double kObstacleStep = 1e-3;
   /// Smallest per-query budget in real-time mode when the frame is already
   /// over (the query then answers with the root pair), s.
   static constexpr double kMinRealTimeBudget = 1e-6;
@@ -180,6 +240,15 @@ class World {
   /// Net energy the current episode may add, J (-1: no episode under way).
   double m_passive_allowance = -1;
   Snapshot m_snapshot;  ///< reused storage for the single-cycle trial
+  std::vector<Snapshot> m_split_snapshots;  ///< per split depth (collision.swept)
+  /// Set by cycle(): the cycle should be re-run as m_split_factor shorter cycles.
+  bool m_split = false;
+  int m_split_factor = 1;
+  /// Median leaf radius of each pair's smaller tree (same order as plan().pairs), m.
+  std::vector<double> m_pair_leaf;
+  std::vector<collision::NodePair> m_sweep_stack;  ///< reused storage of the swept queries
+  /// Per pair: the swept query of the last cycle reported a pair.
+  std::vector<char> m_swept_hit;
   int m_frame = 0;
   double m_time = 0;
 };

@@ -26,6 +26,8 @@ void validate(const WorldSettings& s) {
     fail("collision.contact.stiffness", "must be > 0 and finite", c.contact.stiffness);
   if (!(c.previous_max_age >= 0))
     fail("collision.previous_max_age", "must be >= 0", c.previous_max_age);
+  if (!(c.cycle_motion > 0) || !std::isfinite(c.cycle_motion))
+    fail("collision.cycle_motion", "must be > 0 and finite", c.cycle_motion);
   if (!(c.update.margin >= 0) || !std::isfinite(c.update.margin))
     fail("collision.update.margin", "must be >= 0 and finite", c.update.margin);
 }

@@ -12,6 +12,7 @@
 #include <icd/collision/traversal.hpp>
 #include <icd/coupling/asset_bundle.hpp>
 #include <icd/coupling/contact_response.hpp>
+#include <icd/coupling/obstacle.hpp>
 #include <icd/fem/integrators.hpp>
 #include <icd/fem/material.hpp>
 #include <icd/fem/model.hpp>
@@ -35,6 +36,9 @@ struct ObjectSetup {
   std::vector<int> fixed_nodes;  ///< coarse node indices held fixed
   /// Initial velocity of a deformable object, constant velocity of a rigid one, m/s.
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  /// false: the object takes no part in sphere-tree collisions (e.g. a static
+  /// box that collides as an analytic obstacle, WorldSettings::obstacles).
+  bool sphere_collisions = true;
 };
 
 /// One object ready to simulate: its setup and its geometry (dense surface,
@@ -87,6 +91,20 @@ struct CollisionSpec {
   /// cycle, rolled back and re-run in full cycles if its closing query finds
   /// a contact (see World::step). false: every frame runs all its cycles.
   bool single_cycle_when_apart = true;
+  /// Continuous detection (not in the paper): each cycle first queries the
+  /// swept trees (every sphere grown to enclose its positions at the cycle's
+  /// start and end, collision/swept_spheres.hpp), so two objects that cross
+  /// each other between two queries are still found. A pair whose swept trees
+  /// are apart skips its end-of-cycle query. A cycle that starts contact-free
+  /// and ends in a contact deeper than the penetrating leaf's radius, or whose
+  /// sweep touched while its end did not after a motion larger than a leaf, is
+  /// rolled back and re-run in shorter cycles (FrameMetrics::subdivided).
+  bool swept = true;
+  /// Largest motion of a pair relative to each other per cycle, as a fraction
+  /// of the smaller of their median leaf radii, when frames are cut into
+  /// cycles by motion (in contact, or after a frame tried as one cycle found
+  /// a contact). Bounds the depth at which a contact is first seen.
+  double cycle_motion = 0.5;
   /// Detect at the coarse positions predicted for the middle of the next
   /// cycle (x + h v / 2), during which the resulting forces act, instead of
   /// at its start: the staggered penalty then engages and releases half a
@@ -119,6 +137,9 @@ struct WorldSettings {
   /// getting what is left of each frame (0 = off).
   double target_fps = 0;
   CollisionSpec collision;
+  /// Static analytic obstacles (planes, boxes) that deformable objects are
+  /// kept out of by projection (coupling/obstacle.hpp).
+  std::vector<Obstacle> obstacles;
   /// Keep the dense meshes of moving objects up to date every frame (the
   /// rigid links; for output). Without it they are evaluated only where the
   /// exact reference needs them.

@@ -80,8 +80,17 @@ std::string format_duration(double s) {
 
 }  // namespace
 
+// A static box collides as an analytic box obstacle (see make_world).
+static bool analytic_box(const ObjectSpec& spec) {
+  return spec.kind == ObjectKind::Static && spec.primitive && spec.primitive->type == "box" &&
+         spec.analytic_collider;
+}
+
 std::vector<coupling::ObjectSetup> object_setups(const Scene& scene) {
-  return {scene.objects.begin(), scene.objects.end()};  // (each ObjectSpec is an ObjectSetup)
+  std::vector<coupling::ObjectSetup> setups(scene.objects.begin(), scene.objects.end());
+  for (size_t i = 0; i < setups.size(); ++i)
+    if (analytic_box(scene.objects[i])) setups[i].sphere_collisions = false;
+  return setups;
 }
 
 coupling::StagePlan scene_plan(const Scene& scene) {
@@ -92,6 +101,12 @@ std::vector<std::string> describe_plan(const Scene& scene) {
   const std::vector<coupling::ObjectSetup> setups = object_setups(scene);
   const coupling::WorldSettings settings = world_settings(scene);
   std::vector<std::string> lines = coupling::make_plan(setups, settings).describe(setups, settings);
+  int boxes = 0;
+  for (const ObjectSpec& o : scene.objects) boxes += analytic_box(o);
+  if (!scene.world.obstacles.empty() || boxes > 0)
+    lines.push_back("obstacles: " + std::to_string(scene.world.obstacles.size() + boxes) +
+                    " static plane/box obstacle(s) (" + std::to_string(boxes) +
+                    " from static box objects), deformable surfaces projected out of them");
   lines.push_back(std::string("output: ") + (scene.output.csv ? "frames.csv" : "no csv") +
                   (scene.output.vtu_every > 0 ? ", VTU/PVD series" : ""));
   return lines;
@@ -106,16 +121,29 @@ World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
   check_scene_inputs(scene);
   std::vector<coupling::WorldObject> objects;
   objects.reserve(scene.objects.size());
+  coupling::WorldSettings settings = world_settings(scene);
   for (const ObjectSpec& spec : scene.objects) {
     coupling::WorldObject o;
     o.setup = spec;
     o.asset = load_object_asset(spec, cache_dir, tool_dir, limits);
     place_object(o.asset, spec);
+    if (analytic_box(spec)) {
+      // A static box collides as what it is, an analytic box obstacle, not
+      // through its sphere tree (whose leaves stand out of its faces).
+      coupling::Obstacle box;
+      box.type = coupling::Obstacle::Type::Box;
+      box.point = spec.position;
+      box.axes = coupling::rotation_matrix(spec.rotation_deg);
+      const MatX3d local = (o.asset.dense.V.rowwise() - spec.position.transpose()) * box.axes;
+      box.half_extents = local.cwiseAbs().colwise().maxCoeff().transpose();
+      settings.obstacles.push_back(box);
+      o.setup.sphere_collisions = false;
+    }
     objects.push_back(std::move(o));
   }
   for (const std::string& w : scale_warnings(objects))
     std::fprintf(stderr, "[icd] warning: %s\n", w.c_str());
-  return World(std::move(objects), world_settings(scene));
+  return World(std::move(objects), settings);
 }
 
 std::vector<std::string> scale_warnings(const std::vector<coupling::WorldObject>& objects) {
@@ -203,7 +231,7 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
   csv << "frame,time,wall,fem,links,sphere_update,collision,response,budget,pair_list,"
          "collision_list,tests,interrupted,completed_level,active_pairs,max_penetration,"
          "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened,"
-         "limited\n";
+         "limited,subdivided,deep_pairs,depth_ratio,obstacle_vertices,obstacle_depth\n";
   for (const FrameMetrics& m : frames)
     csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
         << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
@@ -211,7 +239,9 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
         << m.interrupted << ',' << m.completed_level << ',' << m.active_pairs << ','
         << m.max_penetration << ',' << m.contact_force << ',' << m.cycles << ',' << m.substeps
         << ',' << m.min_step << ',' << m.energy << ',' << m.exact_contacts << ',' << m.rollback
-        << ',' << m.reused << ',' << m.softened << ',' << m.limited << '\n';
+        << ',' << m.reused << ',' << m.softened << ',' << m.limited << ',' << m.subdivided << ','
+        << m.deep_pairs << ',' << m.depth_ratio << ',' << m.obstacle_vertices << ','
+        << m.obstacle_depth << '\n';
   return csv.str();
 }
 
@@ -311,6 +341,24 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
                    100 * sum.response / wall, pl / n, cl / n, intr, reused, cycles / n);
     }
   }
+
+  // Never silent: surfaces that went through each other deeper than the
+  // spheres resolve (a contact too fast or a penalty too soft for the load).
+  int deep_frames = 0, first_deep = -1;
+  double deepest = 0;
+  for (const FrameMetrics& m : frames)
+    if (m.deep_pairs > 0) {
+      ++deep_frames;
+      if (first_deep < 0) first_deep = m.frame;
+      deepest = std::max(deepest, m.depth_ratio);
+    }
+  if (deep_frames > 0)
+    std::fprintf(opt.log ? opt.log : stderr,
+                 "warning: %d frame(s) with a penetration deeper than the penetrating leaf "
+                 "sphere's radius (first at frame %d, deepest %.2f radii; frames.csv columns "
+                 "deep_pairs, depth_ratio): the objects partly passed through each other (penalty "
+                 "too soft for the speed or load: raise collision.stiffness)\n",
+                 deep_frames, first_deep, deepest);
 
   if (opt.log && scene.world.target_fps > 0) {
     const double el =

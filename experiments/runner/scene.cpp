@@ -176,6 +176,7 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
   o.kind = kind == "deformable" ? ObjectKind::Deformable
            : kind == "rigid"    ? ObjectKind::Rigid
                                 : ObjectKind::Static;
+  o.analytic_collider = f.string("collider", "analytic", {"analytic", "spheres"}) == "analytic";
   if (o.kind == ObjectKind::Static && o.velocity.norm() > 0)
     f.fail(f.path("velocity"), "a static object cannot have a velocity");
   if (const Json* mat = f.get("material")) {
@@ -265,6 +266,8 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
            "filter; use \"fifo\"");
   c.layered = f.boolean("layered", c.layered);
   c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", c.single_cycle_when_apart);
+  c.swept = f.boolean("swept", c.swept);
+  c.cycle_motion = f.number("cycle_motion", c.cycle_motion, 0, 1e3, true);
   c.midpoint = f.boolean("midpoint", c.midpoint);
   c.passive = f.boolean("passive", c.passive);
   const bool paper_update = c.update.mode == collision::SphereUpdateMode::PaperRatio;
@@ -320,6 +323,31 @@ Scene parse_scene(const Json& json, const std::string& source,
       f.fail("objects[" + std::to_string(i) + "].name",
              "duplicate object name \"" + escape_bytes(s.objects[i].name) + "\"");
   if (const Json* c = f.get("collision")) s.world.collision = parse_collision(*c, source);
+  if (const Json* obs = f.get("obstacles")) {
+    if (!obs->is_array()) f.fail("obstacles", "must be an array of obstacles");
+    for (size_t k = 0; k < obs->as_array().size(); ++k) {
+      const std::string path = "obstacles[" + std::to_string(k) + "]";
+      Fields o(obs->as_array()[k], path, source);
+      coupling::Obstacle ob;
+      const std::string type = o.string("type", "plane", {"plane", "box"});
+      if (type == "plane") {
+        ob.type = coupling::Obstacle::Type::Plane;
+        ob.point = o.vec3("point", ob.point, 1e6);
+        ob.normal = o.vec3("normal", ob.normal, 1e6);
+        if (!(ob.normal.norm() > 0)) o.fail(o.path("normal"), "must be a non-zero vector");
+        ob.normal.normalize();
+      } else {
+        ob.type = coupling::Obstacle::Type::Box;
+        ob.point = o.vec3("center", ob.point, 1e6);
+        const Eigen::Vector3d extent = o.vec3("extent", 2 * ob.half_extents, 1e6);
+        if (!(extent.minCoeff() > 0)) o.fail(o.path("extent"), "sides must be positive");
+        ob.half_extents = extent / 2;
+        ob.axes = coupling::rotation_matrix(o.vec3("rotation_deg", Eigen::Vector3d::Zero(), 1e4));
+      }
+      o.finish();
+      s.world.obstacles.push_back(ob);
+    }
+  }
   if (const Json* o = f.get("output")) {
     Fields out(*o, "output", source);
     s.output.csv = out.boolean("csv", true);

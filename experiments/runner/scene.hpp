@@ -44,6 +44,9 @@ struct ObjectSpec : coupling::ObjectSetup {
   double size = 0;  ///< scale so the longest bounding-box side is this (m); 0 = keep units
   Eigen::Vector3d position = Eigen::Vector3d::Zero();      ///< of the bounding-box centre, m
   Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();  ///< XYZ Euler angles, degrees
+  /// "collider": a static box primitive collides as an analytic box obstacle
+  /// ("analytic", default) or through its sphere tree ("spheres").
+  bool analytic_collider = true;
 };
 
 /// What the run writes.

@@ -152,7 +152,7 @@ TEST(Plan, OneObjectSceneHasNoCollisionPipeline) {
 
 TEST(Plan, RigidObstacleGetsNoFemButCollides) {
   const Scene s = parse(with_objects(
-      R"({"name": "ball", "primitive": {}}, {"name": "wall", "primitive": {"type": "box"}, "kind": "static"})",
+      R"({"name": "ball", "primitive": {}}, {"name": "wall", "primitive": {"type": "box"}, "kind": "static", "collider": "spheres"})",
       R"("output": {"vtu_every": 5})"));
   const coupling::StagePlan p = scene_plan(s);
   EXPECT_TRUE(p.objects[0].fem);
@@ -167,6 +167,20 @@ TEST(Plan, RigidObstacleGetsNoFemButCollides) {
   EXPECT_FALSE(p.broad_phase);
   const auto lines = describe_plan(s);
   EXPECT_EQ(lines[1], "wall: load, static, sphere tree");
+}
+
+// By default a static box collides as an analytic box obstacle, not through
+// its sphere tree.
+TEST(Plan, StaticBoxIsAnAnalyticObstacleByDefault) {
+  const Scene s = parse(with_objects(
+      R"({"name": "ball", "primitive": {}}, {"name": "wall", "primitive": {"type": "box"}, "kind": "static"})",
+      R"("output": {"vtu_every": 5})"));
+  const coupling::StagePlan p = scene_plan(s);
+  EXPECT_TRUE(p.pairs.empty());
+  EXPECT_FALSE(p.objects[1].sphere_tree);
+  bool listed = false;
+  for (const std::string& l : describe_plan(s)) listed = listed || l.rfind("obstacles: 1", 0) == 0;
+  EXPECT_TRUE(listed);
 }
 
 TEST(Plan, TwoDeformableObjectsRunEverything) {

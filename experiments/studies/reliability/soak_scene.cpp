@@ -16,9 +16,9 @@ runner::Scene make_contact_box_scene(const ContactBoxOptions& o) {
     << R"(, 0, 0], "material": {"model": "stvk", "young": 2e5, "poisson": 0.3, "density": 500},)"
     << R"( "integrator": ")" << o.integrator << R"(", "preprocess": {"tree_depth": 3}},)"
     << R"({"name": "left", "primitive": {"type": "box", "extent": [0.1, 0.6, 0.6], "cells": 2},)"
-    << R"( "position": [-0.3, 0, 0], "kind": "static", "preprocess": {"tree_depth": 2}},)"
+    << R"( "position": [-0.3, 0, 0], "kind": "static", "collider": "spheres", "preprocess": {"tree_depth": 2}},)"
     << R"({"name": "right", "primitive": {"type": "box", "extent": [0.1, 0.6, 0.6], "cells": 2},)"
-    << R"( "position": [0.3, 0, 0], "kind": "static", "preprocess": {"tree_depth": 2}}],)"
+    << R"( "position": [0.3, 0, 0], "kind": "static", "collider": "spheres", "preprocess": {"tree_depth": 2}}],)"
     << R"("collision": {"budget_tests": )" << o.budget_tests << R"(, "mode": "fifo", "stiffness": )"
     << o.stiffness << R"(, "layered": true}, "output": {"vtu_every": 0}})";
   return runner::parse_scene(runner::parse_json(s.str(), "contact_box"), "contact_box", ".");
