@@ -212,6 +212,27 @@ TEST(Repair, OverlappingSpheresBecomeTheirUnion) {
   EXPECT_NEAR(r.report.volume, expected, 0.02 * expected);
 }
 
+TEST(Repair, LocalFoldIsNotCutAway) {
+  // One sphere with a few vertices pushed through the opposite side: a
+  // single component whose repair must keep (nearly) all of its volume.
+  SurfaceMesh m = make_icosphere(3);
+  const double v0 = enclosed_volume(m.V, m.F);
+  int moved = 0;
+  for (int i = 0; i < m.V.rows() && moved < 1; ++i)
+    if (m.V(i, 2) > 0.99) {
+      m.V(i, 2) = -1.2;  // the north pole pokes out through the south pole
+      ++moved;
+    }
+  ASSERT_EQ(moved, 1);
+  try {
+    const RepairResult r = repair_surface(m, {}, "in.off");
+    EXPECT_GT(r.report.volume, 0.9 * v0);
+    EXPECT_GT(r.mesh.F.rows(), m.F.rows() / 2);
+  } catch (const InputError& e) {  // a refusal is acceptable; a silent cut is not
+    std::cout << "  message: " << e.what() << "\n";
+  }
+}
+
 TEST(Repair, RefusesSelfIntersectionWithCountLocationAndOption) {
   RepairOptions o;
   o.autorefine = false;          // only the local repair, which changes the shape a lot here
