@@ -43,8 +43,11 @@ void print_help(const PreprocessOptions& d) {
       "  --simplify-ratio R         or a fraction of the input faces, in (0, 1]\n"
       "  --max-hole-edges N         fill holes with at most N boundary edges [%d]\n"
       "  --max-hole-diameter F      ... and diameter at most F * bbox diagonal [%g]\n"
+      "  --max-surface-change F     largest area/volume change of a local self-intersection\n"
+      "                             repair, relative [%g]\n"
       "  --radius-edge B            tet radius-edge ratio bound, >= 2 [%g]\n"
       "  --facet-distance F         surface approximation bound, F * cell size [%g]\n"
+      "  --feature-angle DEG        protect edges sharper than DEG (0: none) [%g]\n"
       "  --sliver-bound DEG         dihedral angle targeted by perturb/exude [%g]\n"
       "  --spheres KIND             sphere-tree builder: medial (adaptive medial axis), octree, "
       "none [medial]\n"
@@ -59,12 +62,15 @@ void print_help(const PreprocessOptions& d) {
       "                             a limit that fires makes the output machine-load dependent\n"
       "  --assoc-nearest K          coarse nodes associated with each sphere, at least [%d]\n"
       "  --no-hausdorff             skip the Hausdorff distance of the summary\n"
+      "  --time-limit S             CPU seconds each stage may use [%g]\n"
+      "  --memory-limit MB          memory each stage may use, MiB [%g]\n"
       "  -q, --quiet                only errors and the final summary\n"
       "  -h, --help                 this text\n",
       d.tetrahedralize.target_tets, d.simplify.target_faces, d.repair.max_hole_edges,
-      d.repair.max_hole_diameter, d.tetrahedralize.radius_edge_bound,
-      d.tetrahedralize.facet_distance_factor, d.tetrahedralize.sliver_bound_deg, d.spheres.depth,
-      d.spheres.branching, d.association.k_nearest);
+      d.repair.max_hole_diameter, d.repair.max_surface_change, d.tetrahedralize.radius_edge_bound,
+      d.tetrahedralize.facet_distance_factor, d.tetrahedralize.feature_angle_deg,
+      d.tetrahedralize.sliver_bound_deg, d.spheres.depth,
+      d.spheres.branching, d.association.k_nearest, d.limits.cpu_seconds, d.limits.memory_mb);
 }
 
 struct Cli {
@@ -135,10 +141,14 @@ Cli parse(int argc, char** argv) {
       o.repair.max_hole_edges = to_int(a, value());
     } else if (a == "--max-hole-diameter") {
       o.repair.max_hole_diameter = to_double(a, value());
+    } else if (a == "--max-surface-change") {
+      o.repair.max_surface_change = to_double(a, value());
     } else if (a == "--radius-edge") {
       o.tetrahedralize.radius_edge_bound = to_double(a, value());
     } else if (a == "--facet-distance") {
       o.tetrahedralize.facet_distance_factor = to_double(a, value());
+    } else if (a == "--feature-angle") {
+      o.tetrahedralize.feature_angle_deg = to_double(a, value());
     } else if (a == "--sliver-bound") {
       o.tetrahedralize.sliver_bound_deg = to_double(a, value());
     } else if (a == "--spheres") {
@@ -173,6 +183,12 @@ Cli parse(int argc, char** argv) {
       o.spheres.time_limit = to_double(a, value());
     } else if (a == "--assoc-nearest") {
       o.association.k_nearest = to_int(a, value());
+    } else if (a == "--time-limit") {
+      o.limits.cpu_seconds = to_double(a, value());
+      if (!(o.limits.cpu_seconds > 0)) usage_error("--time-limit must be > 0");
+    } else if (a == "--memory-limit") {
+      o.limits.memory_mb = to_double(a, value());
+      if (!(o.limits.memory_mb > 0)) usage_error("--memory-limit must be > 0");
     } else if (a == "--no-hausdorff") {
       o.compute_hausdorff = false;
     } else if (a == "-q" || a == "--quiet") {
@@ -227,14 +243,17 @@ void print_summary(const Cli& c, const icd::mesh::PreprocessResult& r, double wr
         "bbox diagonal %.4g)\n",
         r.hausdorff_dense_simplified, r.hausdorff_dense_coarse,
         100.0 * r.hausdorff_dense_coarse / r.bbox_diagonal, r.bbox_diagonal);
-  std::printf("-- time per stage, wall (cpu) s:");
-  double total = 0, total_cpu = 0;
+  std::printf("-- time per stage, wall (cpu) s [peak MB]:");
+  double total = 0, total_cpu = 0, peak = 0;
   for (const auto& t : r.times) {
-    std::printf(" %s %.2f (%.2f),", t.stage.c_str(), t.seconds, t.cpu_seconds);
+    std::printf(" %s %.2f (%.2f) [%.0f],", t.stage.c_str(), t.seconds, t.cpu_seconds, t.peak_mb);
     total += t.seconds;
     total_cpu += t.cpu_seconds;
+    peak = std::max(peak, t.peak_mb);
   }
-  std::printf(" write %.2f; total %.2f (%.2f)\n", write_s, total + write_s, total_cpu);
+  std::printf(" write %.2f; total %.2f (%.2f), peak %.0f MB\n", write_s, total + write_s,
+              total_cpu, peak);
+  for (const auto& n : r.notes) std::printf("-- note: %s\n", n.c_str());
   std::printf("-- bundle load check: %.1f ms wall, %.1f ms cpu (medians of 5 loads)\n", load_ms,
               load_cpu_ms);
 }

@@ -1,7 +1,6 @@
 #include <icd/mesh/pipeline/preprocess.hpp>
 
-#include <chrono>
-#include <ctime>
+#include <cmath>
 #include <sstream>
 #include <utility>
 
@@ -12,38 +11,106 @@
 namespace icd::mesh {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+std::string fmt(double x) {
+  std::ostringstream s;
+  s.precision(4);
+  s << x;
+  return s.str();
+}
 
-/// Times a stage and reports its start and end.
-class StageTimer {
+/// Runs one stage bounded, reports start, progress and end, records its usage.
+class Stage {
  public:
-  StageTimer(PreprocessResult& r, const ProgressFn& progress, std::string stage)
-      : m_result(r),
-        m_progress(progress),
-        m_stage(std::move(stage)),
-        m_start(Clock::now()),
-        m_cpu_start(std::clock()) {
-    if (m_progress) m_progress(m_stage, "start");
+  Stage(PreprocessResult& r, const ProgressFn& progress, std::string name)
+      : m_result(r), m_progress(progress), m_name(std::move(name)) {
+    if (m_progress) m_progress(m_name, "start");
   }
+  HeartbeatFn heartbeat() const {
+    if (!m_progress) return {};
+    return [this](const std::string& s) { m_progress(m_name, s); };
+  }
+  std::string run(const StageLimits& limits, const std::function<std::string()>& work,
+                  const std::string& hint = "") {
+    return run_bounded(m_name, limits, work, &m_usage, heartbeat(), hint);
+  }
+  void set_usage(const StageUsage& u) { m_usage = u; }
   void done(const std::string& message) {
-    const double s = std::chrono::duration<double>(Clock::now() - m_start).count();
-    const double cpu = static_cast<double>(std::clock() - m_cpu_start) / CLOCKS_PER_SEC;
-    m_result.times.push_back({m_stage, s, cpu});
+    m_result.times.push_back({m_name, m_usage.wall_seconds, m_usage.cpu_seconds, m_usage.peak_mb});
     if (m_progress) {
       std::ostringstream o;
       o.precision(3);
-      o << message << " (" << s << " s, cpu " << cpu << " s)";
-      m_progress(m_stage, o.str());
+      o << message << " (" << m_usage.wall_seconds << " s, cpu " << m_usage.cpu_seconds << " s, "
+        << std::lround(m_usage.peak_mb) << " MB)";
+      m_progress(m_name, o.str());
     }
   }
 
  private:
   PreprocessResult& m_result;
   const ProgressFn& m_progress;
-  std::string m_stage;
-  Clock::time_point m_start;
-  std::clock_t m_cpu_start;
+  std::string m_name;
+  StageUsage m_usage;
 };
+
+void write_surface(ByteWriter& w, const SurfaceMesh& m) {
+  w.mat(m.V);
+  w.mat(m.F);
+}
+SurfaceMesh read_surface(ByteReader& r) {
+  SurfaceMesh m;
+  m.V = r.mat<MatX3d>();
+  m.F = r.mat<MatX3i>();
+  return m;
+}
+
+void write_tree(ByteWriter& w, const collision::SphereTree& t) {
+  w.vec(t.spheres);
+  w.vec(t.rest_spheres);
+  w.vec(t.first_child);
+  w.vec(t.child_count);
+  w.vec(t.level);
+  w.vec(t.level_offset);
+  w.vec(t.assoc_offset);
+  w.vec(t.assoc_nodes);
+  w.vec(t.assoc_rest_dist);
+}
+collision::SphereTree read_tree(ByteReader& r) {
+  collision::SphereTree t;
+  t.spheres = r.vec<collision::Sphere>();
+  t.rest_spheres = r.vec<collision::Sphere>();
+  t.first_child = r.vec<int32_t>();
+  t.child_count = r.vec<int32_t>();
+  t.level = r.vec<int32_t>();
+  t.level_offset = r.vec<int32_t>();
+  t.assoc_offset = r.vec<int32_t>();
+  t.assoc_nodes = r.vec<int32_t>();
+  t.assoc_rest_dist = r.vec<double>();
+  return t;
+}
+
+Normalisation normalisation_of(const MatX3d& V) {
+  Normalisation n;
+  if (V.rows() == 0 || !V.allFinite()) return n;  // repair refuses it, naming the vertex
+  const Eigen::RowVector3d lo = V.colwise().minCoeff(), hi = V.colwise().maxCoeff();
+  const double diagonal = (hi - lo).norm();
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return n;
+  const Eigen::RowVector3d centre = 0.5 * (lo + hi);
+  if (centre.norm() > 4.0 * diagonal) n.centre = centre;
+  n.scale = std::ldexp(1.0, -std::ilogb(diagonal));  // diagonal * scale in [1, 2)
+  return n;
+}
+
+void to_model(MatX3d& V, const Normalisation& n) {
+  V /= n.scale;  // exact: a power of two
+  if (!n.centre.isZero()) V.rowwise() += n.centre;
+}
+
+void sphere_to_model(collision::Sphere& s, const Normalisation& n) {
+  s.x = s.x / n.scale + n.centre[0];
+  s.y = s.y / n.scale + n.centre[1];
+  s.z = s.z / n.scale + n.centre[2];
+  s.r /= n.scale;
+}
 
 }  // namespace
 
@@ -96,64 +163,136 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
                             const ProgressFn& progress, const std::string& name) {
   PreprocessResult r;
   coupling::AssetBundle& b = r.bundle;
+  const StageLimits& limits = o.limits;
+  const Normalisation norm = normalisation_of(dense.V);
+  r.normalisation = norm;
+  const double s = norm.scale, s3 = s * s * s;
+  SurfaceMesh input = dense;
+  if (!norm.centre.isZero()) input.V.rowwise() -= norm.centre;
+  input.V *= s;
   {
-    StageTimer t(r, progress, "repair");
-    RepairResult rep = repair_surface(dense, o.repair, name);
-    b.dense = std::move(rep.mesh);
-    r.repair = rep.report;
+    Stage t(r, progress, "repair");
+    ByteReader in(t.run(limits, [&] {
+      RepairResult rep = repair_surface(input, o.repair, name);
+      ByteWriter w;
+      write_surface(w, rep.mesh);
+      w.pod(rep.report);
+      return w.take();
+    }));
+    b.dense = read_surface(in);
+    r.repair = in.pod<RepairReport>();
     t.done(std::to_string(b.dense.V.rows()) + " vertices, " + std::to_string(b.dense.F.rows()) +
            " faces, " + std::to_string(r.repair.holes_filled) + " hole(s) filled");
   }
   r.bbox_diagonal = (b.dense.V.colwise().maxCoeff() - b.dense.V.colwise().minCoeff()).norm();
   SurfaceMesh simplified;
   {
-    StageTimer t(r, progress, "simplify");
-    SimplifyResult s = simplify_surface(b.dense, o.simplify);
-    simplified = std::move(s.mesh);
-    r.simplify = s.report;
+    Stage t(r, progress, "simplify");
+    ByteReader in(t.run(limits, [&] {
+      SimplifyResult sr = simplify_surface(b.dense, o.simplify);
+      ByteWriter w;
+      write_surface(w, sr.mesh);
+      w.pod(sr.report);
+      return w.take();
+    }));
+    simplified = read_surface(in);
+    r.simplify = in.pod<SimplifyReport>();
     t.done(std::to_string(r.simplify.input_faces) + " -> " +
            std::to_string(r.simplify.output_faces) + " faces");
   }
   {
-    StageTimer t(r, progress, "tetrahedralize");
-    TetrahedralizeResult tet = tetrahedralize_surface(simplified, o.tetrahedralize);
+    Stage t(r, progress, "tetrahedralize");
+    TetrahedralizeOptions to = o.tetrahedralize;
+    to.limits = limits;
+    to.cell_size *= s;
+    TetrahedralizeResult tet = tetrahedralize_surface(simplified, to, t.heartbeat());
+    t.set_usage(tet.usage);
     b.coarse = std::move(tet.mesh);
     r.quality = tet.quality;
-    r.cell_size = tet.cell_size;
+    r.cell_size = tet.cell_size / s;
     r.mesher_passes = tet.passes;
+    for (const std::string& n : tet.notes) r.notes.push_back("tetrahedralize: " + n);
     b.surface_nodes = boundary_nodes(b.coarse.F);
     t.done(std::to_string(b.coarse.T.rows()) + " tets, " + std::to_string(b.surface_nodes.size()) +
-           " surface nodes, " + std::to_string(tet.passes) + " pass(es)");
+           " surface nodes, " + std::to_string(tet.passes) + " pass(es)" +
+           (tet.failed_passes ? ", " + std::to_string(tet.failed_passes) + " failed and retried"
+                              : ""));
   }
   {
-    StageTimer t(r, progress, "rigid links");
-    b.links = coupling::build_rigid_links(b.dense.V, b.coarse.V, b.surface_nodes, o.links);
+    Stage t(r, progress, "rigid links");
+    ByteReader in(t.run(limits, [&] {
+      const coupling::RigidLinks l =
+          coupling::build_rigid_links(b.dense.V, b.coarse.V, b.surface_nodes, o.links);
+      ByteWriter w;
+      w.mat(l.nodes);
+      w.mat(l.alpha);
+      w.mat(l.coeffs);
+      w.pod(l.num_coarse_nodes);
+      return w.take();
+    }));
+    b.links.nodes = in.mat<coupling::MatX3i32>();
+    b.links.alpha = in.mat<MatX3d>();
+    b.links.coeffs = in.mat<MatX3d>();
+    b.links.num_coarse_nodes = in.pod<int32_t>();
     t.done(std::to_string(b.links.num_links()) + " links");
   }
   if (o.sphere_builder != SphereBuilder::none) {
-    StageTimer t(r, progress, "sphere tree");
-    if (o.sphere_builder == SphereBuilder::medial_axis) {
-      SphereTreeBuild st = build_sphere_tree(b.dense, o.spheres);
-      b.spheres = std::move(st.tree);
-      r.sphere_time_limit_hit = st.hit_time_limit;
-    } else {
-      b.spheres = collision::build_octree_tree(b.dense.V, b.dense.F, o.octree);
-    }
+    Stage t(r, progress, "sphere tree");
+    ByteReader in(t.run(
+        limits,
+        [&] {
+          collision::SphereTree tree;
+          bool hit = false;
+          if (o.sphere_builder == SphereBuilder::medial_axis) {
+            SphereTreeBuild st = build_sphere_tree(b.dense, o.spheres);
+            tree = std::move(st.tree);
+            hit = st.hit_time_limit;
+          } else {
+            tree = collision::build_octree_tree(b.dense.V, b.dense.F, o.octree);
+          }
+          const std::vector<int> cand(b.surface_nodes.data(),
+                                      b.surface_nodes.data() + b.surface_nodes.size());
+          collision::associate_nearest_nodes(tree, b.coarse.V, o.association, cand);
+          ByteWriter w;
+          write_tree(w, tree);
+          w.pod(hit);
+          return w.take();
+        },
+        "--spheres octree builds a coarser tree much faster"));
+    b.spheres = read_tree(in);
+    r.sphere_time_limit_hit = in.pod<bool>();
     r.sphere_levels = b.spheres.num_levels();
-    const std::vector<int> cand(b.surface_nodes.data(),
-                                b.surface_nodes.data() + b.surface_nodes.size());
-    collision::associate_nearest_nodes(b.spheres, b.coarse.V, o.association, cand);
     t.done(std::to_string(b.spheres.num_nodes()) + " spheres on " +
            std::to_string(r.sphere_levels) + " levels" +
            (r.sphere_time_limit_hit ? " (time limit hit)" : ""));
   }
   if (o.compute_hausdorff) {
-    StageTimer t(r, progress, "hausdorff");
-    r.hausdorff_dense_simplified = approximate_hausdorff_distance(b.dense, simplified);
-    const SurfaceMesh coarse_surface{b.coarse.V, b.coarse.F};
-    r.hausdorff_dense_coarse = approximate_hausdorff_distance(b.dense, coarse_surface);
-    t.done("dense-coarse " + std::to_string(r.hausdorff_dense_coarse));
+    Stage t(r, progress, "hausdorff");
+    ByteReader in(t.run(
+        limits,
+        [&] {
+          ByteWriter w;
+          w.pod(approximate_hausdorff_distance(b.dense, simplified));
+          const SurfaceMesh coarse_surface{b.coarse.V, b.coarse.F};
+          w.pod(approximate_hausdorff_distance(b.dense, coarse_surface));
+          return w.take();
+        },
+        "--no-hausdorff skips it"));
+    r.hausdorff_dense_simplified = in.pod<double>() / s;
+    r.hausdorff_dense_coarse = in.pod<double>() / s;
+    t.done("dense-coarse " + fmt(r.hausdorff_dense_coarse));
   }
+
+  // Back to model units.
+  to_model(b.dense.V, norm);
+  to_model(b.coarse.V, norm);
+  b.links.coeffs /= s;
+  for (auto& sp : b.spheres.spheres) sphere_to_model(sp, norm);
+  for (auto& sp : b.spheres.rest_spheres) sphere_to_model(sp, norm);
+  for (double& d : b.spheres.assoc_rest_dist) d /= s;
+  r.bbox_diagonal /= s;
+  r.repair.volume /= s3;
+  r.quality = tet_quality(b.coarse);
   return r;
 }
 

@@ -12,6 +12,7 @@
 #include <icd/coupling/asset_bundle.hpp>
 #include <icd/coupling/rigid_links.hpp>
 #include <icd/mesh/core/types.hpp>
+#include <icd/mesh/pipeline/bounded.hpp>
 #include <icd/mesh/pipeline/repair.hpp>
 #include <icd/mesh/pipeline/simplify.hpp>
 #include <icd/mesh/pipeline/tetrahedralize.hpp>
@@ -68,6 +69,9 @@ struct PreprocessOptions {
   collision::OctreeTreeOptions octree;  ///< octree builder options (levels = depth + 1)
   collision::NodeAssociationOptions association;
   bool compute_hausdorff = true;  ///< dense vs coarse surface distance for the summary
+  /// CPU-time and memory limits of every stage (each runs in a child
+  /// process, bounded.hpp); tetrahedralize.limits is set from it.
+  StageLimits limits;
   PreprocessOptions() {
     spheres.time_limit = 1e9;
     apply_sphere_fit(SphereFit::light, spheres);
@@ -81,6 +85,17 @@ struct StageTime {
   std::string stage;
   double seconds = 0.0;
   double cpu_seconds = 0.0;
+  double peak_mb = 0.0;  ///< peak resident memory of the stage's process (MiB)
+};
+
+/// The similarity that maps the input to normalised coordinates, in which
+/// every stage works: x_n = (x - centre) * scale, scale a power of two (exact)
+/// with the bounding-box diagonal in [1, 2); centre the bounding-box centre
+/// when the model lies far from the origin (farther than 4 diagonals), else 0,
+/// so that the round trip is exact and the dense vertices keep their bits.
+struct Normalisation {
+  Eigen::RowVector3d centre = Eigen::RowVector3d::Zero();
+  double scale = 1.0;
 };
 
 /// Everything preprocess() produced and measured.
@@ -98,15 +113,21 @@ struct PreprocessResult {
   double hausdorff_dense_coarse = -1.0;      ///< repaired dense vs coarse tet boundary
   double bbox_diagonal = 0.0;                ///< of the repaired dense surface
   std::vector<StageTime> times;              ///< in stage order
+  Normalisation normalisation;               ///< the stages' coordinates
+  /// Retries and warnings of every stage, for the summary (one line each).
+  std::vector<std::string> notes;
 };
 
 /// Progress report: the stage name and a short message (start, pass, done).
 using ProgressFn = std::function<void(const std::string& stage, const std::string& message)>;
 
 /// Runs all stages on `dense` (a raw surface as read from file; `name` prefixes
-/// error messages). Deterministic for identical input and options unless the
+/// error messages), in normalised coordinates (Normalisation; the bundle and
+/// every figure of the result are in model units). Every stage runs bounded by
+/// options.limits. Deterministic for identical input and options unless the
 /// sphere builder hits its time limit (reported). Throws what the stages
-/// throw: InputError for unusable input, ParameterError for bad options.
+/// throw: InputError for unusable input (StageError for a stage beyond its
+/// limits), ParameterError for bad options.
 PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& options = {},
                             const ProgressFn& progress = {}, const std::string& name = "surface");
 

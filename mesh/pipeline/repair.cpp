@@ -7,6 +7,7 @@
 
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
@@ -100,8 +101,23 @@ std::string RepairReport::to_string() const {
   if (reversed_to_outward) s << "reversed to face outward\n";
   if (holes_filled)
     s << "filled holes: " << holes_filled << " (" << hole_faces_added << " faces)\n";
-  if (self_intersections_repaired)
-    s << "repaired self-intersections: " << self_intersections_repaired << " face pair(s)\n";
+  if (split_nonmanifold_vertices)
+    s << "split non-manifold vertices: " << split_nonmanifold_vertices
+      << " (copies moved 1 % into their own fan)\n";
+  if (largest_hole_filled > 0.1)
+    s << "WARNING: filled a hole spanning " << 100.0 * largest_hole_filled
+      << " % of the bounding-box diagonal: check the patch\n";
+  if (self_intersections_autorefined)
+    s << "resolved self-intersections by autorefinement: " << self_intersections_autorefined
+      << " face pair(s); " << 100.0 * area_removed_inside
+      << " % of the area lay inside the solid and was removed\n";
+  if (self_intersections_repaired) {
+    s << "repaired self-intersections locally: " << self_intersections_repaired
+      << " face pair(s); area change " << 100.0 * area_change << " %, volume change "
+      << 100.0 * volume_change << " %\n";
+    if (std::max(std::abs(area_change), std::abs(volume_change)) > 0.005)
+      s << "WARNING: the repair changed the surface by more than 0.5 %\n";
+  }
   s << "output " << output_vertices << " vertices, " << output_faces << " faces, " << components
     << " component(s), volume " << volume << "\n";
   return s.str();
@@ -110,6 +126,7 @@ std::string RepairReport::to_string() const {
 RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& options,
                             const std::string& name) {
   if (options.max_hole_edges < 0 || !(options.max_hole_diameter >= 0.0) ||
+      !(options.max_surface_change >= 0.0) ||
       !(options.min_volume_fraction >= 0.0))
     throw ParameterError(
         "repair_surface: max_hole_edges, max_hole_diameter and "
@@ -245,14 +262,30 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
   const size_t n_points = points.size();
   PMP::orient_polygon_soup(points, polygons);
   if (points.size() != n_points) {
-    const Point& p = points[n_points];
-    int orig = -1;
-    for (size_t v = 0; v < n_points; ++v)
-      if (points[v] == p) orig = original_vertex[v];
-    throw InputError(name + ": non-manifold vertex " + std::to_string(orig) + " at " +
-                     fmt_point(p) + " (its faces form " +
-                     std::to_string(points.size() - n_points + 1) + " separate fans); " +
-                     std::to_string(points.size() - n_points) + " vertex split(s) needed in total");
+    // A vertex whose faces form separate fans (two surfaces touching at a
+    // point, often made by the exact-duplicate merge above) was split into one
+    // copy per fan. Each copy moves 1 % of the way towards the centroid of its
+    // fan's other vertices, so that the fans no longer touch (a shared point
+    // would count as a self-intersection) while the shape stays put.
+    rep.split_nonmanifold_vertices = static_cast<int>(points.size() - n_points);
+    std::vector<Eigen::Vector3d> sum(points.size() - n_points, Eigen::Vector3d::Zero());
+    std::vector<int> count(points.size() - n_points, 0);
+    for (const auto& poly : polygons)
+      for (std::size_t k = 0; k < poly.size(); ++k)
+        if (poly[k] >= n_points)
+          for (std::size_t j = 0; j < poly.size(); ++j)
+            if (j != k) {
+              const Point& q = points[poly[j]];
+              sum[poly[k] - n_points] += Eigen::Vector3d(q.x(), q.y(), q.z());
+              ++count[poly[k] - n_points];
+            }
+    for (std::size_t i = n_points; i < points.size(); ++i) {
+      if (count[i - n_points] == 0) continue;
+      const Eigen::Vector3d c = sum[i - n_points] / count[i - n_points];
+      const Eigen::Vector3d x(points[i].x(), points[i].y(), points[i].z());
+      const Eigen::Vector3d y = x + 0.01 * (c - x);
+      points[i] = Point(y[0], y[1], y[2]);
+    }
   }
   for (size_t f = 0; f < polygons.size(); ++f) {
     const auto& a = before[f];
@@ -280,6 +313,7 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
   // 8. Fill small holes.
   for (const Loop& l : boundary_loops(mesh)) {
     if (l.edges > options.max_hole_edges || l.diameter > options.max_hole_diameter * diag) continue;
+    rep.largest_hole_filled = std::max(rep.largest_hole_filled, l.diameter / diag);
     std::vector<CgalMesh::Face_index> patch;
     std::vector<CgalMesh::Vertex_index> new_vertices;
     if (options.fair_holes)
@@ -298,47 +332,134 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
       std::ostringstream s;
       s << name << ": open surface: " << left.size() << " boundary loop(s) remain after filling "
         << rep.holes_filled << " small hole(s); the largest has " << big->edges
-        << " edges and diameter " << big->diameter << " (limits: " << options.max_hole_edges
-        << " edges, " << options.max_hole_diameter * diag << ") and passes through "
-        << fmt_point(mesh.point(mesh.source(big->h)));
+        << " edges and diameter " << big->diameter << " = " << big->diameter / diag
+        << " of the bounding-box diagonal (limits: --max-hole-edges " << options.max_hole_edges
+        << ", --max-hole-diameter " << options.max_hole_diameter
+        << " of the diagonal) and passes through " << fmt_point(mesh.point(mesh.source(big->h)));
+      int need_edges = 0;
+      double need_diameter = 0.0;
+      for (const Loop& l : left) {
+        need_edges = std::max(need_edges, l.edges);
+        need_diameter = std::max(need_diameter, l.diameter / diag);
+      }
+      s << "; to fill every hole: --max-hole-edges " << std::max(need_edges, options.max_hole_edges)
+        << " --max-hole-diameter "
+        << std::max(std::ceil(need_diameter * 100.0 + 1e-9) / 100.0, options.max_hole_diameter);
       throw InputError(s.str());
     }
   }
   mesh.collect_garbage();
 
-  // 9. Self-intersections: try CGAL's local repair (remove the faces around
-  // the intersections, fill/smooth the holes), refuse if any remain.
+  // 9. Self-intersections: first CGAL's autorefinement (split the faces
+  // along the intersections, drop the patches inside the solid, stitch: the
+  // union of the overlapping parts, the enclosed region unchanged); then its
+  // local repair (remove the faces around each intersection, re-fill), which
+  // changes the shape: its area and volume change is measured and limited;
+  // else refuse with the count and a location.
   if (options.check_self_intersections && PMP::does_self_intersect(mesh)) {
+    // The autorefinement keeps the outside of outward surfaces: turn each
+    // component with a negative signed volume (orient_to_bound_a_volume needs
+    // a surface without self-intersections).
+    double largest_component = 0.0, all_components = 0.0;
+    {
+      auto fcc = mesh.add_property_map<CgalMesh::Face_index, std::size_t>("f:cc").first;
+      const std::size_t n = PMP::connected_components(mesh, fcc);
+      std::vector<double> vol(n, 0.0);
+      for (auto f : mesh.faces()) {
+        auto h = mesh.halfedge(f);
+        const Point &a = mesh.point(mesh.source(h)), &b = mesh.point(mesh.target(h)),
+                    &c = mesh.point(mesh.target(mesh.next(h)));
+        vol[fcc[f]] += CGAL::scalar_product(
+            a - CGAL::ORIGIN, CGAL::cross_product(b - CGAL::ORIGIN, c - CGAL::ORIGIN));
+      }
+      for (double v : vol) {
+        largest_component = std::max(largest_component, std::abs(v) / 6.0);
+        all_components += std::abs(v) / 6.0;
+      }
+      std::vector<CgalMesh::Face_index> flip;
+      for (auto f : mesh.faces())
+        if (vol[fcc[f]] < 0) flip.push_back(f);
+      mesh.remove_property_map(fcc);
+      if (!flip.empty()) PMP::reverse_face_orientations(flip, mesh);
+    }
     std::vector<std::pair<CgalMesh::Face_index, CgalMesh::Face_index>> pairs;
     PMP::self_intersections(mesh, std::back_inserter(pairs));
     const std::size_t found = pairs.size();
+    const auto centroid = [](const CgalMesh& m, CgalMesh::Face_index f) {
+      auto h = m.halfedge(f);
+      return CGAL::centroid(m.point(m.source(h)), m.point(m.target(h)),
+                            m.point(m.target(m.next(h))));
+    };
+    std::ostringstream where;
+    where << "e.g. faces near " << fmt_point(centroid(mesh, pairs[0].first)) << " and "
+          << fmt_point(centroid(mesh, pairs[0].second));
+    const double area0 = PMP::area(mesh), volume0 = std::abs(signed_volume(mesh));
+    const auto clean = [](CgalMesh& m) {
+      return CGAL::is_closed(m) && CGAL::is_valid_polygon_mesh(m) && !PMP::does_self_intersect(m);
+    };
     bool repaired = false;
-    if (options.remove_self_intersections) {
-      PMP::experimental::remove_self_intersections(mesh);
-      mesh.collect_garbage();
-      repaired = CGAL::is_closed(mesh) && CGAL::is_valid_polygon_mesh(mesh) &&
-                 !PMP::does_self_intersect(mesh);
-    }
-    if (repaired) {
-      rep.self_intersections_repaired = static_cast<int>(found);
-    } else {
-      pairs.clear();
-      PMP::self_intersections(mesh, std::back_inserter(pairs));
-      std::ostringstream s;
-      s << name << ": the surface intersects itself: " << found << " intersecting face pair(s)";
-      if (options.remove_self_intersections)
-        s << "; local repair left " << pairs.size()
-          << (CGAL::is_closed(mesh) ? "" : " and opened the surface");
-      if (!pairs.empty()) {
-        const auto centroid = [&](CgalMesh::Face_index f) {
-          auto h = mesh.halfedge(f);
-          return CGAL::centroid(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)),
-                                mesh.point(mesh.target(mesh.next(h))));
-        };
-        s << ", e.g. faces " << pairs[0].first.idx() << " near "
-          << fmt_point(centroid(pairs[0].first)) << " and " << pairs[0].second.idx() << " near "
-          << fmt_point(centroid(pairs[0].second));
+    std::string local_result;
+    if (options.autorefine) {
+      CgalMesh trial = mesh;
+      bool ok = false;
+      try {
+        ok = PMP::experimental::autorefine_and_remove_self_intersections(trial);
+        trial.collect_garbage();
+      } catch (const std::exception&) {  // CGAL failure: fall back to the local repair
+        ok = false;
       }
+      // The union encloses at least the largest component and at most all of
+      // them: anything else means patches outside were dropped (measured: the
+      // Chinese dragon's local folds left 18 faces).
+      const double v = ok && clean(trial) ? std::abs(signed_volume(trial)) : 0.0;
+      const double tol = options.max_surface_change;
+      if (ok && trial.number_of_faces() > 0 && v >= (1.0 - tol) * largest_component &&
+          v <= (1.0 + tol) * all_components) {
+        rep.self_intersections_autorefined = static_cast<int>(found);
+        rep.area_removed_inside = 1.0 - PMP::area(trial) / area0;
+        mesh = std::move(trial);
+        repaired = true;
+      }
+    }
+    if (!repaired && options.remove_self_intersections) {
+      CgalMesh trial = mesh;
+      bool ok = false;
+      try {
+        PMP::experimental::remove_self_intersections(trial);
+        trial.collect_garbage();
+        ok = clean(trial);
+      } catch (const std::exception&) {
+        ok = false;
+      }
+      if (ok) {
+        const double da = PMP::area(trial) / area0 - 1.0;
+        const double dv = std::abs(signed_volume(trial)) / volume0 - 1.0;
+        const double worst = std::max(std::abs(da), std::abs(dv));
+        if (worst <= options.max_surface_change) {
+          rep.self_intersections_repaired = static_cast<int>(found);
+          rep.area_change = da;
+          rep.volume_change = dv;
+          mesh = std::move(trial);
+          repaired = true;
+        } else {
+          std::ostringstream m;
+          m << "; the local repair would change the area by " << 100.0 * da
+            << " % and the volume by " << 100.0 * dv << " % (limit "
+            << 100.0 * options.max_surface_change
+            << " %, option --max-surface-change F accepts up to F, e.g. --max-surface-change "
+            << std::ceil(worst * 100.0 + 1e-9) / 100.0 << ")";
+          local_result = m.str();
+        }
+      } else {
+        local_result = "; the local repair did not remove them";
+      }
+    }
+    if (!repaired) {
+      std::ostringstream s;
+      s << name << ": the surface intersects itself: " << found << " intersecting face pair(s), "
+        << where.str();
+      if (options.autorefine) s << "; autorefinement failed or changed the enclosed volume";
+      s << local_result;
       throw InputError(s.str());
     }
   }

@@ -14,7 +14,8 @@ struct RepairOptions {
   int max_hole_edges = 200;
   /// ...and whose diameter (largest distance between two loop vertices) is at
   /// most this fraction of the bounding-box diagonal. Larger holes are refused.
-  double max_hole_diameter = 0.1;
+  /// (1: any size; a filled hole wider than 0.1 of the diagonal is reported.)
+  double max_hole_diameter = 1.0;
   /// Refine and fair the hole patch (CGAL triangulate_refine_and_fair_hole);
   /// false: plain minimal-area triangulation (triangulate_hole).
   bool fair_holes = true;
@@ -26,6 +27,13 @@ struct RepairOptions {
   /// Try CGAL's local self-intersection repair (experimental::remove_self_intersections:
   /// removes the faces around each intersection and re-fills the hole) before refusing.
   bool remove_self_intersections = true;
+  /// Resolve self-intersections first by CGAL's autorefinement
+  /// (experimental::autorefine_and_remove_self_intersections): the union of
+  /// the overlapping parts; the region enclosed does not change.
+  bool autorefine = true;
+  /// Largest relative change of area or volume the local repair may make
+  /// (changes above 0.5 % are reported).
+  double max_surface_change = 0.05;
 };
 
 /// What repair_surface() did, in counts.
@@ -39,7 +47,13 @@ struct RepairReport {
   bool reversed_to_outward = false;  ///< whole surface (or components) flipped outward
   int holes_filled = 0;
   int hole_faces_added = 0;
+  int split_nonmanifold_vertices = 0;   ///< vertex copies made to split fans touching at a point
+  double largest_hole_filled = 0.0;     ///< diameter / bbox diagonal of the largest filled hole
+  int self_intersections_autorefined = 0;  ///< intersecting face pairs resolved by autorefinement
+  double area_removed_inside = 0.0;        ///< area fraction the autorefinement dropped (inside)
   int self_intersections_repaired = 0;  ///< intersecting face pairs removed by local repair
+  double area_change = 0.0;             ///< relative area change of the local repair
+  double volume_change = 0.0;           ///< relative volume change of the local repair
   int components = 0;                   ///< connected components of the output
   int output_vertices = 0, output_faces = 0;
   double volume = 0.0;  ///< enclosed volume of the output (model units^3)

@@ -13,6 +13,7 @@
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/GarlandHeckbert_plane_policies.h>
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 
 #include <cmath>
 #include <string>
@@ -22,6 +23,7 @@
 
 namespace icd::mesh {
 namespace SMS = CGAL::Surface_mesh_simplification;
+namespace PMP = CGAL::Polygon_mesh_processing;
 using detail::CgalMesh;
 
 SimplifyResult simplify_surface(const SurfaceMesh& input, const SimplifyOptions& options) {
@@ -40,7 +42,16 @@ SimplifyResult simplify_surface(const SurfaceMesh& input, const SimplifyOptions&
   if (!detail::to_cgal(input, m))
     throw InputError(
         "simplify_surface: input is not a manifold, consistently oriented triangle mesh");
-  if (nf > target) {
+  // A collapse sequence can fold the surface into itself (the mesher then
+  // fails or stalls): check, and retry with twice the faces, else keep the input.
+  const CgalMesh original = m;
+  for (int attempt = 0; nf > target; ++attempt) {
+    if (attempt > 0) {
+      m = original;
+      target *= 2;
+      ++result.report.self_intersection_retries;
+      if (nf <= target) break;
+    }
     using Policies = SMS::GarlandHeckbert_plane_policies<CgalMesh, detail::Kernel>;
     Policies gh(m);
     // A closed triangle mesh has E = 3F/2 edges; the predicate counts edges.
@@ -51,6 +62,7 @@ SimplifyResult simplify_surface(const SurfaceMesh& input, const SimplifyOptions&
             ? SMS::edge_collapse(m, stop, np.filter(SMS::Bounded_normal_change_filter<>()))
             : SMS::edge_collapse(m, stop, np);
     m.collect_garbage();
+    if (!options.check_self_intersections || !PMP::does_self_intersect(m)) break;
   }
   result.mesh = detail::from_cgal(m);
   result.report.output_faces = static_cast<int>(result.mesh.F.rows());

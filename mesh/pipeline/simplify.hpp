@@ -13,12 +13,16 @@ struct SimplifyOptions {
   /// Reject collapses that flip a face normal (CGAL Bounded_normal_change_filter):
   /// avoids folds that would make the surface self-intersect.
   bool bounded_normal_change = true;
+  /// Check the result for self-intersections; retry with twice the faces
+  /// (until the input's count, which is kept) while it intersects itself.
+  bool check_self_intersections = true;
 };
 
 /// What simplify_surface() did.
 struct SimplifyReport {
   int input_faces = 0, output_faces = 0;
   int collapsed_edges = 0;
+  int self_intersection_retries = 0;  ///< results that intersected themselves and were redone
 };
 
 /// Result of simplify_surface().

@@ -4,16 +4,20 @@
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
-#include <CGAL/Polyhedral_mesh_domain_3.h>
+#include <CGAL/Polyhedral_mesh_domain_with_features_3.h>
 #include <CGAL/Random.h>
+#include <CGAL/exceptions.h>
 #include <CGAL/make_mesh_3.h>
 #include <CGAL/refine_mesh_3.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <tuple>
 #include <set>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -28,7 +32,7 @@ namespace {
 
 using detail::CgalMesh;
 using detail::Kernel;
-using Domain = CGAL::Polyhedral_mesh_domain_3<CgalMesh, Kernel>;
+using Domain = CGAL::Polyhedral_mesh_domain_with_features_3<Kernel, CgalMesh>;
 using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
@@ -57,7 +61,10 @@ void seed(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, double s
   const auto cwp = tr.geom_traits().construct_weighted_point_3_object();
   for (const auto& [p, index] : pts) {
     const Tr::Vertex_handle v = tr.insert(cwp(p));
-    if (v == Tr::Vertex_handle()) continue;
+    // A seed inside a protecting ball of a sharp feature is hidden: keep the ball.
+    if (v == Tr::Vertex_handle() || tr.point(v).point() != p || tr.point(v).weight() != 0 ||
+        c3t3.in_dimension(v) >= 0 && c3t3.in_dimension(v) < 2)
+      continue;
     c3t3.set_dimension(v, 2);
     c3t3.set_index(v, index);
   }
@@ -72,8 +79,14 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
   const Criteria criteria(p::facet_angle = o.facet_angle_deg,
                           p::facet_size = o.facet_size_factor * size,
                           p::facet_distance = o.facet_distance_factor * size,
-                          p::cell_radius_edge_ratio = o.radius_edge_bound, p::cell_size = size);
+                          p::cell_radius_edge_ratio = o.radius_edge_bound, p::cell_size = size,
+                          p::edge_size = o.facet_size_factor * size);
   C3t3 c3t3;
+  // Sharp features (detected on the domain) are protected by balls first, as
+  // make_mesh_3 does: without protection the refinement need not terminate
+  // near small input angles (CAD parts stalled for minutes).
+  if (o.feature_angle_deg > 0.0)
+    CGAL::Mesh_3::internal::init_c3t3_with_features(c3t3, domain, criteria);
   seed(c3t3, domain, surface, o.facet_size_factor * size);
   // manifold(): the boundary of the complex must be a manifold surface (thin
   // parts otherwise yield boundary edges shared by four faces).
@@ -106,20 +119,63 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
   return out;
 }
 
+/// Empty when the boundary F of `m` is a closed manifold surface (each
+/// directed edge exactly once, its reverse exactly once); else what is wrong.
+std::string boundary_problem(const TetMesh& m) {
+  std::map<std::pair<int, int>, int> directed;
+  const MatX3i& F = m.F;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ++directed[{F(f, k), F(f, (k + 1) % 3)}];
+  for (const auto& [e, n] : directed) {
+    const auto rev = directed.find({e.second, e.first});
+    if (n != 1 || rev == directed.end() || rev->second != 1)
+      return "the boundary of the tet mesh is not a closed manifold surface at the edge between "
+             "nodes " +
+             std::to_string(e.first) + " and " + std::to_string(e.second);
+  }
+  return "";
+}
+
+std::string serialize(const TetMesh& m) {
+  ByteWriter w;
+  w.mat(m.V);
+  w.mat(m.T);
+  w.mat(m.F);
+  return w.take();
+}
+
+TetMesh deserialize(const std::string& bytes) {
+  ByteReader r(bytes);
+  TetMesh m;
+  m.V = r.mat<MatX3d>();
+  m.T = r.mat<MatX4i>();
+  m.F = r.mat<MatX3i>();
+  return m;
+}
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s.precision(4);
+  s << x;
+  return s.str();
+}
+
 }  // namespace
 
 TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
-                                            const TetrahedralizeOptions& o) {
+                                            const TetrahedralizeOptions& o,
+                                            const HeartbeatFn& heartbeat) {
   if ((o.cell_size <= 0.0 && o.target_tets < 1) || !(o.cell_size >= 0.0) ||
       !(o.facet_size_factor > 0.0) || !(o.facet_distance_factor > 0.0) ||
       !(o.facet_angle_deg > 0.0 && o.facet_angle_deg <= 30.0) || !(o.radius_edge_bound >= 2.0) ||
       !(o.sliver_bound_deg >= 0.0 && o.sliver_bound_deg < 70.0) || o.max_size_iterations < 1 ||
-      !(o.count_tolerance > 0.0))
+      !(o.count_tolerance > 0.0) || !(o.pass_share > 0.0 && o.pass_share <= 1.0) ||
+      o.max_retries < 0 || !(o.feature_angle_deg >= 0.0 && o.feature_angle_deg < 180.0) ||
+      !(o.limits.cpu_seconds > 0.0) || !(o.limits.memory_mb > 0.0))
     throw ParameterError(
         "tetrahedralize_surface: need target_tets >= 1 or cell_size > 0, facet_angle_deg in (0, "
-        "30], "
-        "radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, "
-        "max_size_iterations >= 1");
+        "30], radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, "
+        "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits");
   CgalMesh sm;
   if (!detail::to_cgal(surface, sm) || !CGAL::is_closed(sm))
     throw InputError("tetrahedralize_surface: the surface is not a closed manifold triangle mesh");
@@ -127,61 +183,133 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
   if (!(volume > 0.0))
     throw InputError("tetrahedralize_surface: the surface encloses no positive volume (" +
                      std::to_string(volume) + "); is it oriented outward?");
-  const Domain domain(sm);
+  const double diagonal = (surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff()).norm();
+  const double max_size = 0.5 * diagonal;  // a larger circumradius bound changes nothing
+  Domain domain(sm);
+  TetrahedralizeResult res;
+  if (o.feature_angle_deg > 0.0) {
+    domain.detect_features(o.feature_angle_deg);
+    std::vector<std::tuple<Domain::Curve_index, std::pair<Domain::Point_3, Domain::Index>,
+                           std::pair<Domain::Point_3, Domain::Index>>>
+        curves;
+    domain.get_curves(std::back_inserter(curves));
+    res.feature_curves = static_cast<int>(curves.size());
+  }
+  double spent = 0.0;  // CPU seconds of all passes
+  int retries_left = o.max_retries;
+  std::string last_cause;
+  std::vector<std::string> failures;
+  // One bounded pass; false (and a note) when it failed.
+  const auto attempt = [&](double size, bool optimise, TetMesh& out) {
+    StageLimits pl = o.limits;
+    pl.cpu_seconds = std::min(o.limits.cpu_seconds - spent, o.pass_share * o.limits.cpu_seconds);
+    if (pl.cpu_seconds < 0.5) {
+      last_cause = "the stage's CPU-time limit of " + fmt(o.limits.cpu_seconds) +
+                   " s (--time-limit) is used up";
+      return false;
+    }
+    ++res.passes;
+    const std::string label = "pass " + std::to_string(res.passes) + " (cell size " + fmt(size) +
+                              (optimise ? ", optimised" : "") + ")";
+    const HeartbeatFn beat = [&](const std::string& s) {
+      if (heartbeat) heartbeat(label + " " + s);
+    };
+    StageUsage u;
+    try {
+      const std::string bytes = run_bounded(
+          "tetrahedralize", pl,
+          [&] {
+            TetMesh m = mesh_once(domain, surface, o, size, optimise);
+            if (m.T.rows() == 0) throw InputError("the mesher produced no tetrahedron");
+            const std::string problem = boundary_problem(m);
+            if (!problem.empty()) throw InputError(problem);
+            return serialize(m);
+          },
+          &u, beat);
+      out = deserialize(bytes);
+    } catch (const ParameterError&) {
+      throw;
+    } catch (const InputError& e) {
+      last_cause = e.what();
+    } catch (const CGAL::Failure_exception&) {  // only without isolation
+      last_cause = "stage 'tetrahedralize' failed inside CGAL (an internal check did not hold)";
+    }
+    spent += u.cpu_seconds;
+    res.usage.cpu_seconds += u.cpu_seconds;
+    res.usage.wall_seconds += u.wall_seconds;
+    res.usage.peak_mb = std::max(res.usage.peak_mb, u.peak_mb);
+    if (out.T.rows() > 0) return true;
+    ++res.failed_passes;
+    failures.push_back("cell size " + fmt(size) + ": " + last_cause);
+    return false;
+  };
+  static constexpr double kNearby[] = {0.85, 1.15, 0.7, 1.3, 0.6, 1.5, 0.5, 1.7};
+  // Tries `size`, then nearby sizes while retries are left.
+  const auto attempt_near = [&](double size, bool optimise, TetMesh& out, double& used) {
+    double prev = size;
+    for (int k = -1; k < static_cast<int>(std::size(kNearby)); ++k) {
+      used = k < 0 ? size : std::min(max_size, size * kNearby[k]);
+      if (k >= 0) {
+        if (retries_left-- <= 0) return false;
+        res.notes.push_back("pass at cell size " + fmt(prev) + " failed (" +
+                            last_cause + "); retrying at cell size " + fmt(used));
+        if (heartbeat) heartbeat(res.notes.back());
+      }
+      prev = used;
+      TetMesh m;
+      if (attempt(used, optimise, m)) {
+        out = std::move(m);
+        return true;
+      }
+      if (o.limits.cpu_seconds - spent < 0.5) return false;
+    }
+    return false;
+  };
 
-  TetrahedralizeResult best;
   if (o.cell_size > 0.0) {
-    best.mesh = mesh_once(domain, surface, o, o.cell_size, true);
-    best.cell_size = o.cell_size;
-    best.passes = 1;
+    double used = 0.0;
+    if (attempt_near(o.cell_size, true, res.mesh, used)) res.cell_size = used;
   } else {
     // Size search without sliver optimisation (which changes the count only
     // slightly), then one optimised pass at the best size. Initial guess: a
     // regular tet of edge a has volume a^3 / (6 sqrt 2) and circumradius
     // a sqrt(6) / 4; refinement stops well below the bound, hence the factor.
     const double a = std::cbrt(6.0 * std::sqrt(2.0) * volume / o.target_tets);
-    double size = a * std::sqrt(6.0) / 4.0 * 2.0;
-    double best_err = INFINITY, best_size = size;
+    double size = std::min(max_size, a * std::sqrt(6.0) / 4.0 * 2.0);
+    double best_err = INFINITY, best_size = 0.0;
     for (int pass = 1; pass <= o.max_size_iterations; ++pass) {
-      const double n = static_cast<double>(mesh_once(domain, surface, o, size, false).T.rows());
+      TetMesh m;
+      double used = 0.0;
+      if (!attempt_near(size, false, m, used)) break;
+      const double n = static_cast<double>(m.T.rows());
       const double err = std::abs(n / o.target_tets - 1.0);
       if (err < best_err) {
         best_err = err;
-        best_size = size;
+        best_size = used;
       }
-      best.passes = pass;
-      if (err <= o.count_tolerance || n == 0) break;
+      if (err <= o.count_tolerance) break;
       // Count ~ size^-3 for volume-dominated meshes, flatter when the surface
       // dominates; the exponent 1/2 undershoots less on thin shapes.
-      size *= std::pow(n / o.target_tets, 0.5);
+      size = std::min(max_size, used * std::pow(n / o.target_tets, 0.5));
+      if (size == used) break;  // at the largest size: no coarser mesh exists
     }
-    best.mesh = mesh_once(domain, surface, o, best_size, true);
-    best.cell_size = best_size;
-    ++best.passes;
+    double used = 0.0;
+    if (best_size > 0.0 && attempt_near(best_size, true, res.mesh, used)) res.cell_size = used;
   }
-  if (best.mesh.T.rows() == 0)
-    throw InputError("tetrahedralize_surface: the mesher produced no tetrahedron (cell size " +
-                     std::to_string(best.cell_size) + ")");
-  // The boundary must be a closed manifold surface (the coarse surface nodes
-  // and the collision surface rely on it): each directed edge exactly once,
-  // its reverse exactly once.
-  {
-    std::map<std::pair<int, int>, int> directed;
-    const MatX3i& F = best.mesh.F;
-    for (int f = 0; f < F.rows(); ++f)
-      for (int k = 0; k < 3; ++k) ++directed[{F(f, k), F(f, (k + 1) % 3)}];
-    for (const auto& [e, n] : directed) {
-      const auto rev = directed.find({e.second, e.first});
-      if (n != 1 || rev == directed.end() || rev->second != 1)
-        throw InputError(
-            "tetrahedralize_surface: the boundary of the tet mesh is not a closed manifold "
-            "surface at the edge between nodes " +
-            std::to_string(e.first) + " and " + std::to_string(e.second) + " (cell size " +
-            std::to_string(best.cell_size) + "); try a smaller cell size or more tets");
-    }
+  if (res.mesh.T.rows() == 0) {
+    std::ostringstream s;
+    s << "tetrahedralize: the mesher failed in all " << res.passes << " pass(es)";
+    for (const std::string& f : failures) s << "; " << f;
+    if (failures.empty() && !last_cause.empty()) s << ": " << last_cause;
+    s << ". Options that change this: --coarse-tets N or --cell-size H (other sizes), "
+         "--time-limit S and --memory-limit MB (the stage's limits)";
+    throw InputError(s.str());
   }
-  best.quality = tet_quality(best.mesh);
-  return best;
+  if (res.failed_passes > 0 && heartbeat)
+    heartbeat(std::to_string(res.failed_passes) + " pass(es) failed and were retried at nearby "
+              "cell sizes; kept cell size " + fmt(res.cell_size));
+  res.quality = tet_quality(res.mesh);
+  return res;
 }
 
 }  // namespace icd::mesh

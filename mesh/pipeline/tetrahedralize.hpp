@@ -3,7 +3,11 @@
 /// mesh of a closed surface, with CGAL's 3D mesh generator (Mesh_3, polyhedral
 /// domain), Delaunay refinement with quality bounds, then sliver perturbation
 /// and exudation. Its boundary nodes are the reduced coordinates Q (paper 3.1).
+#include <string>
+#include <vector>
+
 #include <icd/mesh/core/types.hpp>
+#include <icd/mesh/pipeline/bounded.hpp>
 #include <icd/mesh/pipeline/tet_quality.hpp>
 
 namespace icd::mesh {
@@ -21,8 +25,26 @@ struct TetrahedralizeOptions {
   double radius_edge_bound = 3.0;  ///< cell radius-edge ratio bound (>= 2 guarantees termination)
   bool perturb = true;             ///< CGAL perturb_mesh_3 against slivers
   bool exude = true;               ///< CGAL exude_mesh_3 against slivers
-  double sliver_bound_deg = 10.0;  ///< dihedral angle targeted by perturb/exude
+  /// Dihedral angle (deg) targeted by perturb/exude: 12 meets the minimum
+  /// dihedral target of explicit FEM on the bunny at 4 s CPU (15: 17 s; 10: 1.3 s).
+  double sliver_bound_deg = 12.0;
+  /// Edges whose faces meet at more than this angle (deg, between normals)
+  /// are sharp features, protected (Mesh_3 polyhedral domain with features):
+  /// kept in the coarse surface and the refinement terminates near them.
+  /// 0: no feature detection (the default: measured on the corpus, protection
+  /// gave worse tets and more failed passes with this seeding, see
+  /// experiments/studies/preprocess/README.md).
+  double feature_angle_deg = 0.0;
   unsigned random_seed = 0;        ///< CGAL default random generator seed (determinism)
+  /// CPU-time and memory limits of the whole stage; each meshing pass runs
+  /// bounded (bounded.hpp) by at most pass_share of the CPU time, so that a
+  /// pass that stalls leaves time for the retries.
+  StageLimits limits;
+  double pass_share = 0.34;  ///< in (0, 1]
+  /// Passes that fail (no tet, a non-manifold boundary, a CGAL failure, a pass
+  /// limit) are retried at nearby cell sizes (x 0.85, 1.15, 0.7, 1.3, ...) up
+  /// to this many times in all; each retry is reported in the result's notes.
+  int max_retries = 6;
 };
 
 /// Result of tetrahedralize_surface().
@@ -31,16 +53,26 @@ struct TetrahedralizeResult {
   TetQuality quality;
   double cell_size = 0;  ///< cell size of the pass that was kept
   int passes = 0;        ///< meshing passes run (size search + the final optimised one)
+  int feature_curves = 0;  ///< sharp-feature polylines protected
+  int failed_passes = 0;  ///< passes that failed and were retried at another size
+  /// One line per retry or notable event ("pass 2 at cell size 0.03 failed:
+  /// ...; retrying at 0.0255").
+  std::vector<std::string> notes;
+  StageUsage usage;  ///< summed over the passes (peak: the largest)
 };
 
 /// Tetrahedralizes the region bounded by `surface` (closed, outward-oriented,
 /// no self-intersection: the output of repair_surface()/simplify_surface()).
 /// Deterministic: CGAL's default random generator is reset to random_seed
-/// before each pass and the meshing runs sequentially without time limits.
+/// before each pass and the meshing runs sequentially (only a limit that
+/// fires makes the result depend on timing; it is reported in notes).
 /// Throws ParameterError on bad options, InputError when the surface is not
-/// closed, the mesher produces no tet, or the tet boundary is not a closed
-/// manifold surface (Mesh_3 runs with its manifold option, so this is a safeguard).
+/// closed, and StageError/InputError when every retry failed (no tet, a tet
+/// boundary that is not a closed manifold surface, a limit): the message
+/// names the cause of each failed pass and the options to change.
+/// `heartbeat` (optional) receives progress lines.
 TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
-                                            const TetrahedralizeOptions& options = {});
+                                            const TetrahedralizeOptions& options = {},
+                                            const HeartbeatFn& heartbeat = {});
 
 }  // namespace icd::mesh

@@ -112,7 +112,27 @@ TEST(Repair, RefusesLargeHole) {
   std::set<int> drop;
   for (int f = 0; f < s.F.rows(); ++f)
     if ((s.V.row(s.F(f, 0)) + s.V.row(s.F(f, 1)) + s.V.row(s.F(f, 2)))(2) / 3 > 0.6) drop.insert(f);
-  expect_refused(test::without_faces(s, drop), {"open surface", "1 boundary loop", "edges"});
+  RepairOptions o;
+  o.max_hole_diameter = 0.1;
+  const SurfaceMesh open = test::without_faces(s, drop);
+  expect_refused(open, {"open surface", "1 boundary loop", "edges", "--max-hole-diameter 0.1 of",
+                        "to fill every hole: --max-hole-edges"},
+                 o);
+  // The option the message names fixes it.
+  try {
+    repair_surface(open, o, "in.off");
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    const std::string key = "--max-hole-diameter ";
+    const double f = std::stod(msg.substr(msg.rfind(key) + key.size()));
+    EXPECT_GT(f, 0.1);
+    o.max_hole_diameter = f;
+    const RepairResult r = repair_surface(open, o, "in.off");
+    EXPECT_EQ(r.report.holes_filled, 1);
+    EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+    // A hole this wide is reported.
+    EXPECT_NE(r.report.to_string().find("WARNING: filled a hole"), std::string::npos);
+  }
 }
 
 TEST(Repair, RefusesNonManifoldEdge) {
@@ -126,7 +146,7 @@ TEST(Repair, RefusesNonManifoldEdge) {
   expect_refused(m, {"non-manifold edge", "shared by 3 faces"});
 }
 
-TEST(Repair, RefusesNonManifoldVertex) {
+TEST(Repair, SplitsNonManifoldVertex) {
   // Two tetrahedra touching at one vertex: every edge is fine, the vertex is not.
   const TetMesh t = make_unit_tet();
   SurfaceMesh m;
@@ -137,17 +157,90 @@ TEST(Repair, RefusesNonManifoldVertex) {
   for (int f = 4; f < 8; ++f)
     for (int c = 0; c < 3; ++c)
       if (m.F(f, c) != 0) m.F(f, c) += 3;
-  expect_refused(m, {"non-manifold vertex 0"});
+  // The vertex is split (one copy per fan, moved slightly into its fan); the
+  // two tets stay closed and keep their volume.
+  const RepairResult r = repair_surface(m, {}, "in.off");
+  EXPECT_EQ(r.report.split_nonmanifold_vertices, 1);
+  EXPECT_EQ(r.mesh.V.rows(), 8);
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  EXPECT_EQ(r.report.components, 2);
+  EXPECT_NEAR(r.report.volume, 2.0 / 6.0, 0.02 * 2.0 / 6.0);
+  EXPECT_NE(r.report.to_string().find("split non-manifold vertices: 1"), std::string::npos);
 }
 
-TEST(Repair, RefusesSelfIntersection) {
-  const SurfaceMesh a = make_icosphere(2);
+TEST(Repair, WeldingThatMakesANonManifoldVertexIsSplit) {
+  // Two tets with distinct but coincident tip vertices: the exact-duplicate
+  // merge welds them into a non-manifold vertex, which is then split again.
+  const TetMesh t = make_unit_tet();
+  SurfaceMesh m;
+  m.V.resize(8, 3);
+  m.V << t.V, -t.V;
+  m.F.resize(8, 3);
+  m.F << t.F, t.F.array() + 4;
+  const RepairResult r = repair_surface(m, {}, "in.off");
+  EXPECT_EQ(r.report.merged_duplicate_vertices, 1);
+  EXPECT_EQ(r.report.split_nonmanifold_vertices, 1);
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+}
+
+SurfaceMesh two_overlapping_spheres() {
+  const SurfaceMesh a = make_icosphere(3);  // 640 faces each
   SurfaceMesh m;
   m.V.resize(2 * a.V.rows(), 3);
   m.V << a.V, a.V.rowwise() + Eigen::RowVector3d(1.0, 0.2, 0.1);
   m.F.resize(2 * a.F.rows(), 3);
   m.F << a.F, a.F.array() + static_cast<int>(a.V.rows());
-  expect_refused(m, {"intersects itself", "intersecting face pair"});
+  return m;
+}
+
+TEST(Repair, OverlappingSpheresBecomeTheirUnion) {
+  // Two closed unit spheres overlapping: the autorefinement keeps the outer
+  // surface of their union (the case where the local repair cut 640
+  // faces to 62). Oracle: the union volume 2 V_ball - V_lens of two balls at
+  // distance d (lens = pi (2r - d/2)^2 (d + 4r... ) / 12 form below).
+  const SurfaceMesh m = two_overlapping_spheres();
+  const RepairResult r = repair_surface(m, {}, "in.off");
+  EXPECT_GT(r.report.self_intersections_autorefined, 0);
+  EXPECT_EQ(r.report.self_intersections_repaired, 0);
+  EXPECT_EQ(r.report.components, 1);
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  EXPECT_GT(r.mesh.F.rows(), 1000);
+  const double d = Eigen::Vector3d(1.0, 0.2, 0.1).norm(), R = 1.0;
+  const double lens = std::numbers::pi * (4 * R + d) * (2 * R - d) * (2 * R - d) / 12.0;
+  const double vball = enclosed_volume(make_icosphere(3).V, make_icosphere(3).F);
+  const double expected = 2 * vball - lens * vball / (4.0 / 3.0 * std::numbers::pi);
+  EXPECT_NEAR(r.report.volume, expected, 0.02 * expected);
+}
+
+TEST(Repair, LocalFoldIsNotCutAway) {
+  // One sphere with a few vertices pushed through the opposite side: a
+  // single component whose repair must keep (nearly) all of its volume.
+  SurfaceMesh m = make_icosphere(3);
+  const double v0 = enclosed_volume(m.V, m.F);
+  int moved = 0;
+  for (int i = 0; i < m.V.rows() && moved < 1; ++i)
+    if (m.V(i, 2) > 0.99) {
+      m.V(i, 2) = -1.2;  // the north pole pokes out through the south pole
+      ++moved;
+    }
+  ASSERT_EQ(moved, 1);
+  try {
+    const RepairResult r = repair_surface(m, {}, "in.off");
+    EXPECT_GT(r.report.volume, 0.9 * v0);
+    EXPECT_GT(r.mesh.F.rows(), m.F.rows() / 2);
+  } catch (const InputError& e) {  // a refusal is acceptable; a silent cut is not
+    std::cout << "  message: " << e.what() << "\n";
+  }
+}
+
+TEST(Repair, RefusesSelfIntersectionWithCountLocationAndOption) {
+  RepairOptions o;
+  o.autorefine = false;          // only the local repair, which changes the shape a lot here
+  o.max_surface_change = 0.001;  // refused above 0.1 %
+  expect_refused(two_overlapping_spheres(),
+                 {"intersects itself", "intersecting face pair", "e.g. faces near",
+                  "the local repair"},
+                 o);
 }
 
 TEST(Repair, RefusesZeroVolume) {

@@ -1,0 +1,94 @@
+#!/usr/bin/python3
+"""Reads the logs of run_corpus.sh (OUT/logs/MESH.log, .rc) and writes
+OUT/corpus.csv and OUT/corpus_table.md: one row per mesh.
+
+usage: corpus_table.py OUT MESH...
+"""
+import csv
+import os
+import re
+import sys
+
+TARGET_TETS = 2000
+
+
+def num(pattern, text, group=1, default=""):
+    m = re.search(pattern, text)
+    return m.group(group) if m else default
+
+
+def row(out, mesh):
+    log = open(os.path.join(out, "logs", mesh + ".log"), errors="replace").read()
+    rc = int(open(os.path.join(out, "logs", mesh + ".rc")).read().strip() or 1)
+    r = {"mesh": mesh,
+         "triangles": num(r"\[read\][^\n]*?(\d+) triangles", log),
+         "outcome": "ok" if rc == 0 else ("refused" if rc == 1 else f"exit {rc}")}
+    err = num(r"^icd-preprocess: (.*)$", log, default="") if rc else ""
+    m = re.search(r"^icd-preprocess: (.*)$", log, re.M)
+    r["message"] = (m.group(1)[:160] + ("..." if len(m.group(1)) > 160 else "")) if (m and rc) else ""
+    q = re.search(r"(\d+) vertices \((\d+) on the surface\), (\d+) tets", log)
+    if q:
+        nv, ns, nt = map(int, q.groups())
+        r.update(tets=nt, interior_nodes=nv - ns,
+                 tet_count_error=f"{100.0 * (nt / TARGET_TETS - 1):+.0f}%")
+    d = re.search(r"dihedral angles \[([^,]+), ([^\]]+)\] deg, max radius-edge ratio ([^,]+), "
+                  r"min volume [^,]+, total volume (\S+)", log)
+    if d:
+        r.update(min_dihedral=f"{float(d.group(1)):.1f}", max_dihedral=f"{float(d.group(2)):.1f}",
+                 max_radius_edge=f"{float(d.group(3)):.2f}")
+        vol_rep = num(r"component\(s\), volume (\S+)", log)
+        if vol_rep:
+            r["volume_change"] = f"{100.0 * (float(d.group(4)) / float(vol_rep) - 1):+.1f}%"
+    h = num(r"\(([\d.e+-]+)% of the bbox diagonal", log)
+    if h:
+        r["hausdorff_pct_diag"] = f"{float(h):.2f}"
+    t = re.search(r"; total ([\d.]+) \(([\d.]+)\), peak (\d+) MB", log)
+    if t:
+        r.update(wall_s=t.group(1), cpu_s=t.group(2), peak_mb=t.group(3))
+    tet_cpu = num(r"tetrahedralize [\d.]+ \(([\d.]+)\)", log)
+    if tet_cpu:
+        r["tet_cpu_s"] = tet_cpu
+    r["retries"] = len(re.findall(r"-- note: tetrahedralize: pass at", log))
+    r["repairs"] = "; ".join(
+        s for s in [
+            "autorefined" if "resolved self-intersections by autorefinement" in log else "",
+            "local SI repair" if "repaired self-intersections locally" in log else "",
+            "split vertices" if "split non-manifold vertices" in log else "",
+            "holes %s" % num(r"filled holes: (\d+)", log) if "filled holes" in log else "",
+            "WIDE HOLE" if "WARNING: filled a hole" in log else ""] if s)
+    warn = []
+    if d and float(d.group(1)) < 12.0:
+        warn.append("min dihedral < 12")
+    if h and float(h) > 3.0:
+        warn.append("Hausdorff > 3%")
+    if "volume_change" in r and abs(float(r["volume_change"].rstrip("%"))) > 5.0:
+        warn.append("volume > 5%")
+    if q and abs(nt / TARGET_TETS - 1) > 0.25:
+        warn.append("tets off by > 25%")
+    if q and nv - ns < 10:
+        warn.append("< 10 interior nodes")
+    r["target_misses"] = ", ".join(warn)
+    return r
+
+
+def main():
+    out, meshes = sys.argv[1], sys.argv[2:]
+    rows = [row(out, m) for m in meshes]
+    cols = ["mesh", "triangles", "outcome", "tets", "tet_count_error", "interior_nodes",
+            "min_dihedral", "max_dihedral", "max_radius_edge", "hausdorff_pct_diag",
+            "volume_change", "tet_cpu_s", "cpu_s", "wall_s", "peak_mb", "retries", "repairs",
+            "target_misses", "message"]
+    with open(os.path.join(out, "corpus.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    ok = sum(r["outcome"] == "ok" for r in rows)
+    with open(os.path.join(out, "corpus_table.md"), "w") as f:
+        f.write(f"{ok} of {len(rows)} meshes succeeded ({100.0 * ok / max(1, len(rows)):.0f} %).\n\n")
+        f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
+        for r in rows:
+            f.write("| " + " | ".join(str(r.get(c, "")).replace("|", "/") for c in cols) + " |\n")
+    print(f"[corpus] {ok}/{len(rows)} ok; table in {out}/corpus_table.md")
+
+
+main()
