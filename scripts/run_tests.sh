@@ -5,6 +5,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install_deps.sh"
 "$root/scripts/fetch_meshes.sh"
+"$root/scripts/fetch_corpus.sh"
 build="$root/build/test"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DICD_ENABLE_ASSERTS=ON -DICD_BUILD_TESTS=ON -DICD_BUILD_BENCHMARKS=ON >/dev/null

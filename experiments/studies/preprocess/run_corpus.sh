@@ -4,7 +4,8 @@
 #   experiments/studies/preprocess/run_corpus.sh BIN_DIR OUT [--subset] [-- EXTRA ICD-PREPROCESS ARGS]
 # --subset: four small meshes only (the CTest PreprocessCorpus.Subset). Exit
 # status 0 when every mesh succeeded or was refused with a message (no limit
-# exceeded without a message, no crash), 77 when the corpus is not fetched.
+# exceeded without a message, no crash), 1 when the corpus is not fetched
+# (scripts/run_tests.sh fetches it).
 set -uo pipefail
 root=$(cd "$(dirname "$0")/../../.." && pwd)
 bin="$1"; out="$2"; shift 2
@@ -19,8 +20,8 @@ while [ $# -gt 0 ]; do
 done
 corpus="$root/data/corpus"
 if [ ! -d "$corpus" ]; then
-  echo "run_corpus.sh: $corpus missing (run scripts/fetch_corpus.sh); skipped" >&2
-  exit 77
+  echo "run_corpus.sh: $corpus missing (run scripts/fetch_corpus.sh)" >&2
+  exit 1
 fi
 mkdir -p "$out/logs"
 if [ $subset = 1 ]; then
