@@ -29,8 +29,9 @@ inline constexpr std::uint64_t kSurfaceMesh = 64 * kMiB;
 inline constexpr std::uint64_t kVtu = 64 * kMiB;
 /// `.sph` sphere trees (the toolkit's text format).
 inline constexpr std::uint64_t kSph = 64 * kMiB;
-/// `bundle.icdb`, the binary part of an asset bundle.
-inline constexpr std::uint64_t kBundle = 256 * kMiB;
+/// `bundle.icdb`, the binary part of an asset bundle (rigid links and sphere
+/// tree: about 60 bytes per dense vertex).
+inline constexpr std::uint64_t kBundle = 128 * kMiB;
 }  // namespace file_limits
 
 /// Checks that `path` names an existing regular file of at most `max_bytes`

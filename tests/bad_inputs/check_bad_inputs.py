@@ -121,6 +121,7 @@ GENERATORS = {
     "mesh_nul_1536mib.stl": lambda p: sparse(p, 1536 * MiB),
     "sph_nul_1536mib.sph": lambda p: sparse(p, 1536 * MiB),
     "vtu_nul_1536mib.vtu": lambda p: sparse(p, 1536 * MiB),
+    "bundle_huge_icdb": lambda p: (os.makedirs(p), sparse(os.path.join(p, "bundle.icdb"), 1536 * MiB)),
     # Just within the limits: read (and refused by their content) in bounded
     # time and memory.
     "scene_nul_63mib.json": lambda p: sparse(p, 63 * MiB),
