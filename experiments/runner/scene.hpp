@@ -81,8 +81,10 @@ Scene parse_scene(const Json& json, const std::string& source,
 /// meshes kept up to date when the output writes them.
 coupling::WorldSettings world_settings(const Scene& scene);
 
-/// Reads and parses a scene file; relative paths resolve against its folder,
-/// then against the repository root (so shipped scenes find data/).
+/// Reads and parses a scene file (read_json_file: a regular file of at most
+/// 64 MiB); relative paths resolve against its folder, then against the
+/// repository root (so shipped scenes find data/). The paths are only
+/// resolved here: check_scene_inputs (run.hpp) checks that they exist.
 Scene load_scene(const std::filesystem::path& path);
 
 }  // namespace icd::runner
