@@ -7,7 +7,6 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="${1:-$root/data/corpus}"
-mkdir -p "$out"
 
 declare -A SHA=(
   [armadillo.off]=6f7f3ca1abc506569466b72f2f59d49493a284e7376d7a7e23c08115ec8cec4e
@@ -52,34 +51,5 @@ declare -A SHA=(
   [turbine.off]=8ae52b6b325a05e0755983706ab55aba0f42d3ea0569dd29b33cdcb16c20f4c8
 )
 
-verified() {
-  local f
-  for f in "${!SHA[@]}"; do
-    [ -f "$out/$f" ] || return 1
-    echo "${SHA[$f]}  $out/$f" | sha256sum --quiet -c - >/dev/null 2>&1 || return 1
-  done
-}
-verified && exit 0
-
-echo "[icd] fetching the corpus from Debian's libcgal-demo (about 24 MB)"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-chmod 755 "$tmp"
-(cd "$tmp" && apt-get download libcgal-demo >/dev/null 2>&1) || {
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq && (cd "$tmp" && apt-get download libcgal-demo >/dev/null)
-}
-deb=$(ls "$tmp"/libcgal-demo_*.deb)
-dpkg -x "$deb" "$tmp/x"
-members=()
-for f in "${!SHA[@]}"; do members+=("data/meshes/$f"); done
-tar -xzf "$tmp/x/usr/share/doc/libcgal-dev/data.tar.gz" -C "$tmp" "${members[@]}"
-for f in "${!SHA[@]}"; do
-  got=$(sha256sum "$tmp/data/meshes/$f" | cut -d' ' -f1)
-  if [ "$got" != "${SHA[$f]}" ]; then
-    echo "[icd] checksum mismatch for $f: got $got, expected ${SHA[$f]}" >&2
-    exit 1
-  fi
-  cp "$tmp/data/meshes/$f" "$out/$f.part" && mv "$out/$f.part" "$out/$f"
-done
-echo "[icd] ${#SHA[@]} corpus meshes cached in $out"
+. "$root/scripts/cgal_demo_meshes.sh"
+fetch_cgal_demo_meshes "$out" "the corpus (about 24 MB)"
