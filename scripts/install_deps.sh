@@ -9,6 +9,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-dev python3-meshio python3-numpy python3-matplotlib
   pybind11-dev python3-pybind11
+  libcli11-dev nlohmann-json3-dev openmpi-bin libopenmpi-dev
 )
 # Optional extras: the FCL baseline of the collision benchmark.
 OPTIONAL=(libfcl-dev)
