@@ -1,5 +1,6 @@
 #include <icd/mesh/io/vtk_writer.hpp>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <set>
@@ -14,6 +15,7 @@ namespace icd {
 namespace {
 
 constexpr int kVtkVertex = 1;
+constexpr int kVtkPolyVertex = 2;
 constexpr int kVtkTriangle = 5;
 constexpr int kVtkTetra = 10;
 
@@ -41,104 +43,143 @@ void check_indices(const std::filesystem::path& path, const Eigen::MatrixBase<De
 }
 
 void check_point_data(const std::filesystem::path& path, std::span<const PointDataArray> arrays,
-                      Eigen::Index num_points, std::set<std::string> names) {
+                      Eigen::Index num_points, std::set<std::string> names,
+                      const std::string& kind = "point-data") {
   for (const PointDataArray& a : arrays) {
-    if (a.name.empty()) fail(path, "a point-data array has an empty name");
+    if (a.name.empty()) fail(path, "a " + kind + " array has an empty name");
     if (!names.insert(a.name).second)
-      fail(path, "point-data array name '" + a.name + "' is used twice");
+      fail(path, kind + " array name '" + a.name + "' is used twice");
     if (a.values.rows() != num_points || a.values.cols() < 1)
-      fail(path, "point-data array '" + a.name + "' is " + std::to_string(a.values.rows()) + " x " +
+      fail(path, kind + " array '" + a.name + "' is " + std::to_string(a.values.rows()) + " x " +
                      std::to_string(a.values.cols()) + "; expected " + std::to_string(num_points) +
                      " rows and at least 1 column");
-    check_finite(path, a.values, "point-data array '" + a.name + "'");
+    check_finite(path, a.values, kind + " array '" + a.name + "'");
   }
 }
 
-void append_array(std::string& out, const std::string& attrs, const auto& values, Eigen::Index rows,
-                  Eigen::Index cols) {
+// One DataArray: its XML attributes (type, Name, NumberOfComponents) and its
+// values, value(i, c) for i < rows, c < cols, converted to T when binary.
+template <class T, class Value>
+void append_array(std::string& out, std::string* appended, const std::string& attrs,
+                  const Value& value, Eigen::Index rows, Eigen::Index cols) {
+  if (appended) {
+    // Raw appended block: UInt64 byte count, then the values, little-endian
+    // (the only byte order of the machines we build on; checked below).
+    static_assert(std::endian::native == std::endian::little);
+    out += "        <DataArray " + attrs + " format=\"appended\" offset=\"" +
+           std::to_string(appended->size()) + "\"/>\n";
+    const uint64_t bytes = static_cast<uint64_t>(rows * cols) * sizeof(T);
+    appended->append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
+    for (Eigen::Index i = 0; i < rows; ++i)
+      for (Eigen::Index c = 0; c < cols; ++c) {
+        const T v = static_cast<T>(value(i, c));
+        appended->append(reinterpret_cast<const char*>(&v), sizeof v);
+      }
+    return;
+  }
   out += "        <DataArray " + attrs + " format=\"ascii\">\n";
   for (Eigen::Index i = 0; i < rows; ++i) {
     out += "          ";
     for (Eigen::Index c = 0; c < cols; ++c) {
       if (c) out += ' ';
-      detail::append_number(out, values(i, c));
+      detail::append_number(out, value(i, c));
     }
     out += '\n';
   }
   out += "        </DataArray>\n";
 }
 
-void append_double_array(std::string& out, const std::string& name_attr,
+void append_double_array(std::string& out, std::string* appended, const std::string& name,
                          const Eigen::Ref<const Eigen::MatrixXd>& values) {
-  std::string attrs = "type=\"Float64\"" + name_attr;
-  attrs += " NumberOfComponents=\"" + std::to_string(values.cols()) + "\"";
-  append_array(
-      out, attrs, [&](Eigen::Index i, Eigen::Index c) { return values(i, c); }, values.rows(),
-      values.cols());
+  const std::string attrs = "type=\"Float64\" Name=\"" + detail::xml_escape(name) +
+                            "\" NumberOfComponents=\"" + std::to_string(values.cols()) + "\"";
+  append_array<double>(
+      out, appended, attrs, [&](Eigen::Index i, Eigen::Index c) { return values(i, c); },
+      values.rows(), values.cols());
 }
 
 // Writes a whole UnstructuredGrid whose cells all have `corners` vertices and
 // VTK type `cell_type`; cell(i, c) gives the vertex indices.
 void write_grid(const std::filesystem::path& path, const Eigen::Ref<const MatX3d>& points,
                 Eigen::Index num_cells, int corners, int cell_type, const auto& cell,
-                std::span<const PointDataArray> point_data, const PointDataArray* extra) {
-  std::string out;
-  out.reserve(static_cast<size_t>(points.rows() * 64 + num_cells * 32));
+                std::span<const PointDataArray> point_data, const PointDataArray* extra,
+                const VtuOptions& options) {
+  check_point_data(path, options.cell_data, num_cells, {}, "cell-data");
+  const bool binary = options.encoding == VtuEncoding::Binary;
+  std::string out, appended;
+  std::string* app = binary ? &appended : nullptr;
+  out.reserve(static_cast<size_t>(binary ? 4096 : points.rows() * 64 + num_cells * 32));
+  if (binary) appended.reserve(static_cast<size_t>(points.rows() * 32 + num_cells * 48));
   out += "<?xml version=\"1.0\"?>\n";
-  out += "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n";
+  out += "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\"";
+  out += binary ? " header_type=\"UInt64\">\n" : ">\n";
   out += "  <UnstructuredGrid>\n";
   out += "    <Piece NumberOfPoints=\"" + std::to_string(points.rows()) + "\" NumberOfCells=\"" +
          std::to_string(num_cells) + "\">\n";
   if (!point_data.empty() || extra) {
     out += "      <PointData>\n";
-    if (extra)
-      append_double_array(out, " Name=\"" + detail::xml_escape(extra->name) + "\"", extra->values);
-    for (const PointDataArray& a : point_data)
-      append_double_array(out, " Name=\"" + detail::xml_escape(a.name) + "\"", a.values);
+    if (extra) append_double_array(out, app, extra->name, extra->values);
+    for (const PointDataArray& a : point_data) append_double_array(out, app, a.name, a.values);
     out += "      </PointData>\n";
   }
+  if (!options.cell_data.empty()) {
+    out += "      <CellData>\n";
+    for (const PointDataArray& a : options.cell_data)
+      append_double_array(out, app, a.name, a.values);
+    out += "      </CellData>\n";
+  }
   out += "      <Points>\n";
-  append_double_array(out, " Name=\"Points\"", points);
+  append_double_array(out, app, "Points", points);
   out += "      </Points>\n      <Cells>\n";
-  append_array(
-      out, "type=\"Int64\" Name=\"connectivity\"",
+  append_array<int64_t>(
+      out, app, "type=\"Int64\" Name=\"connectivity\"",
       [&](Eigen::Index i, Eigen::Index c) { return static_cast<int64_t>(cell(i, c)); }, num_cells,
       corners);
-  append_array(
-      out, "type=\"Int64\" Name=\"offsets\"",
+  append_array<int64_t>(
+      out, app, "type=\"Int64\" Name=\"offsets\"",
       [&](Eigen::Index i, Eigen::Index) { return static_cast<int64_t>(corners * (i + 1)); },
       num_cells, 1);
-  append_array(
-      out, "type=\"UInt8\" Name=\"types\"",
+  append_array<uint8_t>(
+      out, app, "type=\"UInt8\" Name=\"types\"",
       [&](Eigen::Index, Eigen::Index) { return static_cast<int64_t>(cell_type); }, num_cells, 1);
-  out += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  out += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n";
+  if (binary) {
+    // "_" starts the data; the newline after it is part of the format as
+    // readers expect it (meshio strips the last one).
+    out += "  <AppendedData encoding=\"raw\">\n   _";
+    out += appended;
+    out += "\n  </AppendedData>\n";
+  }
+  out += "</VTKFile>\n";
   write_file_atomically(path, out);
 }
 
 }  // namespace
 
 void write_vtu_tet_mesh(const std::filesystem::path& path, const TetMesh& mesh,
-                        std::span<const PointDataArray> point_data) {
+                        std::span<const PointDataArray> point_data, const VtuOptions& options) {
   check_finite(path, mesh.V, "vertex");
   check_indices(path, mesh.T, mesh.V.rows(), "tet");
   check_point_data(path, point_data, mesh.V.rows(), {});
   write_grid(
       path, mesh.V, mesh.T.rows(), 4, kVtkTetra,
-      [&](Eigen::Index i, Eigen::Index c) { return mesh.T(i, c); }, point_data, nullptr);
+      [&](Eigen::Index i, Eigen::Index c) { return mesh.T(i, c); }, point_data, nullptr, options);
 }
 
 void write_vtu_surface_mesh(const std::filesystem::path& path, const SurfaceMesh& mesh,
-                            std::span<const PointDataArray> point_data) {
+                            std::span<const PointDataArray> point_data,
+                            const VtuOptions& options) {
   check_finite(path, mesh.V, "vertex");
   check_indices(path, mesh.F, mesh.V.rows(), "face");
   check_point_data(path, point_data, mesh.V.rows(), {});
   write_grid(
       path, mesh.V, mesh.F.rows(), 3, kVtkTriangle,
-      [&](Eigen::Index i, Eigen::Index c) { return mesh.F(i, c); }, point_data, nullptr);
+      [&](Eigen::Index i, Eigen::Index c) { return mesh.F(i, c); }, point_data, nullptr, options);
 }
 
 void write_vtu_sphere_set(const std::filesystem::path& path, const SphereSet& spheres,
-                          std::span<const PointDataArray> point_data) {
+                          std::span<const PointDataArray> point_data,
+                          const VtuOptions& options) {
   const Eigen::Index n = spheres.centers.rows();
   if (spheres.radii.size() != n)
     fail(path, "sphere set has " + std::to_string(n) + " centres but " +
@@ -150,9 +191,21 @@ void write_vtu_sphere_set(const std::filesystem::path& path, const SphereSet& sp
                      "; radii must be finite and >= 0");
   check_point_data(path, point_data, n, {"radius"});
   const PointDataArray radius{"radius", spheres.radii};
+  if (n == 0) {
+    // No spheres: one poly-vertex cell of no points. A grid of no cells is
+    // valid VTK, but readers such as meshio 5 fail on it (IndexError); an
+    // empty poly-vertex is a valid empty cell that ParaView and meshio accept.
+    // Written as ASCII: meshio 5 misreads empty arrays in appended binary.
+    VtuOptions ascii = options;
+    ascii.encoding = VtuEncoding::Ascii;
+    write_grid(
+        path, spheres.centers, 1, 0, kVtkPolyVertex, [](Eigen::Index, Eigen::Index) { return 0; },
+        point_data, &radius, ascii);
+    return;
+  }
   write_grid(
       path, spheres.centers, n, 1, kVtkVertex, [](Eigen::Index i, Eigen::Index) { return i; },
-      point_data, &radius);
+      point_data, &radius, options);
 }
 
 void write_pvd(const std::filesystem::path& path, std::span<const PvdEntry> entries) {
@@ -164,9 +217,10 @@ void write_pvd(const std::filesystem::path& path, std::span<const PvdEntry> entr
     if (!std::isfinite(e.time))
       fail(path, "PVD entry " + std::to_string(i) + " has a non-finite time");
     if (e.file.empty()) fail(path, "PVD entry " + std::to_string(i) + " has an empty file name");
+    if (e.part < 0) fail(path, "PVD entry " + std::to_string(i) + " has a negative part");
     out += "    <DataSet timestep=\"";
     detail::append_number(out, e.time);
-    out += "\" group=\"\" part=\"0\" file=\"" + detail::xml_escape(e.file) + "\"/>\n";
+    out += "\" group=\"\" part=\"" + std::to_string(e.part) + "\" file=\"" + detail::xml_escape(e.file) + "\"/>\n";
   }
   out += "  </Collection>\n</VTKFile>\n";
   write_file_atomically(path, out);
