@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
     opt.cache_dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
     opt.tool_dir = std::filesystem::canonical("/proc/self/exe").parent_path();
     opt.frames = frames;
+    opt.scene_file = scene_path;
     icd::runner::run_scene(scene, opt);
     std::printf("results: %s (frames.csv; vtu/*.pvd for ParaView)\n",
                 std::filesystem::absolute(out).c_str());

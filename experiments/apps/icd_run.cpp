@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
     opt.cache_dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
     opt.tool_dir = std::filesystem::canonical("/proc/self/exe").parent_path();
     opt.frames = frames;
+    opt.scene_file = scene_path;
     opt.target_fps = target_fps;
     opt.progress = !quiet;
     icd::runner::run_scene(scene, opt);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <fstream>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -12,6 +13,7 @@
 #include <thread>
 
 #include "experiments/runner/object_asset.hpp"
+#include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/io/vtk_writer.hpp>
@@ -34,28 +36,71 @@ std::vector<std::string> object_file_names(const World& world) {
   return names;
 }
 
+VtuOptions binary_at(double time) {
+  VtuOptions o;
+  o.encoding = VtuEncoding::Binary;
+  o.time = time;
+  return o;
+}
+
+// Velocities of the coarse nodes: the FEM state of a deformable object, the
+// motion over the frame (positions before it, `before`) of any other.
+MatX3d node_velocities(const coupling::RuntimeObject& o, const MatX3d& before, double dt) {
+  if (o.sim) return o.sim->velocities();
+  if (before.rows() == o.positions.rows() && dt > 0) return (o.positions - before) / dt;
+  return MatX3d::Zero(o.positions.rows(), 3);
+}
+
+// Volume of each tet now over its rest volume (< 0: inverted).
+Eigen::MatrixXd volume_ratios(const MatX3d& x, const MatX3d& rest, const MatX4i& T) {
+  Eigen::MatrixXd r(T.rows(), 1);
+  const auto vol6 = [&](const MatX3d& p, Eigen::Index t) {
+    const Eigen::Vector3d a = p.row(T(t, 0)), b = p.row(T(t, 1)), c = p.row(T(t, 2)),
+                          d = p.row(T(t, 3));
+    return (b - a).cross(c - a).dot(d - a);
+  };
+  for (Eigen::Index t = 0; t < T.rows(); ++t) {
+    const double v0 = vol6(rest, t);
+    r(t, 0) = v0 != 0 ? vol6(x, t) / v0 : 0.0;
+  }
+  return r;
+}
+
+// Writes one output frame into `dir` and lists its files in `pvd` (one part
+// per object mesh and per pair side, in the order of output_parts).
 void write_frame_vtu(World& world, const Scene& scene, int frame, const std::filesystem::path& dir,
                      const std::vector<std::string>& file_names,
-                     std::vector<std::vector<PvdEntry>>& series) {
-  const double t = frame / scene.world.frame_rate;
+                     const std::vector<MatX3d>& before, std::vector<PvdEntry>& pvd) {
+  const double t = (frame + 1) / scene.world.frame_rate;  // the state at the end of the frame
+  const double dt = 1.0 / scene.world.frame_rate;
   auto& objects = world.objects();
-  size_t s = 0;
+  int part = 0;
   char suffix[32];
   std::snprintf(suffix, sizeof suffix, "_%06d.vtu", frame);
+  const VtuOptions bin = binary_at(t);
   for (size_t k = 0; k < objects.size(); ++k) {
     coupling::RuntimeObject& o = objects[k];
     TetMesh coarse = o.asset.coarse;
     coarse.V = o.positions;
+    const Eigen::Index n = o.positions.rows();
+    const MatX3d zero = MatX3d::Zero(n, 3);
+    const std::vector<PointDataArray> pd = {
+        {"displacement", o.positions - o.rest},
+        {"velocity", node_velocities(o, before[k], dt)},
+        {"contact_force", o.contact_forces.rows() == n ? MatX3d(o.contact_forces) : zero},
+        {"external_force", o.external_forces.rows() == n ? MatX3d(o.external_forces) : zero}};
+    VtuOptions copt = bin;
+    copt.cell_data = {{"volume_ratio", volume_ratios(o.positions, o.rest, coarse.T)}};
     const std::string cname = file_names[k] + "_coarse" + suffix;
-    write_vtu_tet_mesh(dir / cname, coarse);
-    series[s++].push_back({t, cname});
+    write_vtu_tet_mesh(dir / cname, coarse, pd, copt);
+    pvd.push_back({t, cname, part++});
     if (o.plan.dense_update && scene.output.dense) {
       SurfaceMesh dense{o.dense, o.asset.dense.F};
       const std::string dname = file_names[k] + "_dense" + suffix;
-      write_vtu_surface_mesh(dir / dname, dense);
-      series[s].push_back({t, dname});
+      const std::vector<PointDataArray> dpd = {{"displacement", o.dense - o.asset.dense.V}};
+      write_vtu_surface_mesh(dir / dname, dense, dpd, bin);
+      pvd.push_back({t, dname, part++});
     }
-    ++s;
   }
   if (scene.output.spheres && !world.plan().pairs.empty()) {
     // The spheres used for the contact response: colliding and untested pairs.
@@ -64,11 +109,34 @@ void write_frame_vtu(World& world, const Scene& scene, int frame, const std::fil
       for (int side = 0; side < 2; ++side) {
         const std::string name =
             file_names[side ? j : i] + "_contact_spheres_pair" + std::to_string(p) + suffix;
-        write_contact_spheres(world, p, side, dir / name);
-        series[s].push_back({t, name});
-        ++s;
+        write_contact_spheres(world, p, side, dir / name, bin);
+        pvd.push_back({t, name, part++});
       }
     }
+  }
+}
+
+// Writes each object's whole sphere tree as placed at the start (a sphere set
+// with point arrays "level" and "leaf"), <name>_tree.vtu: the levels people
+// look at (scripts/plot_run.py, ParaView's Threshold on "level").
+void write_trees(World& world, const std::filesystem::path& dir,
+                 const std::vector<std::string>& file_names) {
+  for (size_t k = 0; k < world.objects().size(); ++k) {
+    const collision::SphereTree& tree = world.objects()[k].asset.spheres;
+    const auto n = static_cast<Eigen::Index>(tree.spheres.size());
+    if (n == 0) continue;
+    SphereSet set{MatX3d(n, 3), Eigen::VectorXd(n)};
+    PointDataArray level{"level", Eigen::MatrixXd(n, 1)};
+    PointDataArray leaf{"leaf", Eigen::MatrixXd(n, 1)};
+    for (Eigen::Index s = 0; s < n; ++s) {
+      const collision::Sphere& sp = tree.spheres[static_cast<size_t>(s)];
+      set.centers.row(s) << sp.x, sp.y, sp.z;
+      set.radii[s] = sp.r;
+      level.values(s, 0) = tree.level[static_cast<size_t>(s)];
+      leaf.values(s, 0) = tree.is_leaf(static_cast<int>(s)) ? 1.0 : 0.0;
+    }
+    const PointDataArray arrays[] = {level, leaf};
+    write_vtu_sphere_set(dir / (file_names[k] + "_tree.vtu"), set, arrays, binary_at(0.0));
   }
 }
 
@@ -199,7 +267,8 @@ std::string file_name_from(const std::string& name) {
   return out;
 }
 
-void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path) {
+void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path,
+                           const VtuOptions& options) {
   const auto [i, j] = world.plan().pairs[pair];
   const collision::CollisionResult& r = world.results()[pair];
   const collision::SphereTree& tree = world.objects()[side ? j : i].asset.spheres;
@@ -222,7 +291,7 @@ void write_contact_spheres(World& world, size_t pair, int side, const std::files
     colliding.values(k, 0) = leaf[static_cast<size_t>(k)];
   }
   const PointDataArray arrays[] = {level, colliding};
-  write_vtu_sphere_set(path, set, arrays);
+  write_vtu_sphere_set(path, set, arrays, options);
 }
 
 std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
@@ -256,6 +325,16 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   std::filesystem::create_directories(opt.out_dir);
   // Remove a previous run's results first: nothing stale that looks complete.
   std::filesystem::remove(opt.out_dir / "frames.csv");
+  std::filesystem::remove(opt.out_dir / "scene.json");
+  std::filesystem::remove(opt.out_dir / "version.txt");
+  std::string scene_text;  // read first: a missing scene file fails before the run
+  if (!opt.scene_file.empty()) {
+    std::ifstream in(opt.scene_file, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (!in) throw InputError(opt.scene_file.string() + ": cannot read the scene file to copy it");
+    scene_text = text.str();
+  }
   const std::filesystem::path vtu_dir = opt.out_dir / "vtu";
   const std::filesystem::path vtu_tmp = opt.out_dir / "vtu.part";
   std::filesystem::remove_all(vtu_dir);
@@ -266,10 +345,11 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   const bool tty = opt.progress && isatty(fileno(stderr));
   std::vector<FrameMetrics> frames;
   frames.reserve(scene.frames);
-  std::vector<std::vector<PvdEntry>> series;
+  std::vector<PvdEntry> pvd;
+  std::vector<MatX3d> before(world.objects().size());  // non-FEM objects' positions before a frame
   if (scene.output.vtu_every > 0) {
     std::filesystem::create_directories(vtu_tmp);
-    series.resize(world.objects().size() * 2 + world.plan().pairs.size() * 2);
+    write_trees(world, vtu_tmp, file_names);
   }
   const auto start = std::chrono::steady_clock::now();
   // Real-time mode: frame f is due at start + (f + 1) / target_fps. Collision
@@ -281,10 +361,15 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   int missed = 0;
   for (int f = 0; f < scene.frames; ++f) {
     deadline += period;
+    const bool write_vtu =
+        scene.output.vtu_every > 0 && (f % scene.output.vtu_every == 0 || f + 1 == scene.frames);
+    if (write_vtu)
+      for (size_t k = 0; k < before.size(); ++k)
+        if (!world.objects()[k].sim) before[k] = world.objects()[k].positions;
     FrameMetrics m = world.step();
-    if (scene.output.vtu_every > 0 && (f % scene.output.vtu_every == 0 || f + 1 == scene.frames)) {
+    if (write_vtu) {
       const auto t0 = std::chrono::steady_clock::now();
-      write_frame_vtu(world, scene, f, vtu_tmp, file_names, series);
+      write_frame_vtu(world, scene, f, vtu_tmp, file_names, before, pvd);
       m.times.output = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     if (scene.world.target_fps > 0) {
@@ -369,13 +454,14 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
         scene.world.target_fps, scene.frames / el, missed, scene.frames);
   }
   if (scene.output.csv) write_file_atomically(opt.out_dir / "frames.csv", metrics_csv(frames));
+  if (!opt.scene_file.empty()) write_file_atomically(opt.out_dir / "scene.json", scene_text);
+  write_file_atomically(opt.out_dir / "version.txt",
+                        std::string("icd ") + ICD_VERSION_STRING + "\nscene: " +
+                            (opt.scene_file.empty() ? scene.name : opt.scene_file.string()) + "\n");
   if (scene.output.vtu_every > 0) {
-    for (size_t s = 0; s < series.size(); ++s) {
-      if (series[s].empty()) continue;
-      const std::string stem = series[s].front().file.substr(
-          0, series[s].front().file.size() - std::string("_000000.vtu").size());
-      write_pvd(vtu_tmp / (stem + ".pvd"), series[s]);
-    }
+    // One collection for the whole run: every part (coarse and dense meshes,
+    // contact spheres of each pair side) at every written frame.
+    write_pvd(vtu_tmp / "run.pvd", pvd);
     std::filesystem::rename(vtu_tmp, vtu_dir);
   }
   return frames;

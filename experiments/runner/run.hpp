@@ -8,6 +8,7 @@
 #include <string>
 
 #include <icd/coupling/world.hpp>
+#include <icd/mesh/io/vtk_types.hpp>
 
 #include "experiments/runner/child_process.hpp"
 #include "experiments/runner/scene.hpp"
@@ -64,10 +65,20 @@ struct RunOptions {
   bool progress = true;             ///< progress bar on stderr
   int summary_ranges = 4;           ///< summary lines (frame ranges) printed at the end
   std::FILE* log = stdout;          ///< where summaries go (nullptr = silent)
+  /// The scene file run, copied as <out_dir>/scene.json beside version.txt
+  /// (empty: no copy), so a results folder records what made it.
+  std::filesystem::path scene_file;
 };
 
-/// Runs the scene and writes `<out_dir>/frames.csv` (and the VTU/PVD series
-/// if asked; their file names are file_name_from(object name), made unique).
+/// Runs the scene and writes `<out_dir>/frames.csv`, `version.txt` (the
+/// program version) and a copy of options.scene_file as `scene.json`, and if
+/// asked the VTU series in `<out_dir>/vtu/`: per written frame, the coarse
+/// meshes (binary VTU; point data displacement, velocity, contact_force,
+/// external_force; cell data volume_ratio), the dense meshes (displacement)
+/// and each pair side's contact spheres (radius, level, colliding_leaf), all
+/// listed as parts of one collection, run.pvd; and each object's whole sphere
+/// tree at the start, <name>_tree.vtu (radius, level, leaf). File names are
+/// file_name_from(object name), made unique.
 /// Files are written under temporary names and renamed at the end, so an
 /// interrupted run leaves no complete-looking output. Returns the metrics of
 /// every frame. Throws ParameterError for a frame count below 1 (as the scene
@@ -80,7 +91,9 @@ std::vector<FrameMetrics> run_scene(const Scene& scene, const RunOptions& option
 /// pairs' spheres and the untested pairs' spheres (paper 4.3, Fig. 9), with
 /// point arrays "level" (tree level) and "colliding_leaf" (1: from a
 /// colliding leaf pair, 0: from an untested pair).
-void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path);
+/// `options` picks the encoding (ASCII by default, which read_vtu reads).
+void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path,
+                           const VtuOptions& options = {});
 
 /// The per-frame CSV (header + one row per frame).
 std::string metrics_csv(const std::vector<FrameMetrics>& frames);
