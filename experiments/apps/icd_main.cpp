@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
     opt.frames = frames;
     opt.scene_file = scene_path;
     icd::runner::run_scene(scene, opt);
-    std::printf("results: %s (frames.csv; vtu/*.pvd for ParaView)\n",
+    std::printf("results: %s (frames.csv, scene.json, version.txt; vtu/run.pvd for ParaView)\n",
                 std::filesystem::absolute(out).c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "icd-main: %s\n", e.what());

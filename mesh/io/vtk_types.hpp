@@ -1,5 +1,6 @@
 #pragma once
 /// Data exchanged with the VTK writers and readers besides the meshes.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct VtuOptions {
   VtuEncoding encoding = VtuEncoding::Ascii;
   /// Per-cell arrays (#cells rows each, >= 1 column), written as CellData.
   std::vector<PointDataArray> cell_data;
+  /// Simulated time (s) of the data, written as the field array "TimeValue"
+  /// that VTK's readers use as the time of a file series; NaN: none.
+  double time = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A set of spheres: centres (#S x 3, model units) and radii (#S, >= 0).

@@ -1,10 +1,12 @@
 #include <icd/mesh/io/vtk_writer.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <icd/mesh/io/atomic_write.hpp>
 #include <icd/mesh/io/detail/number_format.hpp>
@@ -59,22 +61,62 @@ void check_point_data(const std::filesystem::path& path, std::span<const PointDa
 
 // One DataArray: its XML attributes (type, Name, NumberOfComponents) and its
 // values, value(i, c) for i < rows, c < cols, converted to T when binary.
+// Binary arrays: each block (UInt64 byte count + values) is kept apart and
+// its DataArray gets a placeholder offset, filled in by place_blocks.
+using Blocks = std::vector<std::string>;
+
+std::string offset_placeholder(size_t k) { return "@ICD_OFFSET_" + std::to_string(k) + "@"; }
+
+// The order of the blocks in the appended data, and their offsets. meshio 5
+// converts raw appended data to base64 array by array, in data order, and
+// finds each array by its original offset among attributes it already
+// rewrote to base64 offsets: if a rewritten offset equals a later array's
+// original offset, it reads the wrong array. Any order is valid VTK, so pick
+// the first (identity first) without such a collision.
+std::vector<uint64_t> place_blocks(const Blocks& blocks, std::vector<size_t>& order) {
+  order.resize(blocks.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::vector<uint64_t> offset(blocks.size());
+  do {
+    uint64_t raw = 0, b64 = 0;
+    std::vector<uint64_t> rewritten;
+    bool clash = false;
+    for (const size_t k : order) {
+      offset[k] = raw;
+      for (const uint64_t r : rewritten) clash |= r == raw;
+      rewritten.push_back(b64);
+      raw += blocks[k].size();
+      b64 += 4 * ((blocks[k].size() + 2) / 3);
+    }
+    if (!clash) return offset;
+  } while (std::next_permutation(order.begin(), order.end()));
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;  // none found (never seen): identity
+  uint64_t raw = 0;
+  for (size_t k = 0; k < order.size(); ++k) offset[k] = raw, raw += blocks[k].size();
+  return offset;
+}
+
+// One DataArray: its XML attributes (type, Name, NumberOfComponents) and its
+// values, value(i, c) for i < rows, c < cols, converted to T when binary.
 template <class T, class Value>
-void append_array(std::string& out, std::string* appended, const std::string& attrs,
+void append_array(std::string& out, Blocks* blocks, const std::string& attrs,
                   const Value& value, Eigen::Index rows, Eigen::Index cols) {
-  if (appended) {
+  if (blocks) {
     // Raw appended block: UInt64 byte count, then the values, little-endian
     // (the only byte order of the machines we build on; checked below).
     static_assert(std::endian::native == std::endian::little);
     out += "        <DataArray " + attrs + " format=\"appended\" offset=\"" +
-           std::to_string(appended->size()) + "\"/>\n";
+           offset_placeholder(blocks->size()) + "\"/>\n";
+    std::string b;
     const uint64_t bytes = static_cast<uint64_t>(rows * cols) * sizeof(T);
-    appended->append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
+    b.reserve(sizeof bytes + bytes);
+    b.append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
     for (Eigen::Index i = 0; i < rows; ++i)
       for (Eigen::Index c = 0; c < cols; ++c) {
         const T v = static_cast<T>(value(i, c));
-        appended->append(reinterpret_cast<const char*>(&v), sizeof v);
+        b.append(reinterpret_cast<const char*>(&v), sizeof v);
       }
+    blocks->push_back(std::move(b));
     return;
   }
   out += "        <DataArray " + attrs + " format=\"ascii\">\n";
@@ -89,7 +131,7 @@ void append_array(std::string& out, std::string* appended, const std::string& at
   out += "        </DataArray>\n";
 }
 
-void append_double_array(std::string& out, std::string* appended, const std::string& name,
+void append_double_array(std::string& out, Blocks* appended, const std::string& name,
                          const Eigen::Ref<const Eigen::MatrixXd>& values) {
   const std::string attrs = "type=\"Float64\" Name=\"" + detail::xml_escape(name) +
                             "\" NumberOfComponents=\"" + std::to_string(values.cols()) + "\"";
@@ -106,14 +148,21 @@ void write_grid(const std::filesystem::path& path, const Eigen::Ref<const MatX3d
                 const VtuOptions& options) {
   check_point_data(path, options.cell_data, num_cells, {}, "cell-data");
   const bool binary = options.encoding == VtuEncoding::Binary;
-  std::string out, appended;
-  std::string* app = binary ? &appended : nullptr;
+  std::string out;
+  Blocks blocks;
+  Blocks* app = binary ? &blocks : nullptr;
   out.reserve(static_cast<size_t>(binary ? 4096 : points.rows() * 64 + num_cells * 32));
-  if (binary) appended.reserve(static_cast<size_t>(points.rows() * 32 + num_cells * 48));
   out += "<?xml version=\"1.0\"?>\n";
   out += "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\"";
   out += binary ? " header_type=\"UInt64\">\n" : ">\n";
   out += "  <UnstructuredGrid>\n";
+  if (!std::isnan(options.time)) {
+    if (!std::isfinite(options.time)) fail(path, "the time (TimeValue) is infinite");
+    out += "    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" "
+           "NumberOfTuples=\"1\" format=\"ascii\">";
+    detail::append_number(out, options.time);
+    out += "</DataArray>\n    </FieldData>\n";
+  }
   out += "    <Piece NumberOfPoints=\"" + std::to_string(points.rows()) + "\" NumberOfCells=\"" +
          std::to_string(num_cells) + "\">\n";
   if (!point_data.empty() || extra) {
@@ -146,8 +195,14 @@ void write_grid(const std::filesystem::path& path, const Eigen::Ref<const MatX3d
   if (binary) {
     // "_" starts the data; the newline after it is part of the format as
     // readers expect it (meshio strips the last one).
+    std::vector<size_t> order;
+    const std::vector<uint64_t> offset = place_blocks(blocks, order);
+    for (size_t k = 0; k < blocks.size(); ++k) {
+      const std::string key = " offset=\"" + offset_placeholder(k) + "\"";
+      out.replace(out.find(key), key.size(), " offset=\"" + std::to_string(offset[k]) + "\"");
+    }
     out += "  <AppendedData encoding=\"raw\">\n   _";
-    out += appended;
+    for (const size_t k : order) out += blocks[k];
     out += "\n  </AppendedData>\n";
   }
   out += "</VTKFile>\n";

@@ -244,14 +244,29 @@ TEST(VtkIo, MeshioReadsBinaryFilesAndCellData) {
   const SphereSet spheres = random_spheres(23);
   write_vtu_sphere_set(dir / "spheres.vtu", spheres,
                        std::vector<PointDataArray>{{"level", random_matrix(23, 1, 7)}}, plain_bin);
+  // 570 spheres with two arrays: in data order, meshio 5's base64 offset of
+  // an array equals a later array's raw offset (it then read the wrong one).
+  const SphereSet tree = random_spheres(570);
+  const std::vector<PointDataArray> tree_arrays = {{"level", random_matrix(570, 1, 8)},
+                                                   {"leaf", random_matrix(570, 1, 9)}};
+  write_vtu_sphere_set(dir / "tree.vtu", tree, tree_arrays, plain_bin);
   const SphereSet none{MatX3d(0, 3), Eigen::VectorXd(0)};
   write_vtu_sphere_set(dir / "empty.vtu", none,
                        std::vector<PointDataArray>{{"level", Eigen::MatrixXd(0, 1)}}, plain_bin);
   write_vtu_sphere_set(dir / "empty_ascii.vtu", none);
 
   auto views = read_with_meshio({dir / "tets.vtu", dir / "tets_ascii.vtu", dir / "torus.vtu",
-                                 dir / "spheres.vtu", dir / "empty.vtu", dir / "empty_ascii.vtu"});
-  ASSERT_EQ(views.size(), 6u);
+                                 dir / "spheres.vtu", dir / "empty.vtu", dir / "empty_ascii.vtu",
+                                 dir / "tree.vtu"});
+  ASSERT_EQ(views.size(), 7u);
+  const MeshioView& tr = views[(dir / "tree.vtu").string()];
+  EXPECT_EQ(tr.points, row_major(tree.centers));
+  ASSERT_TRUE(tr.cells.count("vertex"));
+  EXPECT_EQ(tr.cells.at("vertex").size(), 570u);
+  for (const PointDataArray& a : tree_arrays) {
+    ASSERT_TRUE(tr.point_data.count(a.name)) << a.name;
+    EXPECT_EQ(tr.point_data.at(a.name).second, row_major(a.values)) << a.name;
+  }
   for (const char* name : {"tets.vtu", "tets_ascii.vtu"}) {
     SCOPED_TRACE(name);
     const MeshioView& t = views[(dir / name).string()];
