@@ -102,6 +102,38 @@ def surface_triangles(mesh):
     return np.zeros((0, 3), dtype=int)
 
 
+def cluster(points, tris, max_faces):
+    """Vertex-clustering decimation: vertices binned on a grid over the
+    first frame's bounding box, refined until at most max_faces triangles
+    remain that join three different bins. Returns (bin of each vertex,
+    triangles over bins); cluster_points gives the bins' positions."""
+    if len(tris) <= max_faces:
+        return np.arange(len(points)), tris
+    lo, hi = points.min(0), points.max(0)
+    best = None
+    for cells in (96, 80, 64, 48, 40, 32, 24, 16, 12, 8):
+        q = np.floor((points - lo) / ((hi - lo).max() / cells + 1e-30)).astype(np.int64)
+        _, label = np.unique(q, axis=0, return_inverse=True)
+        label = label.ravel()
+        t = label[tris]
+        t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 0] != t[:, 2])]
+        _, keep = np.unique(np.sort(t, axis=1), axis=0, return_index=True)
+        best = (label, t[np.sort(keep)])
+        if len(best[1]) <= max_faces:
+            break
+    return best
+
+
+def cluster_points(points, label, tris):
+    """Positions of the bins (mean of their vertices), as cluster() made them."""
+    if len(label) == len(points) and label.max() + 1 == len(points) and tris.max() < len(points) \
+            and np.array_equal(label, np.arange(len(points))):
+        return points
+    n = label.max() + 1
+    count = np.bincount(label, minlength=n)[:, None]
+    return np.stack([np.bincount(label, points[:, k], minlength=n) for k in range(3)], 1) / count
+
+
 def shade(points, tris, colour):
     """Face colours: the object's colour lit from a fixed direction."""
     a, b, c = points[tris[:, 0]], points[tris[:, 1]], points[tris[:, 2]]
@@ -116,14 +148,11 @@ def shade(points, tris, colour):
 def animation(run, series, out, max_faces, fps):
     names = object_names(series[0][1])
     first = {}
-    for name in names:  # which mesh to draw, and a fixed face subset (decimation)
+    for name in names:  # which mesh to draw, and its decimation
         lab = name + "_dense" if name + "_dense" in series[0][1] else name + "_coarse"
         m = read_mesh(series[0][1][lab])
         tris = surface_triangles(m)
-        rng = np.random.default_rng(0)
-        keep = np.sort(rng.choice(len(tris), max_faces, replace=False)) if len(tris) > max_faces \
-            else np.arange(len(tris))
-        first[name] = (lab, tris[keep], len(tris))
+        first[name] = (lab,) + cluster(m.points, tris, max_faces) + (len(tris),)
     # Fixed axes: the bounding box of every drawn frame.
     lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
     frames = []
@@ -134,15 +163,16 @@ def animation(run, series, out, max_faces, fps):
             lo, hi = np.minimum(lo, m.points.min(0)), np.maximum(hi, m.points.max(0))
         frames.append((t, meshes, spheres))
     centre, half = (lo + hi) / 2, (hi - lo).max() / 2 * 1.05
-    fig = plt.figure(figsize=(6.4, 4.8), dpi=80)
+    fig = plt.figure(figsize=(8, 6), dpi=80)
     ax = fig.add_subplot(projection="3d")
+    ax.computed_zorder = False  # the contact spheres are drawn over the meshes: always seen
     writer = PillowWriter(fps=fps)
     with writer.saving(fig, out, dpi=80):
         for t, meshes, spheres in frames:
             ax.cla()
             for k, name in enumerate(names):
-                lab, tris, total = first[name]
-                p = meshes[name].points
+                lab, label, tris, total = first[name]
+                p = cluster_points(meshes[name].points, label, tris)
                 poly = Poly3DCollection(p[tris], facecolors=shade(p, tris, COLOURS[k % 5]),
                                         edgecolors="none")
                 ax.add_collection3d(poly)
@@ -154,10 +184,10 @@ def animation(run, series, out, max_faces, fps):
                 r = np.ravel(s.point_data["radius"])
                 n_col += int(flag.sum())
                 n_unt += int((~flag).sum())
-                size = (r / half * 150) ** 2  # marker area ~ radius in axes units
+                size = (r / half * 110) ** 2  # marker area ~ radius in axes units
                 for sel, colour in ((~flag, "0.45"), (flag, "red")):
                     if sel.any():
-                        ax.scatter(*s.points[sel].T, s=size[sel], c=colour, alpha=0.5,
+                        ax.scatter(*s.points[sel].T, s=size[sel], c=colour, alpha=0.3,
                                    depthshade=False, linewidths=0)
             for i, set_lim in enumerate((ax.set_xlim, ax.set_ylim, ax.set_zlim)):
                 set_lim(centre[i] - half, centre[i] + half)
@@ -167,8 +197,7 @@ def animation(run, series, out, max_faces, fps):
                          f"{n_unt} untested", fontsize=9)
             writer.grab_frame()
     plt.close(fig)
-    drawn = ", ".join(f"{n}: {min(first[n][2], max_faces)} of {first[n][2]} faces"
-                      for n in names)
+    drawn = ", ".join(f"{n}: {len(first[n][2])} of {first[n][3]} faces" for n in names)
     return f"{len(frames)} frames ({drawn})"
 
 
@@ -257,7 +286,7 @@ def main():
     ap.add_argument("run")
     ap.add_argument("--out", help="folder of the pictures (default: RUN_DIR)")
     ap.add_argument("--max-faces", type=int, default=4000,
-                    help="faces drawn per object in the animation (a fixed random subset)")
+                    help="faces per object in the animation (vertex-clustering decimation)")
     ap.add_argument("--fps", type=float, default=6)
     a = ap.parse_args()
     out = a.out or a.run

@@ -180,14 +180,21 @@ void write_grid(const std::filesystem::path& path, const Eigen::Ref<const MatX3d
   out += "      <Points>\n";
   append_double_array(out, app, "Points", points);
   out += "      </Points>\n      <Cells>\n";
-  append_array<int64_t>(
-      out, app, "type=\"Int64\" Name=\"connectivity\"",
-      [&](Eigen::Index i, Eigen::Index c) { return static_cast<int64_t>(cell(i, c)); }, num_cells,
-      corners);
-  append_array<int64_t>(
-      out, app, "type=\"Int64\" Name=\"offsets\"",
-      [&](Eigen::Index i, Eigen::Index) { return static_cast<int64_t>(corners * (i + 1)); },
-      num_cells, 1);
+  const auto conn = [&](Eigen::Index i, Eigen::Index c) { return static_cast<int64_t>(cell(i, c)); };
+  const auto offs = [&](Eigen::Index i, Eigen::Index) {
+    return static_cast<int64_t>(corners * (i + 1));
+  };
+  // Binary: 32-bit indices when they fit (a third less than 64-bit for a
+  // triangle mesh); ASCII keeps Int64 (the asset bundles' format).
+  if (binary && static_cast<int64_t>(num_cells) * corners < INT32_MAX) {
+    append_array<int32_t>(out, app, "type=\"Int32\" Name=\"connectivity\"", conn, num_cells,
+                          corners);
+    append_array<int32_t>(out, app, "type=\"Int32\" Name=\"offsets\"", offs, num_cells, 1);
+  } else {
+    append_array<int64_t>(out, app, "type=\"Int64\" Name=\"connectivity\"", conn, num_cells,
+                          corners);
+    append_array<int64_t>(out, app, "type=\"Int64\" Name=\"offsets\"", offs, num_cells, 1);
+  }
   append_array<uint8_t>(
       out, app, "type=\"UInt8\" Name=\"types\"",
       [&](Eigen::Index, Eigen::Index) { return static_cast<int64_t>(cell_type); }, num_cells, 1);
