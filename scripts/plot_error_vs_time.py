@@ -133,6 +133,13 @@ def plot_sphere_update(path, out):
         ax.set_xlabel("time per object per frame (µs; median, bars: min-max over frames)")
     axes[2].set_xlabel("frame")
     axes[2].set_ylabel("uncovered fraction (worst object)")
+    # Fractions are >= 0: no negative axis; an all-zero panel says so.
+    for ax in (axes[0], axes[2]):
+        top = max(float(r["uncovered_fraction"]) for r in rows)
+        ax.set_ylim(0, top * 1.1 if top > 0 else 1e-3)
+        if top == 0:
+            ax.text(0.5, 0.5, "0 in every frame: every deformed vertex\ninside a leaf sphere",
+                    transform=ax.transAxes, ha="center", va="center", fontsize=8)
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -51,6 +52,7 @@ const std::map<std::string, std::map<double, PaperRow>> kPaper = {
 struct Row {
   std::string scene;
   double budget = 0;
+  bool tests = false;  // budget is a number of sphere tests (deterministic), not seconds
   int contact_frame = -1, measure_frame = -1;
   FrameMetrics at;          // metrics of the measured frame
   double fps = 0;           // frames per wall second over the contact window
@@ -63,6 +65,8 @@ int main(int argc, char** argv) {
   fs::path out = "results/table1";
   std::vector<fs::path> scenes;
   std::vector<double> budgets = {1e-4, 1e-3, 1e-2, 1e-1, 1.0};
+  std::vector<double> test_budgets;  // deterministic twin: budgets in sphere tests
+  bool time_budgets_given = false;
   int max_frames = 200, after = 3;
   double paper_scale = 1;  // our critical time x paper_scale = the paper's row we sit beside
   icd::experiments::CommandLine cli(
@@ -76,16 +80,30 @@ int main(int argc, char** argv) {
       .custom("--budgets", "a,b,...", "critical times (s)",
               [&](const std::string& v) {
                 budgets.clear();
+                time_budgets_given = true;
                 std::stringstream ss(v);
                 for (std::string t; std::getline(ss, t, ',');)
                   budgets.push_back(icd::experiments::CommandLine::parse_real(t, 0.0));
                 if (budgets.empty()) throw std::invalid_argument("needs at least one time");
+              })
+      .custom("--test-budgets", "a,b,...",
+              "budgets in sphere tests (deterministic: the same lists on any machine); alone, "
+              "they replace the default critical times",
+              [&](const std::string& v) {
+                std::stringstream ss(v);
+                for (std::string t; std::getline(ss, t, ',');)
+                  test_budgets.push_back(icd::experiments::CommandLine::parse_real(t, 1.0));
+                if (test_budgets.empty()) throw std::invalid_argument("needs at least one count");
               })
       .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1)
       .real("--paper-scale", paper_scale, "F",
             "the paper's row at critical time x F sits beside ours (default 1)", 0.0)
       .integer("--after", after, "N", "frames after first contact (default 3)", 0);
   if (const auto status = cli.parse(argc, argv)) return *status;
+  if (!test_budgets.empty() && !time_budgets_given) budgets.clear();
+  std::vector<std::pair<bool, double>> all;  // (tests?, budget)
+  for (double b : budgets) all.emplace_back(false, b);
+  for (double b : test_budgets) all.emplace_back(true, b);
   if (scenes.empty())
     for (const char* s : {"dragon_dragon", "bunny_bunny", "bunny_dragon"})
       scenes.push_back(fs::path(ICD_SOURCE_DIR) / "experiments/scenes" /
@@ -99,13 +117,15 @@ int main(int argc, char** argv) {
       scene.output = OutputSpec{};
       scene.output.csv = false;
       scene.world.target_fps = 0;
-      scene.world.collision.query.budget_tests = -1;
-      for (double budget : budgets) {
-        scene.world.collision.query.budget_seconds = budget;
+      for (const auto& [tests, budget] : all) {
+        scene.world.collision.query.budget_tests = tests ? static_cast<int64_t>(budget) : -1;
+        scene.world.collision.query.budget_seconds =
+            tests ? std::numeric_limits<double>::infinity() : budget;
         World world = make_world(scene, cache, tools);
         Row row;
         row.scene = scene.name;
         row.budget = budget;
+        row.tests = tests;
         std::vector<FrameMetrics> frames;
         for (int f = 0; f < max_frames; ++f) {
           frames.push_back(world.step());
@@ -130,8 +150,8 @@ int main(int argc, char** argv) {
           row.collision_ms = 1e3 * coll / n;
         }
         std::printf(
-            "%-14s budget %-7g contact frame %3d: PAIRLIST %6lld COLLISIONLIST %5lld fps %6.1f\n",
-            row.scene.c_str(), budget, row.contact_frame, static_cast<long long>(row.at.pair_list),
+            "%-14s budget %-7g%s contact frame %3d: PAIRLIST %6lld COLLISIONLIST %5lld fps %6.1f\n",
+            row.scene.c_str(), budget, tests ? " tests" : " s", row.contact_frame, static_cast<long long>(row.at.pair_list),
             static_cast<long long>(row.at.collision_list), row.fps);
         std::fflush(stdout);
         rows.push_back(row);
@@ -145,13 +165,13 @@ int main(int argc, char** argv) {
   std::ostringstream csv, md;
   csv << "scene,critical_time,contact_frame,measure_frame,pair_list,collision_list,fps,"
          "collision_ms,tests,interrupted,completed_level,paper_pair_list,paper_collision_list,"
-         "paper_fps\n";
-  md << "| interaction | critical time (s) | PAIRLIST ours | paper | COLLISIONLIST ours | paper | "
+         "paper_fps,budget_kind\n";
+  md << "| interaction | critical time (s) or test budget | PAIRLIST ours | paper | COLLISIONLIST ours | paper | "
         "FPS ours | paper | completed level |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     const auto ps = kPaper.find(r.scene);
     const PaperRow* p = nullptr;
-    if (ps != kPaper.end()) {
+    if (ps != kPaper.end() && !r.tests) {
       for (const auto& [t, row] : ps->second)
         if (std::abs(t - r.budget * paper_scale) <= 1e-9 * t) p = &row;
     }
@@ -160,10 +180,12 @@ int main(int argc, char** argv) {
         << ',' << r.at.tests << ',' << r.at.interrupted << ',' << r.at.completed_level << ','
         << (p ? std::to_string(p->pair_list) : "") << ','
         << (p ? std::to_string(p->collision_list) : "") << ',' << (p ? std::to_string(p->fps) : "")
-        << '\n';
+        << ',' << (r.tests ? "tests" : "seconds") << '\n';
     char fps[32];
     std::snprintf(fps, sizeof fps, "%.1f", r.fps);
-    md << "| " << r.scene << " | " << r.budget << " | " << r.at.pair_list << " | "
+    std::ostringstream budget;
+    budget << r.budget << (r.tests ? " tests" : "");
+    md << "| " << r.scene << " | " << budget.str() << " | " << r.at.pair_list << " | "
        << (p ? std::to_string(p->pair_list) : "-") << " | " << r.at.collision_list << " | "
        << (p ? std::to_string(p->collision_list) : "-") << " | " << fps << " | "
        << (p ? std::to_string(p->fps) : "-") << " | " << r.at.completed_level << " |\n";
