@@ -35,7 +35,7 @@ if [ "$build_it" = 1 ]; then
   say "building $build"
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DICD_BUILD_TESTS=OFF -DICD_BUILD_BENCHMARKS=OFF >>"$log"
-  targets="table1 fig9 contact_error deformation_error sphere_update_error stability_sweep icd-preprocess"
+  targets="table1 fig9 contact_error deformation_error sphere_update_error stability_sweep icd-preprocess icd-main"
   # Other engineers' experiment programs, when they exist in this build.
   for t in fem_error_vs_time icd_collision_accuracy sphere_tree_table; do
     if ninja -C "$build" -t targets all 2>/dev/null | grep -q "^$t:"; then targets="$targets $t"; fi
@@ -58,6 +58,10 @@ run_step() {  # name, command...: runs, records ok/failed (a failed step does no
   else status+=("| $name | FAILED (see run.log) | $(( $(date +%s) - t0 )) s |"); fi
 }
 
+# The main run and its pictures (animation, frames.csv plot, sphere-tree levels).
+if [ "$quick" = 1 ]; then main_frames=(--frames 60); else main_frames=(); fi
+run_step main "$bin/icd-main" --out "$out/main" "${main_frames[@]}"
+run_step plot_run "$py" "$root/scripts/plot_run.py" "$out/main"
 if [ "$quick" = 1 ]; then
   run_step table1 "$bin/table1" --out "$out/table1" --after 1 --budgets 1e-4,1e-2,1 --max-frames 120 \
     --scene "$scenes/bunny_dragon.json"
