@@ -221,11 +221,12 @@ def frames_plot(cols, out):
     axes[3].plot(t, 1e3 * cols["wall"], lw=1, color="k")
     axes[3].set_ylabel("ms per frame")
     axes[3].set_title("wall-clock time per frame")
-    axes[4].step(t, cols["interrupted"], where="mid", lw=1, label="interrupted queries")
-    axes[4].step(t, cols["active_pairs"], where="mid", lw=1, label="pairs in contact")
-    axes[4].set_ylabel("count per frame")
-    axes[4].legend(fontsize=7)
-    axes[4].set_title("interrupted queries")
+    axes[4].step(t, cols["interrupted"], where="mid", lw=1, color="C0")
+    axes[4].set_ylabel("interrupted queries per frame", color="C0")
+    twin = axes[4].twinx()  # own scale: contact pairs outnumber interruptions
+    twin.step(t, cols["active_pairs"], where="mid", lw=0.8, color="C1")
+    twin.set_ylabel("sphere pairs in contact", color="C1")
+    axes[4].set_title(f"interrupted queries ({int(cols['interrupted'].sum())} in the run)")
     # A query that reports no pair has completed every level (frames.csv
     # holds INT_MAX there): left blank rather than drawn at 2e9.
     level = np.where(cols["completed_level"] < 1e6, cols["completed_level"], np.nan)
