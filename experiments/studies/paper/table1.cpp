@@ -49,10 +49,24 @@ const std::map<std::string, std::map<double, PaperRow>> kPaper = {
       {1, {1387, 28, 23}}}},
 };
 
+// A message as one CSV field / one Markdown table cell.
+std::string csv_text(std::string s) {
+  for (char& c : s)
+    if (c == ',' || c == '\n' || c == '"') c = ';';
+  return s;
+}
+std::string md_text(std::string s) {
+  for (char& c : s)
+    if (c == '|' || c == '\n') c = ';';
+  return s;
+}
+
 struct Row {
   std::string scene;
   double budget = 0;
   bool tests = false;  // budget is a number of sphere tests (deterministic), not seconds
+  std::string failure;  // the simulation's error, if it failed before the measured frame
+  int failed_frame = -1;
   int contact_frame = -1, measure_frame = -1;
   FrameMetrics at;          // metrics of the measured frame
   double fps = 0;           // frames per wall second over the contact window
@@ -127,11 +141,21 @@ int main(int argc, char** argv) {
         row.budget = budget;
         row.tests = tests;
         std::vector<FrameMetrics> frames;
-        for (int f = 0; f < max_frames; ++f) {
-          frames.push_back(world.step());
-          // Contact: some sphere pair produced a force.
-          if (row.contact_frame < 0 && frames.back().active_pairs > 0) row.contact_frame = f;
-          if (row.contact_frame >= 0 && f == row.contact_frame + after) break;
+        try {
+          for (int f = 0; f < max_frames; ++f) {
+            frames.push_back(world.step());
+            // Contact: some sphere pair produced a force.
+            if (row.contact_frame < 0 && frames.back().active_pairs > 0) row.contact_frame = f;
+            if (row.contact_frame >= 0 && f == row.contact_frame + after) break;
+          }
+        } catch (const std::exception& e) {
+          // A run that fails is a result (recorded, marked), not the end of the table.
+          row.failure = e.what();
+          row.failed_frame = static_cast<int>(frames.size());
+          std::fprintf(stderr, "table1: %s at %g%s: failed in frame %d: %s\n", scene.name.c_str(),
+                       budget, tests ? " tests" : " s", row.failed_frame, e.what());
+          rows.push_back(row);
+          continue;
         }
         if (row.contact_frame < 0) {
           std::fprintf(stderr, "table1: %s at %g s: no contact within %d frames\n",
@@ -165,7 +189,7 @@ int main(int argc, char** argv) {
   std::ostringstream csv, md;
   csv << "scene,critical_time,contact_frame,measure_frame,pair_list,collision_list,fps,"
          "collision_ms,tests,interrupted,completed_level,paper_pair_list,paper_collision_list,"
-         "paper_fps,budget_kind\n";
+         "paper_fps,budget_kind,failure\n";
   md << "| interaction | critical time (s) or test budget | PAIRLIST ours | paper | COLLISIONLIST ours | paper | "
         "FPS ours | paper | completed level |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
@@ -180,11 +204,17 @@ int main(int argc, char** argv) {
         << ',' << r.at.tests << ',' << r.at.interrupted << ',' << r.at.completed_level << ','
         << (p ? std::to_string(p->pair_list) : "") << ','
         << (p ? std::to_string(p->collision_list) : "") << ',' << (p ? std::to_string(p->fps) : "")
-        << ',' << (r.tests ? "tests" : "seconds") << '\n';
+        << ',' << (r.tests ? "tests" : "seconds") << ',' << csv_text(r.failure) << '\n';
     char fps[32];
     std::snprintf(fps, sizeof fps, "%.1f", r.fps);
     std::ostringstream budget;
     budget << r.budget << (r.tests ? " tests" : "");
+    if (!r.failure.empty()) {
+      md << "| " << r.scene << " | " << budget.str() << " | FAILED in frame " << r.failed_frame
+         << " (first contact " << r.contact_frame << "): " << md_text(r.failure)
+         << " | | | | | | |\n";
+      continue;
+    }
     md << "| " << r.scene << " | " << budget.str() << " | " << r.at.pair_list << " | "
        << (p ? std::to_string(p->pair_list) : "-") << " | " << r.at.collision_list << " | "
        << (p ? std::to_string(p->collision_list) : "-") << " | " << fps << " | "
