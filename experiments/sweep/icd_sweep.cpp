@@ -93,6 +93,7 @@ int report(const Plan& plan, std::vector<CaseResult> results, const fs::path& ou
 
 /// Backend 1: the local process pool (-j N threads, each runs one child at a time).
 int run_local(const Plan& plan, const fs::path& out, int jobs, bool force, bool quiet) {
+  run_setup(plan, out);
   std::vector<std::size_t> pending;
   std::vector<CaseResult> results;
   split(plan, out, force, pending, results);
@@ -134,6 +135,7 @@ int run_mpi(const Plan& plan, const fs::path& out, bool force, bool quiet) {
       msg = run_case(plan, plan.cases.at(static_cast<std::size_t>(k)), out).to_json();
     }
   }
+  run_setup(plan, out);  // (the workers wait for their first case meanwhile)
   std::vector<std::size_t> pending;
   std::vector<CaseResult> results;
   split(plan, out, force, pending, results);
@@ -205,9 +207,20 @@ int emit_slurm(const Plan& plan, const fs::path& out, const fs::path& self, std:
   const std::string gather_script = head + "#SBATCH --job-name=icd-sweep-" + plan.name +
                                     "-gather\n#SBATCH --ntasks=1\n#SBATCH --output=" + o +
                                     "/slurm/gather-%j.log\nexec " + cmd + " --gather\n";
-  const std::string submit = "#!/bin/sh\n# Submits the case array, then the gather step after it (whatever its outcome).\nset -e\njid=$(sbatch --parsable " +
-                             shell_quote((dir / "array.sbatch").string()) + ")\nsbatch --dependency=afterany:\"${jid%%;*}\" " +
-                             shell_quote((dir / "gather.sbatch").string()) + "\n";
+  std::string submit = "#!/bin/sh\n# Submits ";
+  if (!plan.setup.empty()) {
+    const std::string setup_script = head + "#SBATCH --job-name=icd-sweep-" + plan.name +
+                                     "-setup\n#SBATCH --ntasks=1\n#SBATCH --output=" + o +
+                                     "/slurm/setup-%j.log\nexec " + cmd + " --setup\n";
+    icd::write_file_atomically(dir / "setup.sbatch", setup_script);
+    submit += "the setup step, then the case array when it succeeded, then the gather step after the array\n"
+              "# (whatever its outcome).\nset -e\nsid=$(sbatch --parsable " + shell_quote((dir / "setup.sbatch").string()) +
+              ")\njid=$(sbatch --parsable --dependency=afterok:\"${sid%%;*}\" " + shell_quote((dir / "array.sbatch").string()) + ")\n";
+  } else {
+    submit += "the case array, then the gather step after it (whatever its outcome).\nset -e\njid=$(sbatch --parsable " +
+              shell_quote((dir / "array.sbatch").string()) + ")\n";
+  }
+  submit += "sbatch --dependency=afterany:\"${jid%%;*}\" " + shell_quote((dir / "gather.sbatch").string()) + "\n";
   icd::write_file_atomically(dir / "array.sbatch", array);
   icd::write_file_atomically(dir / "gather.sbatch", gather_script);
   icd::write_file_atomically(dir / "submit.sh", submit);
@@ -232,7 +245,7 @@ int main(int argc, char** argv) {
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   long long case_k = -1;
   std::size_t chunk = 0;
-  bool gather_only = false, emit = false, list = false, force = false, quiet = false;
+  bool setup_only = false, gather_only = false, emit = false, list = false, force = false, quiet = false;
   app.set_version_flag("--version", ICD_VERSION_STRING);
   app.add_option("sweep", sweep_file, "the sweep file (JSON; see experiments/sweep/README.md)")->required();
   app.add_option("--out", out_opt, "output folder (default results/sweeps/<sweep name>)");
@@ -244,6 +257,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0LL, 1LL << 40));
   app.add_option("--chunk", chunk, "cases per --case task / Slurm array task (default 1; --emit-slurm: N/1000 rounded up)")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 30));
+  app.add_flag("--setup", setup_only, "run the sweep file's setup commands only (the Slurm setup step)");
   app.add_flag("--gather", gather_only, "gather the finished cases' results only (the Slurm gather step)");
   app.add_flag("--emit-slurm", emit, "write <out>/slurm/{array,gather}.sbatch and submit.sh, run nothing");
   app.add_flag("--list", list, "print the expanded cases (index, id, parameters), run nothing");
@@ -255,9 +269,9 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   }
-  const int modes = (case_k >= 0) + gather_only + emit + list;
+  const int modes = (case_k >= 0) + setup_only + gather_only + emit + list;
   if (modes > 1) {
-    std::fprintf(stderr, "icd-sweep: --case, --gather, --emit-slurm and --list exclude each other\n");
+    std::fprintf(stderr, "icd-sweep: --case, --setup, --gather, --emit-slurm and --list exclude each other\n");
     return 2;
   }
   const fs::path self = fs::canonical("/proc/self/exe");
@@ -285,6 +299,8 @@ int main(int argc, char** argv) {
       }
     } else if (emit) {
       status = emit_slurm(plan, out, self, chunk);
+    } else if (setup_only) {
+      run_setup(plan, out);
     } else if (gather_only) {
       status = report(plan, read_results(plan, out), out, 0);
     } else if (case_k >= 0) {

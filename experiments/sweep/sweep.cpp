@@ -152,7 +152,7 @@ void append_param_args(const ParamValue& p, const Expander& expand, std::vector<
 
 const std::set<std::string> kTopKeys = {"name",   "title",  "program", "args",
                                         "grid",   "cases",  "inputs",  "collect",
-                                        "limits", "accept_exit", "keep_outputs", "comment"};
+                                        "limits", "accept_exit", "keep_outputs", "comment", "setup"};
 
 std::string last_line(const fs::path& p) {
   std::string s;
@@ -422,7 +422,8 @@ Plan load_plan(const fs::path& sweep_file, const fs::path& bin_dir) {
     for (std::size_t i = 0; i < j["args"].size(); ++i)
       base.push_back(scalar_text(j["args"][i], field("args") + "[" + std::to_string(i) + "]"));
   }
-  if (std::find(base.begin(), base.end(), "{out}") == base.end() && j.contains("collect") &&
+  if (std::none_of(base.begin(), base.end(), [](const std::string& a) { return a.find("{out}") != std::string::npos; }) &&
+      j.contains("collect") &&
       (j["collect"].contains("csv") || j["collect"].contains("json")))
     throw InputError(field("args") + ": collecting a file needs \"{out}\" among the arguments");
 
@@ -451,6 +452,21 @@ Plan load_plan(const fs::path& sweep_file, const fs::path& bin_dir) {
   if (j.contains("keep_outputs")) {
     if (!j["keep_outputs"].is_boolean()) throw InputError(field("keep_outputs") + ": expected true or false");
     plan.keep_outputs = j["keep_outputs"].get<bool>();
+  }
+  if (j.contains("setup")) {
+    const ojson& su = j["setup"];
+    if (!su.is_array()) throw InputError(field("setup") + ": expected a list of commands [program, args...]");
+    for (std::size_t i = 0; i < su.size(); ++i) {
+      const std::string w = field("setup") + "[" + std::to_string(i) + "]";
+      if (!su[i].is_array() || su[i].empty()) throw InputError(w + ": expected [program, args...]");
+      std::vector<std::string> cmd;
+      for (std::size_t k = 0; k < su[i].size(); ++k) cmd.push_back(expand(scalar_text(su[i][k], w)));
+      if (cmd[0].empty() || cmd[0].find('/') != std::string::npos || cmd[0][0] == '.')
+        throw InputError(w + ": a program name in the build's bin/ folder (no path), got \"" + escape_bytes(cmd[0]) + "\"");
+      cmd[0] = (fs::absolute(bin_dir) / cmd[0]).string();
+      if (access(cmd[0].c_str(), X_OK) != 0) throw InputError(w + ": " + cmd[0] + " is not an executable (not built?)");
+      plan.setup.push_back(std::move(cmd));
+    }
   }
   // collect
   if (j.contains("collect")) {
@@ -572,7 +588,7 @@ Plan load_plan(const fs::path& sweep_file, const fs::path& bin_dir) {
         append_param_args(pv, expand, c.args);
       }
       std::vector<std::string> args = base;
-      for (std::string& a : args) a = a == "{out}" ? a : expand(a);
+      for (std::string& a : args) a = expand(a);  // ({out} stays: it is per run)
       args.insert(args.end(), c.args.begin(), c.args.end());
       c.args = std::move(args);
       key["inputs"] = ojson::array();
@@ -581,7 +597,7 @@ Plan load_plan(const fs::path& sweep_file, const fs::path& bin_dir) {
         std::string t = templ[i];
         const std::size_t eq = t.find('=');
         if (i > 0 && templ[i - 1] == "--set" && eq != std::string::npos) t = t.substr(eq + 1);
-        if (t == "{out}" || t.empty()) continue;
+        if (t.find("{out}") != std::string::npos || t.empty()) continue;
         const std::string h = checksum(expand(t));
         if (!h.empty()) key["inputs"].push_back({t, h});
       }
@@ -659,7 +675,7 @@ CaseResult run_case(const Plan& plan, const Case& c, const fs::path& out) {
     fs::remove_all(tmp);
     fs::create_directories(tmp / "out");
     std::vector<std::string> argv{plan.program.string()};
-    for (const std::string& a : c.args) argv.push_back(a == "{out}" ? (tmp / "out").string() : a);
+    for (const std::string& a : c.args) argv.push_back(replace_all(a, "{out}", (tmp / "out").string()));
     ojson info;
     info["id"] = c.id;
     info["index"] = c.index;
@@ -715,6 +731,29 @@ CaseResult run_case(const Plan& plan, const Case& c, const fs::path& out) {
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return r;
+}
+
+void run_setup(const Plan& plan, const fs::path& out) {
+  for (std::size_t k = 0; k < plan.setup.size(); ++k) {
+    const fs::path dir = out / "setup" / std::to_string(k);
+    std::vector<std::string> argv = plan.setup[k];
+    for (std::string& a : argv) a = replace_all(a, "{out}", (dir / "out").string());
+    ojson key = argv;
+    const std::string marker = hash_hex(key.dump());
+    std::error_code ec;
+    if (fs::is_regular_file(dir / ("done-" + marker), ec)) continue;
+    fs::remove_all(dir);
+    fs::create_directories(dir / "out");
+    const Spawned s = spawn_and_wait(argv, dir, dir / "stdout.txt", dir / "stderr.txt", plan.limits);
+    if (s.exit_status != 0) {
+      std::string l = last_line(dir / "stderr.txt");
+      if (l.empty()) l = last_line(dir / "stdout.txt");
+      throw InputError("setup command " + std::to_string(k) + " (" + fs::path(argv[0]).filename().string() +
+                       ") " + (s.timed_out ? "ran over its time limit" : s.signal ? "was killed by signal " + std::to_string(s.signal) : "exited with status " + std::to_string(s.exit_status)) +
+                       (l.empty() ? "" : ": " + l) + " (log: " + dir.string() + ")");
+    }
+    write_file_atomically(dir / ("done-" + marker), key.dump() + "\n");
+  }
 }
 
 std::vector<CaseResult> read_results(const Plan& plan, const fs::path& out) {

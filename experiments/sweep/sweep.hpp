@@ -53,7 +53,15 @@ struct Plan {
   Limits limits;
   std::vector<int> accept_exit;  ///< exit statuses counted as success (default {0})
   bool keep_outputs = true;      ///< false: the case's {out} is removed after collection
+  /// Commands run once, one after the other, before any case (e.g. filling
+  /// the asset cache, which is not safe for concurrent first use): program
+  /// paths in bin/ and their arguments ("{out}" = <out>/setup/<k>).
+  std::vector<std::vector<std::string>> setup;
 };
+
+/// Runs the plan's setup commands (skipped when they succeeded before with the
+/// same arguments). Throws icd::InputError naming the command on a failure.
+void run_setup(const Plan& plan, const std::filesystem::path& out);
 
 /// Reads and expands a sweep file. `bin_dir`: where programs are looked up.
 /// Throws icd::InputError naming the file and field on any problem.
