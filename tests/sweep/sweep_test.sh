@@ -42,11 +42,22 @@ resume)
   sed -e 's|{source_dir}/experiments/scenes/two_spheres.json|{sweep_dir}/scene_a.json|' \
       -e 's|{source_dir}/experiments/studies/paper/scenes/two_spheres_soft.json|{sweep_dir}/scene_b.json|' \
       "$eight" > sweep.json
+  # with a setup command (run once before the cases, skipped when done)
+  python3 - sweep.json <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["setup"] = [["icd-run", "{sweep_dir}/scene_a.json", "--frames", "1", "--out", "{out}", "--quiet"]]
+json.dump(d, open(sys.argv[1], "w"), indent=1)
+PY
   "$sweep" sweep.json --out o -j2 2> r1.log || fail "first run failed"
   [ "$(ran r1.log)" = 8 ] || fail "first run: expected 8 cases run, got $(ran r1.log)"
+  [ -f o/setup/0/out/frames.csv ] || fail "the setup command did not run"
+  ls o/setup/0/done-* > /dev/null || fail "the setup command left no marker"
+  touch -d '2001-01-01' o/setup/0/out/frames.csv
   cp o/results.csv first.csv
   "$sweep" sweep.json --out o -j2 2> r2.log || fail "second run failed"
   [ "$(ran r2.log)" = 0 ] || fail "re-run: expected 0 cases run, got $(ran r2.log)"
+  [ "$(stat -c %Y o/setup/0/out/frames.csv)" = "$(date -d '2001-01-01' +%s)" ] || fail "the setup ran again"
   grep -q '8 already finished' r2.log || fail "re-run does not report 8 finished cases"
   cmp first.csv o/results.csv || fail "re-run changed the CSV"
   # one case folder lost: exactly that case runs again
@@ -98,6 +109,8 @@ PY
 slurm)
   "$sweep" "$eight" --out local -j2 2> local.log || fail "local run failed"
   "$sweep" "$eight" --out "$work/slurm" --emit-slurm > emitted.txt || fail "--emit-slurm failed"
+  grep -q 'sbatch --dependency=afterany:"${jid%%;\*}" .*gather.sbatch' slurm/slurm/submit.sh || fail "submit.sh does not chain the gather step"
+  [ -e slurm/slurm/setup.sbatch ] && fail "setup.sbatch written for a sweep without setup"
   for f in array.sbatch gather.sbatch submit.sh; do
     [ -f "slurm/slurm/$f" ] || fail "$f not written"
     bash -n "slurm/slurm/$f" || fail "$f is not valid shell"
@@ -105,6 +118,11 @@ slurm)
   grep -q '^#SBATCH --array=0-7$' slurm/slurm/array.sbatch || fail "array range wrong: $(cat slurm/slurm/array.sbatch)"
   grep -q -- '--case "$SLURM_ARRAY_TASK_ID" --chunk 1' slurm/slurm/array.sbatch || fail "array task command wrong"
   grep -q -- '--gather$' slurm/slurm/gather.sbatch || fail "gather command wrong"
+  # a sweep with setup commands: a setup job first, the array after it succeeded
+  "$sweep" "$src/experiments/sweeps/table1_quick.json" --out "$work/t1" --emit-slurm > /dev/null || fail "--emit-slurm (setup) failed"
+  grep -q -- '--setup$' t1/slurm/setup.sbatch || fail "setup.sbatch missing or wrong"
+  grep -q 'dependency=afterok:' t1/slurm/submit.sh || fail "submit.sh does not wait for the setup"
+  bash -n t1/slurm/submit.sh || fail "submit.sh (setup) is not valid shell"
   # what the array tasks run: --case K, then the gather step
   for k in 0 1 2 3 4 5 6 7; do
     SLURM_ARRAY_TASK_ID=$k "$sweep" "$eight" --out slurm --case "$k" 2>> cases.log || fail "--case $k failed"
@@ -137,6 +155,18 @@ bad_input)
   "$sweep" cut.json --out o4 2> e4.log; [ $? = 1 ] || fail "truncated JSON must be refused"
   grep -q 'cut.json: not valid JSON' e4.log || fail "message: $(cat e4.log)"
   for d in o1 o2 o3 o4; do [ -e "$d" ] && fail "output folder $d written for a bad sweep file"; done
+  # the log collector: a regex group from the case's stdout (icd-run prints its frame count)
+  cat > log.json <<'JSON'
+{"name": "l", "program": "icd-run", "args": ["{source_dir}/experiments/scenes/two_spheres.json", "--out", "{out}", "--quiet"],
+ "grid": {"--frames": [1, 2]},
+ "collect": {"log": {"frames": "^scene \"two_spheres\": 2 objects, (\\d+) frames", "absent": "no such (line)"}}}
+JSON
+  "$sweep" log.json --out l -j1 2> l.log || fail "log sweep failed: $(cat l.log)"
+  python3 - "$work/l/results.csv" <<'PY' || fail "log collector wrong: $(cat l/results.csv)"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 2 and all(r["frames"] == r["--frames"] and r["absent"] == "" for r in rows), rows
+PY
   # scene fields become --set key=value (the scene-reading programs' override option)
   printf '{"name": "s", "program": "icd-run", "args": ["x.json"], "cases": [{"collision.stiffness": 3000, "_label": "a", "--quiet": true, "--dry-run": false}]}' > set.json
   "$sweep" set.json --out s -j1 2> /dev/null
