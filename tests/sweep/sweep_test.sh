@@ -105,6 +105,16 @@ PY
   # a re-run runs the failed cases again, not the finished one
   "$sweep" sweep.json --out o -j1 2> run2.log
   [ "$(ran run2.log)" = 2 ] || fail "re-run: expected the 2 failed cases to run again, got $(ran run2.log)"
+  # SIGTERM (Slurm's time limit, Ctrl-C): the running cases are killed and recorded, exit 130
+  cat > long.json <<'JSON'
+{"name": "long", "program": "icd-run", "args": ["{source_dir}/experiments/scenes/two_spheres.json", "--out", "{out}", "--quiet"],
+ "grid": {"--frames": [100000, 100001]}, "limits": {"wall_seconds": 600}}
+JSON
+  "$sweep" long.json --out long -j2 2> long.log & pid=$!
+  sleep 2; kill -TERM "$pid"; wait "$pid"; rc=$?
+  [ "$rc" = 130 ] || fail "interrupted sweep: expected exit 130, got $rc"
+  pgrep -f "$work/long/cases" > /dev/null && fail "a case process survived the interrupt"
+  [ "$(grep -c ',killed,' long/results.csv)" = 2 ] || fail "interrupted cases not recorded: $(cat long/results.csv)"
   ;;
 slurm)
   "$sweep" "$eight" --out local -j2 2> local.log || fail "local run failed"
