@@ -601,8 +601,14 @@ Plan load_plan(const fs::path& sweep_file, const fs::path& bin_dir) {
         const std::string h = checksum(expand(t));
         if (!h.empty()) key["inputs"].push_back({t, h});
       }
+      c.id = hash_hex(key.dump());
+      // The marker's key also holds what is collected and what counts as a
+      // result: a changed "collect" or "accept_exit" runs the case again
+      // (same id, same folder) instead of keeping rows of the old collection.
+      key["collect"] = j.contains("collect") ? j["collect"] : ojson();
+      key["accept_exit"] = plan.accept_exit;
+      key["keep_outputs"] = plan.keep_outputs;
       c.key = key.dump();
-      c.id = hash_hex(c.key);
       if (!ids.insert(c.id).second)
         throw InputError(where0 + ": two cases have the same parameters (case " + std::to_string(c.index) + ")");
       plan.cases.push_back(std::move(c));

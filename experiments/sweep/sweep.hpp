@@ -38,7 +38,9 @@ struct Case {
   std::size_t index = 0;  ///< position in the expanded order (for --case K)
   std::vector<std::pair<std::string, std::string>> params;
   std::vector<std::string> args;  ///< without argv[0]; "{out}" still a placeholder
-  std::string key;  ///< the full description hashed into id (stored in the marker)
+  /// What id hashes, plus the collection settings (stored in the marker;
+  /// a finished case is skipped only when its marker holds the same key).
+  std::string key;
 };
 
 /// A sweep file, expanded.

@@ -72,6 +72,17 @@ PY
   "$sweep" sweep.json --out o -j2 2> r4.log || fail "fourth run failed"
   [ "$(ran r4.log)" = 4 ] || fail "after changing one input: expected 4 cases run, got $(ran r4.log)"
   cmp -s first.csv o/results.csv && fail "CSV unchanged after changing an input"
+  # what is collected changed: every case runs again (same ids), the CSV has the new columns
+  python3 - sweep.json <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["collect"]["columns"].remove("energy")
+json.dump(d, open(sys.argv[1], "w"), indent=1)
+PY
+  "$sweep" sweep.json --out o -j2 2> r5.log || fail "fifth run failed"
+  [ "$(ran r5.log)" = 8 ] || fail "after changing the collection: expected 8 cases run, got $(ran r5.log)"
+  head -1 o/results.csv | grep -q energy && fail "the CSV still has the dropped column"
+  [ "$(tail -n +2 o/results.csv | cut -d, -f1 | sort -u | wc -l)" = 8 ] || fail "expected 8 case ids after re-collection"
   ;;
 failures)
   cat > sweep.json <<JSON
