@@ -40,3 +40,9 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/icdConfigVersion.cmake
 install(FILES ${PROJECT_BINARY_DIR}/icdConfig.cmake ${PROJECT_BINARY_DIR}/icdConfigVersion.cmake
               ${PROJECT_SOURCE_DIR}/cmake/FindCHOLMOD.cmake ${PROJECT_SOURCE_DIR}/cmake/FindMETIS.cmake
         DESTINATION ${ICD_INSTALL_CMAKEDIR})
+
+# icd-sweep (experiments/sweep/): installed beside the programs it runs (it
+# looks them up in its own folder).
+if(TARGET icd-sweep)
+  install(TARGETS icd-sweep RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
