@@ -11,7 +11,8 @@
 #   -j N        cases at once on this machine (default 2)
 #   --mpi N     run each sweep under mpirun -np N (rank 0 dispatches, N-1 workers)
 #   SWEEP       sweep names to run (default: all of the chosen set)
-# environment: ICD_BUILD_DIR (default build/release), ICD_SWEEPS_DIR (default results/sweeps)
+# environment: ICD_BUILD_DIR (default build/release), ICD_SWEEPS_DIR (default results/sweeps),
+#   ICD_MPIRUN_FLAGS (extra mpirun options split on spaces, e.g. "--oversubscribe --hostfile hosts")
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 quick=0; build_it=1; jobs=2; mpi=0; names=()
@@ -21,7 +22,7 @@ while [ $# -gt 0 ]; do
     --no-build) build_it=0 ;;
     -j) shift; jobs="${1:?-j needs a number}" ;;
     --mpi) shift; mpi="${1:?--mpi needs a number}" ;;
-    -h|--help) sed -n 2,14p "$0"; exit 0 ;;
+    -h|--help) sed -n 2,15p "$0"; exit 0 ;;
     -*) echo "run_sweeps.sh: unknown argument $1" >&2; exit 2 ;;
     *) names+=("$1") ;;
   esac
@@ -56,7 +57,8 @@ for n in "${names[@]}"; do
   t0=$(date +%s)
   echo "== $n"
   if [ "$mpi" -gt 0 ]; then
-    mpirun -np "$mpi" "$sweep" "$root/experiments/sweeps/$n.json" --out "$out/$n"; rc=$?
+    read -ra mpi_flags <<< "${ICD_MPIRUN_FLAGS:-}"
+    mpirun -np "$mpi" "${mpi_flags[@]}" "$sweep" "$root/experiments/sweeps/$n.json" --out "$out/$n"; rc=$?
   else
     "$sweep" "$root/experiments/sweeps/$n.json" --out "$out/$n" -j "$jobs"; rc=$?
   fi

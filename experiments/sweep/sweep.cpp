@@ -735,6 +735,13 @@ CaseResult run_case(const Plan& plan, const Case& c, const fs::path& out) {
     r.columns.clear();
     r.rows.clear();
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    try {  // recorded like any other failure (best effort: the folder may be what failed)
+      fs::create_directories(tmp);
+      write_file_atomically(tmp / "result.json", r.to_json());
+      fs::remove_all(final_dir);
+      fs::rename(tmp, final_dir);
+    } catch (const std::exception&) {
+    }
   }
   return r;
 }
