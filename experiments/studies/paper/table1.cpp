@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
   std::vector<double> budgets = {1e-4, 1e-3, 1e-2, 1e-1, 1.0};
   int max_frames = 200, after = 3;
   double paper_scale = 1;  // our critical time x paper_scale = the paper's row we sit beside
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "table1",
       "  Runs each scene once per critical time (default 1e-4,1e-3,1e-2,1e-1,1 s) and\n"
       "  records the list sizes N frames (--after, default 3) after first contact.\n"
@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
                 budgets.clear();
                 std::stringstream ss(v);
                 for (std::string t; std::getline(ss, t, ',');)
-                  budgets.push_back(icd::experiments::CommandLine::parse_real(t, 0.0));
+                  budgets.push_back(icd::experiments::Cli::parse_real(t, 0.0));
                 if (budgets.empty()) throw std::invalid_argument("needs at least one time");
               })
       .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1)
