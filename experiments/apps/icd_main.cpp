@@ -19,11 +19,9 @@ int main(int argc, char** argv) {
                                     "  The project's main job: the paper's bunny-dragon scene.");
   cli.path("--out", out, "DIR", "results folder (default: results/main)")
       .path("--scene", scene_path, "FILE",
-            "scene to run (default: bunny_dragon.json of experiments/scenes, or share/icd/scenes "
-            "when installed)")
+            "scene to run (default: " + scene_path.string() + ")")
       .path("--cache-dir", cache_dir, "DIR",
-            "asset cache folder (default: $ICD_CACHE_DIR, else assets/ of the source tree, or "
-            "$XDG_CACHE_HOME/icd when installed)")
+            "asset cache folder (default: " + cache_dir.string() + ", see README Programs)")
       .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
