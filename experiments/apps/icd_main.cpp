@@ -6,20 +6,22 @@
 #include <filesystem>
 #include <string>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
+#include "experiments/runner/locations.hpp"
 #include "experiments/runner/run.hpp"
-#include <icd/config.hpp>
 
 int main(int argc, char** argv) {
   std::filesystem::path out = "results/main";
-  std::filesystem::path scene_path =
-      std::filesystem::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
+  std::filesystem::path scene_path = icd::runner::scenes_dir() / "bunny_dragon.json";
+  std::filesystem::path cache_dir = icd::runner::default_cache_dir();
   int frames = -1;
-  icd::experiments::CommandLine cli("icd-main",
+  icd::experiments::Cli cli("icd-main",
                                     "  The project's main job: the paper's bunny-dragon scene.");
   cli.path("--out", out, "DIR", "results folder (default: results/main)")
       .path("--scene", scene_path, "FILE",
-            "scene to run (default: experiments/scenes/bunny_dragon.json)")
+            "scene to run (default: " + scene_path.string() + ")")
+      .path("--cache-dir", cache_dir, "DIR",
+            "asset cache folder (default: " + cache_dir.string() + ", see README Programs)")
       .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
@@ -29,8 +31,8 @@ int main(int argc, char** argv) {
       std::printf("  %s\n", line.c_str());
     icd::runner::RunOptions opt;
     opt.out_dir = out;
-    opt.cache_dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
-    opt.tool_dir = std::filesystem::canonical("/proc/self/exe").parent_path();
+    opt.cache_dir = cache_dir;
+    opt.tool_dir = icd::runner::program_dir();
     opt.frames = frames;
     opt.scene_file = scene_path;
     icd::runner::run_scene(scene, opt);

@@ -1,6 +1,6 @@
 // icd-meshinfo: reads surface meshes (OFF, OBJ, PLY, STL) or our VTU files
 // (tet mesh: statistics of its boundary; triangles; sphere set) and prints
-// their statistics. Usage: icd-meshinfo FILE... ; exit status 1 if any file failed.
+// their statistics. Usage: icd-meshinfo FILE... (--help); exit status 1 if any file failed.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <icd/mesh/core/error.hpp>
+#include "experiments/common/cli.hpp"
 #include <icd/mesh/core/mesh_stats.hpp>
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
@@ -99,30 +100,31 @@ void print_vtu(const std::string& file) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
-    std::fprintf(stderr,
-                 "usage: %s FILE...\n"
-                 "Reads triangle surface meshes (.off .obj .ply .stl) or VTU files written by icd\n"
-                 "(.vtu: tetrahedra, triangles or sphere sets) and prints their statistics.\n",
-                 argv[0]);
-    return argc < 2 ? 2 : 0;
-  }
+  std::vector<std::filesystem::path> files;
+  icd::experiments::Cli cli(
+      "icd-meshinfo",
+      "  Reads triangle surface meshes (.off .obj .ply .stl) or VTU files written by icd\n"
+      "  (.vtu: tetrahedra, triangles or sphere sets) and prints their statistics; exit\n"
+      "  status 1 if any file failed.");
+  cli.arguments("FILE", files, "mesh or VTU files", true);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   int status = 0;
-  for (int i = 1; i < argc; ++i) {
+  for (const std::filesystem::path& file : files) {
+    const std::string name = file.string();
     try {
-      std::string ext = std::filesystem::path(argv[i]).extension().string();
+      std::string ext = file.extension().string();
       std::transform(ext.begin(), ext.end(), ext.begin(),
                      [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
       if (ext == ".vtu") {
-        print_vtu(argv[i]);
+        print_vtu(name);
         continue;
       }
       icd::ReadReport report;
       const auto t0 = std::chrono::steady_clock::now();
-      const icd::SurfaceMesh mesh = icd::read_surface_mesh(argv[i], &report);
+      const icd::SurfaceMesh mesh = icd::read_surface_mesh(name, &report);
       const double ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      print_stats(argv[i], report, ms, icd::compute_surface_stats(mesh));
+      print_stats(name, report, ms, icd::compute_surface_stats(mesh));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "icd-meshinfo: %s\n", e.what());
       status = 1;

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <icd/collision/sph_io.hpp>
@@ -18,62 +19,39 @@
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
 #include <icd/mesh/pipeline/preprocess.hpp>
+#include "experiments/common/cli.hpp"
 
 namespace {
 
 using icd::mesh::PreprocessOptions;
 
-void print_help(const PreprocessOptions& d) {
-  std::printf(
-      "usage: icd-preprocess INPUT -o FOLDER [options]\n"
-      "\n"
-      "Prepares a deformable object: repairs the dense surface INPUT (.off .obj .ply .stl),\n"
-      "simplifies it with quadric error metrics, tetrahedralizes it into the coarse mesh,\n"
-      "ties every dense vertex to the coarse surface by a rigid link, builds the sphere tree\n"
-      "and its node associations, and writes the asset bundle to FOLDER:\n"
-      "  dense_surface.vtu, coarse_tets.vtu (ParaView/meshio), bundle.icdb (links, spheres).\n"
-      "Same input and options give byte-identical files.\n"
-      "\n"
-      "options (defaults in brackets):\n"
-      "  -o, --output FOLDER        bundle folder (created) [required]\n"
-      "  --coarse-tets N            target number of coarse tets [%d]\n"
-      "  --cell-size H              fixed tet size (circumradius bound, model units); overrides "
-      "--coarse-tets\n"
-      "  --simplify-faces N         faces of the simplified surface [%d]\n"
-      "  --simplify-ratio R         or a fraction of the input faces, in (0, 1]\n"
-      "  --max-hole-edges N         fill holes with at most N boundary edges [%d]\n"
-      "  --max-hole-diameter F      ... and diameter at most F * bbox diagonal [%g]\n"
-      "  --max-surface-change F     largest area/volume change of a local self-intersection\n"
-      "                             repair, relative [%g]\n"
-      "  --radius-edge B            tet radius-edge ratio bound, >= 2 [%g]\n"
-      "  --facet-distance F         surface approximation bound, F * cell size [%g]\n"
-      "  --feature-angle DEG        protect edges sharper than DEG (0: none) [%g]\n"
-      "  --sliver-bound DEG         dihedral angle targeted by perturb/exude [%g]\n"
-      "  --spheres KIND             sphere-tree builder: medial (adaptive medial axis), octree, "
-      "none [medial]\n"
-      "  --no-spheres               same as --spheres none\n"
-      "  --sphere-depth D           sphere-tree levels below the root [%d]\n"
-      "  --sphere-branching B       children per sphere [%d]\n"
-      "  --sphere-fit FIT           medial tree optimisation: light, full (the builder's "
-      "defaults),\n"
-      "                             shell (thinnest leaf shell) [light]\n"
-      "  --sph FILE                 also write the sphere tree (rest pose) as .sph to FILE\n"
-      "  --sphere-time-limit S      CPU seconds for the medial-axis optimisation [none];\n"
-      "                             a limit that fires makes the output machine-load dependent\n"
-      "  --assoc-nearest K          coarse nodes associated with each sphere, at least [%d]\n"
-      "  --no-hausdorff             skip the Hausdorff distance of the summary\n"
-      "  --time-limit S             CPU seconds each stage may use [%g]\n"
-      "  --memory-limit MB          memory each stage may use, MiB [%g]\n"
-      "  -q, --quiet                only errors and the final summary\n"
-      "  -h, --help                 this text\n",
+// The footer of --help: what the program does and the defaults it gets from
+// the library's options.
+std::string help_footer(const PreprocessOptions& d) {
+  char defaults[1024];
+  std::snprintf(
+      defaults, sizeof defaults,
+      "  Defaults: --coarse-tets %d, --simplify-faces %d, --max-hole-edges %d,\n"
+      "  --max-hole-diameter %g, --max-surface-change %g, --radius-edge %g,\n"
+      "  --facet-distance %g, --feature-angle %g, --sliver-bound %g, --spheres medial,\n"
+      "  --sphere-depth %d, --sphere-branching %d, --sphere-fit light, --assoc-nearest %d,\n"
+      "  --time-limit %g, --memory-limit %g.\n",
       d.tetrahedralize.target_tets, d.simplify.target_faces, d.repair.max_hole_edges,
       d.repair.max_hole_diameter, d.repair.max_surface_change, d.tetrahedralize.radius_edge_bound,
       d.tetrahedralize.facet_distance_factor, d.tetrahedralize.feature_angle_deg,
-      d.tetrahedralize.sliver_bound_deg, d.spheres.depth,
-      d.spheres.branching, d.association.k_nearest, d.limits.cpu_seconds, d.limits.memory_mb);
+      d.tetrahedralize.sliver_bound_deg, d.spheres.depth, d.spheres.branching,
+      d.association.k_nearest, d.limits.cpu_seconds, d.limits.memory_mb);
+  return std::string(
+             "  Prepares a deformable object: repairs the dense surface INPUT (.off .obj .ply\n"
+             "  .stl), simplifies it with quadric error metrics, tetrahedralizes it into the\n"
+             "  coarse mesh, ties every dense vertex to the coarse surface by a rigid link, builds\n"
+             "  the sphere tree and its node associations, and writes the asset bundle to FOLDER:\n"
+             "  dense_surface.vtu, coarse_tets.vtu (ParaView/meshio), bundle.icdb (links,\n"
+             "  spheres). Same input and options give byte-identical files.\n") +
+         defaults;
 }
 
-struct Cli {
+struct Command {
   std::string input, output;
   PreprocessOptions options;
   icd::mesh::SphereFit fit = icd::mesh::SphereFit::light;
@@ -81,140 +59,117 @@ struct Cli {
   bool quiet = false;
 };
 
-[[noreturn]] void usage_error(const std::string& msg) {
-  std::fprintf(stderr, "icd-preprocess: %s (see --help)\n", msg.c_str());
-  std::exit(2);
-}
-
-double to_double(const std::string& opt, const std::string& v) {
-  try {
-    std::size_t used = 0;
-    const double x = std::stod(v, &used);
-    if (used == v.size()) return x;
-  } catch (const std::exception&) {
-  }
-  usage_error(opt + " needs a number, got '" + v + "'");
-}
-
-int to_int(const std::string& opt, const std::string& v) {
-  try {
-    std::size_t used = 0;
-    const int x = std::stoi(v, &used);
-    if (used == v.size()) return x;
-  } catch (const std::exception&) {
-  }
-  usage_error(opt + " needs an integer, got '" + v + "'");
-}
-
-Cli parse(int argc, char** argv) {
-  Cli c;
+// The command line, or the exit status to return (0 after --help or
+// --version, 2 on a bad command line).
+std::variant<Command, int> parse(int argc, char** argv) {
+  using icd::experiments::Cli;
+  Command c;
   auto& o = c.options;
-  std::vector<std::string> args(argv + 1, argv + argc);
-  std::string faces_option, fit_option;  // for the contradiction checks below
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    const auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) usage_error(a + " needs a value");
-      return args[++i];
-    };
-    if (a == "-h" || a == "--help") {
-      print_help(PreprocessOptions{});
-      std::exit(0);
-    } else if (a == "-o" || a == "--output") {
-      c.output = value();
-    } else if (a == "--coarse-tets") {
-      o.tetrahedralize.target_tets = to_int(a, value());
-    } else if (a == "--cell-size") {
-      o.tetrahedralize.cell_size = to_double(a, value());
-    } else if (a == "--simplify-faces") {
-      o.simplify.target_faces = to_int(a, value());
-      if (faces_option == "--simplify-ratio")
-        usage_error("--simplify-faces and --simplify-ratio contradict each other: give one");
-      faces_option = a;
-    } else if (a == "--simplify-ratio") {
-      if (faces_option == "--simplify-faces")
-        usage_error("--simplify-faces and --simplify-ratio contradict each other: give one");
-      faces_option = a;
-      o.simplify.target_faces = 0;
-      o.simplify.target_ratio = to_double(a, value());
-    } else if (a == "--max-hole-edges") {
-      o.repair.max_hole_edges = to_int(a, value());
-    } else if (a == "--max-hole-diameter") {
-      o.repair.max_hole_diameter = to_double(a, value());
-    } else if (a == "--max-surface-change") {
-      o.repair.max_surface_change = to_double(a, value());
-    } else if (a == "--radius-edge") {
-      o.tetrahedralize.radius_edge_bound = to_double(a, value());
-    } else if (a == "--facet-distance") {
-      o.tetrahedralize.facet_distance_factor = to_double(a, value());
-    } else if (a == "--feature-angle") {
-      o.tetrahedralize.feature_angle_deg = to_double(a, value());
-    } else if (a == "--sliver-bound") {
-      o.tetrahedralize.sliver_bound_deg = to_double(a, value());
-    } else if (a == "--spheres") {
-      const std::string& k = value();
-      if (k == "medial") {
-        o.sphere_builder = icd::mesh::SphereBuilder::medial_axis;
-      } else if (k == "octree") {
-        o.sphere_builder = icd::mesh::SphereBuilder::octree;
-      } else if (k == "none") {
-        o.sphere_builder = icd::mesh::SphereBuilder::none;
-      } else {
-        usage_error("--spheres must be medial, octree or none, got '" + k + "'");
-      }
-    } else if (a == "--no-spheres") {
-      o.sphere_builder = icd::mesh::SphereBuilder::none;
-    } else if (a == "--sphere-depth") {
-      o.spheres.depth = to_int(a, value());
-      o.octree.levels = o.spheres.depth + 1;
-    } else if (a == "--sphere-branching") {
-      o.spheres.branching = to_int(a, value());
-    } else if (a == "--sphere-fit") {
-      fit_option = a;
-      const std::string& f = value();
-      try {
-        c.fit = icd::mesh::parse_sphere_fit(f, "--sphere-fit");
-      } catch (const icd::ParameterError& e) {
-        usage_error(e.what());
-      }
-    } else if (a == "--sph") {
-      c.sph = value();
-    } else if (a == "--sphere-time-limit") {
-      o.spheres.time_limit = to_double(a, value());
-    } else if (a == "--assoc-nearest") {
-      o.association.k_nearest = to_int(a, value());
-    } else if (a == "--time-limit") {
-      o.limits.cpu_seconds = to_double(a, value());
-      if (!(o.limits.cpu_seconds > 0)) usage_error("--time-limit must be > 0");
-    } else if (a == "--memory-limit") {
-      o.limits.memory_mb = to_double(a, value());
-      if (!(o.limits.memory_mb > 0)) usage_error("--memory-limit must be > 0");
-    } else if (a == "--no-hausdorff") {
-      o.compute_hausdorff = false;
-    } else if (a == "-q" || a == "--quiet") {
-      c.quiet = true;
-    } else if (!a.empty() && a[0] == '-') {
-      usage_error("unknown option " + a);
-    } else if (c.input.empty()) {
-      c.input = a;
-    } else {
-      usage_error("more than one input file ('" + c.input + "', '" + a + "')");
-    }
+  bool simplify_faces = false, simplify_ratio = false, no_spheres = false, no_hausdorff = false;
+  std::string fit_option, spheres_option;
+  double cell_size = o.tetrahedralize.cell_size, ratio = o.simplify.target_ratio;
+  Cli cli("icd-preprocess", help_footer(PreprocessOptions{}));
+  cli.argument("INPUT", "dense surface mesh (.off .obj .ply .stl)", true,
+               [&c](const std::string& v) { c.input = v; });
+  cli.text("-o,--output", c.output, "FOLDER", "bundle folder (created) [required]")
+      .integer("--coarse-tets", o.tetrahedralize.target_tets, "N", "target number of coarse tets")
+      .real("--cell-size", cell_size, "H",
+            "fixed tet size (circumradius bound, model units); overrides --coarse-tets")
+      .custom("--simplify-faces", "N", "faces of the simplified surface",
+              [&](const std::string& v) {
+                o.simplify.target_faces = Cli::parse_integer<int>(v);
+                simplify_faces = true;
+              })
+      .custom("--simplify-ratio", "R", "or a fraction of the input faces, in (0, 1]",
+              [&](const std::string& v) {
+                ratio = Cli::parse_real(v);
+                simplify_ratio = true;
+              })
+      .integer("--max-hole-edges", o.repair.max_hole_edges, "N",
+               "fill holes with at most N boundary edges")
+      .real("--max-hole-diameter", o.repair.max_hole_diameter, "F",
+            "... and diameter at most F * bbox diagonal")
+      .real("--max-surface-change", o.repair.max_surface_change, "F",
+            "largest area/volume change of a local self-intersection repair, relative")
+      .real("--radius-edge", o.tetrahedralize.radius_edge_bound, "B",
+            "tet radius-edge ratio bound, >= 2")
+      .real("--facet-distance", o.tetrahedralize.facet_distance_factor, "F",
+            "surface approximation bound, F * cell size")
+      .real("--feature-angle", o.tetrahedralize.feature_angle_deg, "DEG",
+            "protect edges sharper than DEG (0: none)")
+      .real("--sliver-bound", o.tetrahedralize.sliver_bound_deg, "DEG",
+            "dihedral angle targeted by perturb/exude")
+      .custom("--spheres", "KIND",
+              "sphere-tree builder: medial (adaptive medial axis), octree, none",
+              [&](const std::string& k) {
+                if (k == "medial")
+                  o.sphere_builder = icd::mesh::SphereBuilder::medial_axis;
+                else if (k == "octree")
+                  o.sphere_builder = icd::mesh::SphereBuilder::octree;
+                else if (k == "none")
+                  o.sphere_builder = icd::mesh::SphereBuilder::none;
+                else
+                  throw std::invalid_argument("must be medial, octree or none, got '" + k + "'");
+              })
+      .flag("--no-spheres", no_spheres, "same as --spheres none")
+      .custom("--sphere-depth", "D", "sphere-tree levels below the root",
+              [&](const std::string& v) {
+                o.spheres.depth = Cli::parse_integer<int>(v);
+                o.octree.levels = o.spheres.depth + 1;
+              })
+      .integer("--sphere-branching", o.spheres.branching, "B", "children per sphere")
+      .text("--sphere-fit", fit_option, "FIT",
+            "medial tree optimisation: light, full (the builder's defaults), shell (thinnest "
+            "leaf shell)")
+      .text("--sph", c.sph, "FILE", "also write the sphere tree (rest pose) as .sph to FILE")
+      .real("--sphere-time-limit", o.spheres.time_limit, "S",
+            "CPU seconds for the medial-axis optimisation [none]; a limit that fires makes the "
+            "output machine-load dependent")
+      .integer("--assoc-nearest", o.association.k_nearest, "K",
+               "coarse nodes associated with each sphere, at least")
+      .flag("--no-hausdorff", no_hausdorff, "skip the Hausdorff distance of the summary")
+      .custom("--time-limit", "S", "CPU seconds each stage may use",
+              [&](const std::string& v) {
+                o.limits.cpu_seconds = Cli::parse_real(v);
+                if (!(o.limits.cpu_seconds > 0)) throw std::invalid_argument("must be > 0");
+              })
+      .custom("--memory-limit", "MB", "memory each stage may use, MiB",
+              [&](const std::string& v) {
+                o.limits.memory_mb = Cli::parse_real(v);
+                if (!(o.limits.memory_mb > 0)) throw std::invalid_argument("must be > 0");
+              })
+      .flag("-q,--quiet", c.quiet, "only errors and the final summary");
+  if (const auto status = cli.parse(argc, argv)) return *status;
+  const auto fail = [](const std::string& what) { return Cli::fail("icd-preprocess", what); };
+  o.tetrahedralize.cell_size = cell_size;
+  if (simplify_faces && simplify_ratio)
+    return fail("--simplify-faces and --simplify-ratio contradict each other: give one");
+  if (simplify_ratio) {
+    o.simplify.target_faces = 0;
+    o.simplify.target_ratio = ratio;
   }
-  if (!fit_option.empty() && o.sphere_builder != icd::mesh::SphereBuilder::medial_axis)
-    usage_error(std::string("--sphere-fit and ") +
-                (o.sphere_builder == icd::mesh::SphereBuilder::octree ? "--spheres octree"
-                                                                      : "--spheres none") +
-                " contradict each other: --sphere-fit optimises a medial tree");
-  icd::mesh::apply_sphere_fit(c.fit, o.spheres);  // after the loop: keeps --sphere-depth etc.
+  if (no_spheres) o.sphere_builder = icd::mesh::SphereBuilder::none;
+  if (no_hausdorff) o.compute_hausdorff = false;
+  if (!fit_option.empty()) {
+    try {
+      c.fit = icd::mesh::parse_sphere_fit(fit_option, "--sphere-fit");
+    } catch (const icd::ParameterError& e) {
+      return fail(e.what());
+    }
+    if (o.sphere_builder != icd::mesh::SphereBuilder::medial_axis)
+      return fail(std::string("--sphere-fit and ") +
+                  (o.sphere_builder == icd::mesh::SphereBuilder::octree ? "--spheres octree"
+                                                                        : "--spheres none") +
+                  " contradict each other: --sphere-fit optimises a medial tree");
+  }
+  icd::mesh::apply_sphere_fit(c.fit, o.spheres);  // after the options: keeps --sphere-depth etc.
   if (!c.sph.empty() && o.sphere_builder == icd::mesh::SphereBuilder::none)
-    usage_error("--sph needs a sphere tree (not --spheres none)");
-  if (c.input.empty()) usage_error("no input file");
-  if (c.output.empty()) usage_error("no output folder (-o)");
+    return fail("--sph needs a sphere tree (not --spheres none)");
+  if (c.output.empty()) return fail("no output folder (-o)");
   return c;
 }
 
-void print_summary(const Cli& c, const icd::mesh::PreprocessResult& r, double write_s,
+void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, double write_s,
                    double load_ms, double load_cpu_ms) {
   const auto& b = r.bundle;
   std::printf("\n== icd-preprocess summary: %s -> %s\n", c.input.c_str(), c.output.c_str());
@@ -261,7 +216,9 @@ void print_summary(const Cli& c, const icd::mesh::PreprocessResult& r, double wr
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Cli cli = parse(argc, argv);
+  const auto parsed = parse(argc, argv);
+  if (const int* status = std::get_if<int>(&parsed)) return *status;
+  const Command& cli = std::get<Command>(parsed);
   using Clock = std::chrono::steady_clock;
   try {
     const auto t0 = Clock::now();

@@ -1,73 +1,33 @@
-// icd-run: runs a scene file (see experiments/scenes/ and README).
+// icd-run: runs a scene file (see experiments/scenes/ and README); icd-run --help.
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <string>
 
-#include <icd/config.hpp>
-#include <icd/mesh/core/input_file.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/runner/locations.hpp"
 #include "experiments/runner/run.hpp"
 
-namespace {
-
-void usage() {
-  std::printf(
-      "usage: icd-run SCENE.json [--out DIR] [--frames N] [--target-fps F] [--dry-run] [--quiet]\n"
-      "  --out DIR    results folder (default: results/<scene name as a file name>)\n"
-      "  --frames N   override the scene's frame count (1 to 100000000)\n"
-      "  --target-fps F  real-time mode at F frames per second (0 = off; overrides the scene)\n"
-      "  --dry-run    print the stages the scene needs and check its input files, run nothing\n"
-      "  --quiet      no progress bar\n");
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
-  std::string scene_path, out;
+  std::filesystem::path scene_path, out, cache_dir = icd::runner::default_cache_dir();
   int frames = -1;
   double target_fps = -1;
   bool dry = false, quiet = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) {
-      out = argv[++i];
-    } else if (a == "--frames" && i + 1 < argc) {
-      char* end = nullptr;
-      const long v = std::strtol(argv[++i], &end, 10);
-      if (end == argv[i] || *end != '\0' || v < 1 || v > 100000000) {  // as the scene's "frames"
-        std::fprintf(stderr, "icd-run: --frames: must be in [1, 100000000], got '%s'\n",
-                     icd::escape_bytes(argv[i]).c_str());
-        return 2;
-      }
-      frames = static_cast<int>(v);
-    } else if (a == "--target-fps" && i + 1 < argc) {
-      char* end = nullptr;
-      target_fps = std::strtod(argv[++i], &end);
-      if (*end != '\0' || !(target_fps >= 0 && target_fps <= 1e5)) {
-        std::fprintf(stderr, "icd-run: --target-fps: expected a number in [0, 1e5], got '%s'\n",
-                     icd::escape_bytes(argv[i]).c_str());
-        return 2;
-      }
-    } else if (a == "--dry-run") {
-      dry = true;
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else if (a == "--help" || a == "-h") {
-      usage();
-      return 0;
-    } else if (scene_path.empty() && !a.empty() && a[0] != '-') {
-      scene_path = a;
-    } else {
-      std::fprintf(stderr, "icd-run: unknown argument '%s'\n", icd::escape_bytes(a).c_str());
-      usage();
-      return 2;
-    }
-  }
-  if (scene_path.empty()) {
-    usage();
-    return 2;
-  }
+  icd::experiments::Cli cli(
+      "icd-run",
+      "  Runs a scene file (experiments/scenes/, installed under share/icd/scenes).\n"
+      "  Asset cache: --cache-dir, else $ICD_CACHE_DIR, else the source tree's assets/ for a\n"
+      "  program in the build tree and $XDG_CACHE_HOME/icd (~/.cache/icd) for an installed one.\n"
+      "  Relative mesh paths: the scene's folder, the working folder, $ICD_DATA_DIR.");
+  cli.argument("SCENE", scene_path, "scene file (JSON)", true)
+      .path("--out", out, "DIR", "results folder (default: results/<scene name as a file name>)")
+      .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000)
+      .real("--target-fps", target_fps, "F",
+            "real-time mode at F frames per second (0 = off; overrides the scene)", 0.0, 1e5)
+      .path("--cache-dir", cache_dir, "DIR", "asset cache folder (see below)")
+      .flag("--dry-run", dry, "print the stages the scene needs and check its input files, run nothing")
+      .flag("--quiet", quiet, "no progress bar");
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     const icd::runner::Scene scene = icd::runner::load_scene(scene_path);
     std::printf("scene \"%s\": %zu objects, %d frames at %g Hz\n", scene.name.c_str(),
@@ -90,8 +50,8 @@ int main(int argc, char** argv) {
     opt.out_dir = out.empty()
                       ? std::filesystem::path("results") / icd::runner::file_name_from(scene.name)
                       : std::filesystem::path(out);
-    opt.cache_dir = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
-    opt.tool_dir = std::filesystem::canonical("/proc/self/exe").parent_path();
+    opt.cache_dir = cache_dir;
+    opt.tool_dir = icd::runner::program_dir();
     opt.frames = frames;
     opt.scene_file = scene_path;
     opt.target_fps = target_fps;

@@ -3,7 +3,7 @@
 // valid mesh or throw icd::InputError whose message starts with the source
 // name; anything else (another exception, a crash, a sanitizer report when
 // built with ICD_SANITIZE=ON) is a bug.
-// Usage: fuzz_mesh_readers [iterations=200000] [seed=0]
+// Usage: fuzz_mesh_readers [ITERATIONS=200000] [SEED=0] (--help)
 #include <bit>
 #include <chrono>
 #include <cstdio>
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include <icd/mesh/core/error.hpp>
+#include "experiments/common/cli.hpp"
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
 #include <icd/mesh/io/surface_writer.hpp>
@@ -169,8 +170,17 @@ std::string mutate(const std::string& seed, std::mt19937_64& rng) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const long iterations = argc > 1 ? std::atol(argv[1]) : 200000;
-  const unsigned long seed = argc > 2 ? std::strtoul(argv[2], nullptr, 10) : 0;
+  long iterations = 200000;
+  unsigned long seed = 0;
+  using icd::experiments::Cli;
+  Cli cli("fuzz_mesh_readers",
+          "  Mutation fuzzing of every mesh reader: each mutant parses or is refused with an\n"
+          "  InputError naming its source; anything else is reported as BUG (exit status 1).");
+  cli.argument("ITERATIONS", "mutants to try (default 200000)", false,
+               [&](const std::string& v) { iterations = Cli::parse_integer<long>(v, 0); })
+      .argument("SEED", "random seed (default 0)", false,
+                [&](const std::string& v) { seed = Cli::parse_integer<unsigned long>(v); });
+  if (const auto status = cli.parse(argc, argv)) return *status;
   const std::vector<Seed> seeds = make_seeds();
   std::mt19937_64 rng(seed);
   long accepted = 0, rejected = 0;

@@ -1,4 +1,5 @@
 #include "experiments/runner/scene.hpp"
+#include "experiments/runner/locations.hpp"
 
 #include <cmath>
 #include <limits>
@@ -358,13 +359,10 @@ Scene parse_scene(const Json& json, const std::string& source,
     out.finish();
   }
   f.finish();
-  // Resolve paths: against the scene's folder, then the repository root.
+  // Resolve paths: the scene's folder, the working folder, $ICD_DATA_DIR,
+  // then (build tree only) the repository root (locations.hpp).
   for (ObjectSpec& o : s.objects)
-    for (std::filesystem::path* p : {&o.mesh, &o.asset})
-      if (!p->empty() && p->is_relative()) {
-        const auto local = base_dir / *p;
-        *p = std::filesystem::exists(local) ? local : std::filesystem::path(ICD_SOURCE_DIR) / *p;
-      }
+    for (std::filesystem::path* p : {&o.mesh, &o.asset}) *p = resolve_input(*p, base_dir);
   return s;
 }
 

@@ -9,22 +9,24 @@
 
 #include <icd/collision/sph_io.hpp>
 #include <icd/coupling/asset_bundle.hpp>
+#include "experiments/common/cli.hpp"
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: icd-read-check FILE.sph | BUNDLE_FOLDER\n");
-    return 2;
-  }
-  const std::filesystem::path path = argv[1];
+  std::filesystem::path path;
+  icd::experiments::Cli cli("icd-read-check",
+                            "  Loads a .sph sphere tree or an asset bundle folder and prints a "
+                            "summary.");
+  cli.argument("PATH", path, "FILE.sph or BUNDLE_FOLDER", true);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     if (std::filesystem::is_directory(path)) {
       const icd::coupling::AssetBundle b = icd::coupling::read_asset_bundle(path);
-      std::printf("%s: bundle, %ld dense vertices, %ld coarse tets, %d spheres\n", argv[1],
+      std::printf("%s: bundle, %ld dense vertices, %ld coarse tets, %d spheres\n", path.c_str(),
                   static_cast<long>(b.dense.V.rows()), static_cast<long>(b.coarse.T.rows()),
                   b.spheres.num_nodes());
     } else {
       const icd::collision::SphereTree t = icd::collision::read_sph(path.string());
-      std::printf("%s: sphere tree, %d nodes, %d levels\n", argv[1], t.num_nodes(), t.num_levels());
+      std::printf("%s: sphere tree, %d nodes, %d levels\n", path.c_str(), t.num_nodes(), t.num_levels());
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "icd-read-check: %s\n", e.what());

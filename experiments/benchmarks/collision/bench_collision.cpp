@@ -4,6 +4,8 @@
 // run; nothing here gates a build.
 #include <benchmark/benchmark.h>
 
+#include "experiments/common/benchmark_main.hpp"
+
 #include <memory>
 #include <random>
 
@@ -130,4 +132,5 @@ BENCHMARK(BM_QueryBudget)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+ICD_BENCHMARK_MAIN("bench_collision",
+                   "Google Benchmark of the collision module: sphere tests/s, update per sphere, traversals, query time per budget.");

@@ -8,6 +8,8 @@
 // response per pair. Summarise repetitions with summarise_bench.py.
 #include <benchmark/benchmark.h>
 
+#include "experiments/common/benchmark_main.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -162,7 +164,14 @@ std::vector<std::filesystem::path> find_bundles(const std::string& prefix) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (const auto status = icd::experiments::benchmark_preamble(
+          argc, argv, "bench_coupling",
+          "Google Benchmark of the coupling layer per dense vertex: rigid links, origin map, "
+          "barycentric baseline, contact response."))
+    return *status;
   benchmark::Initialize(&argc, argv);
+  if (const auto status = icd::experiments::benchmark_leftover(argc, argv, "bench_coupling"))
+    return *status;
   fixtures()["sphere3"] = std::make_unique<Fixture>(sphere_asset(3));
   fixtures()["sphere5"] = std::make_unique<Fixture>(sphere_asset(5));
   for (const char* prefix : {"bunny00", "ChineseDragon"}) {

@@ -9,6 +9,8 @@
 // prefix, e.g. 30n = 30 ns/tet). Single thread unless the name says threads:2.
 #include <benchmark/benchmark.h>
 
+#include "experiments/common/benchmark_main.hpp"
+
 #include <algorithm>
 #include <filesystem>
 #include <numeric>
@@ -268,4 +270,5 @@ BENCHMARK(BM_Step)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+ICD_BENCHMARK_MAIN("bench_fem",
+                   "Google Benchmark of the FEM kernels: force evaluation per material, one step per integrator.");

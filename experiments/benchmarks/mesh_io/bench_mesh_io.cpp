@@ -3,6 +3,8 @@
 // Run: <build>/bin/bench_mesh_io [--benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
+#include "experiments/common/benchmark_main.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cstdlib>
@@ -140,4 +142,5 @@ BENCHMARK(BM_BoundaryFaces_MapBaseline)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+ICD_BENCHMARK_MAIN("bench_mesh_io",
+                   "Google Benchmark of the mesh readers on the real meshes against an iostream OFF baseline.");

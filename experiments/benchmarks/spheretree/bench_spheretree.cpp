@@ -13,6 +13,8 @@
 // Run: <build>/bin/bench_spheretree [--benchmark_repetitions=5]
 #include <benchmark/benchmark.h>
 
+#include "experiments/common/benchmark_main.hpp"
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -189,4 +191,5 @@ BENCHMARK_CAPTURE(BM_Closest_ScanBaseline, dragon, "ChineseDragon-10kv.off");
 BENCHMARK_CAPTURE(BM_CoverRadius_Bands, dragon, "ChineseDragon-10kv.off");
 BENCHMARK_CAPTURE(BM_CoverRadius_AllMembersBaseline, dragon, "ChineseDragon-10kv.off");
 
-BENCHMARK_MAIN();
+ICD_BENCHMARK_MAIN("bench_spheretree",
+                   "Google Benchmark of the sphere-tree builder's distance queries and covering radius against brute force.");

@@ -17,6 +17,8 @@
 // (README.md there, "Parent filter").
 #include <benchmark/benchmark.h>
 
+#include "experiments/common/benchmark_main.hpp"
+
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -144,4 +146,5 @@ BENCHMARK(BM_NearContactTestBudget)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+ICD_BENCHMARK_MAIN("bench_wrapped_traversal",
+                   "Google Benchmark: full traversals of two wrapped sphere trees near contact, with and without the parent filter.");

@@ -33,7 +33,7 @@
 
 #include <icd/collision/aabb_tree.hpp>
 #include <icd/coupling/contact_response.hpp>
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/paper/contact_moment.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
   std::string budgets_text = "1e-6,3e-6,1e-5,3e-5,1e-4,3e-4,1e-3,3e-3,1e-2";
   std::string tests_text = "30,100,300,1000,3000,10000,30000,100000";
   int reps = 5, after = 3, max_frames = 200;
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "contact_error",
       "  Default scene experiments/scenes/bunny_dragon.json; writes DIR/contact_error.csv.");
   cli.path("--out", out, "DIR", "output folder (default results/contact_error)")

@@ -22,7 +22,7 @@
 
 #include <icd/coupling/barycentric_embedding.hpp>
 #include <icd/coupling/rigid_links.hpp>
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/paper/contact_moment.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
   fs::path res_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
   std::string cells_text = "2,3,4,6,8";
   int frames = 60, reps = 5, fine = 12;
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "deformation_error",
       "  Defaults: bunny_dragon.json for the links, two_spheres.json with cells 2,3,4,6,8\n"
       "  against 12 for the resolution; 60 frames.");

@@ -24,7 +24,7 @@
 #include <icd/collision/coverage.hpp>
 #include <icd/collision/octree_tree.hpp>
 #include <icd/collision/sphere_update.hpp>
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/paper/contact_moment.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
   fs::path out = "results/sphere_update";
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
   int frames = 60, every = 1, reps = 5;
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "sphere_update_error",
       "  Default scene experiments/scenes/two_spheres.json (octree trees, so the rebuilt tree\n"
       "  uses the same builder), 60 frames, every frame.");

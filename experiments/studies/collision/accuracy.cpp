@@ -20,7 +20,7 @@
 #include <icd/collision/sphere_update.hpp>
 #include <icd/collision/traversal.hpp>
 #include "experiments/studies/collision/workloads.hpp"
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -190,7 +190,7 @@ void coherence_experiment(int levels) {
 
 int main(int argc, char** argv) {
   int levels = 6;
-  icd::experiments::CommandLine cli("icd_collision_accuracy");
+  icd::experiments::Cli cli("icd_collision_accuracy");
   cli.integer("--levels", levels, "L", "sphere-tree levels (default 6)", 1);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {

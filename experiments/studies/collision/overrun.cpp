@@ -21,7 +21,7 @@
 
 #include <icd/collision/traversal.hpp>
 #include "experiments/studies/collision/workloads.hpp"
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
   long long max_queries = 10000;
   double max_seconds = 4.0;
   std::string csv_path;
-  icd::experiments::CommandLine cli("icd_collision_overrun");
+  icd::experiments::Cli cli("icd_collision_overrun");
   cli.integer("--queries", max_queries, "N", "queries at most (default 10000)", 1LL)
       .real("--max-seconds", max_seconds, "S", "wall time at most (default 4)", 0.0)
       .text("--csv", csv_path, "FILE", "also write the measurements as CSV");

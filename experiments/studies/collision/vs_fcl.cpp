@@ -21,7 +21,7 @@
 #include <icd/collision/sphere_update.hpp>
 #include <icd/collision/traversal.hpp>
 #include "experiments/studies/collision/workloads.hpp"
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -161,7 +161,7 @@ void run_scene(const std::string& file, int frames, int levels) {
 
 int main(int argc, char** argv) {
   int frames = 20, levels = 4;
-  icd::experiments::CommandLine cli("icd_collision_vs_fcl");
+  icd::experiments::Cli cli("icd_collision_vs_fcl");
   cli.integer("--frames", frames, "N", "frames (default 20)", 1)
       .integer("--levels", levels, "L", "sphere-tree levels (default 4)", 1);
   if (const auto status = cli.parse(argc, argv)) return *status;

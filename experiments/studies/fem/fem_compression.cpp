@@ -21,7 +21,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include <icd/fem/constitutive.hpp>
 #include <icd/fem/stable_step.hpp>
 #include <icd/mesh/core/primitives.hpp>
@@ -79,9 +79,9 @@ double dense_omega_max(Model& model, const MatX3d& x) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  using icd::experiments::CommandLine;
+  using icd::experiments::Cli;
   std::filesystem::path out_path;
-  CommandLine cli("fem_compression", "  Prints the table; OUTPUT gets a copy.");
+  Cli cli("fem_compression", "  Prints the table; OUTPUT gets a copy.");
   cli.argument("OUTPUT", out_path, "also write the table to this file", false);
   if (const auto status = cli.parse(argc, argv)) return *status;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include <icd/fem/simulator.hpp>
 #include <icd/fem/static_solver.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -76,10 +76,10 @@ double static_tip(int r, MaterialModel mm) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  using icd::experiments::CommandLine;
+  using icd::experiments::Cli;
   std::filesystem::path out = "fem_error_vs_time.csv";
   bool quick = false;
-  CommandLine cli("fem_error_vs_time");
+  Cli cli("fem_error_vs_time");
   cli.argument("OUT.csv", out, "the table (default fem_error_vs_time.csv)", false)
       .flag("--quick", quick, "the two coarsest meshes only");
   if (const auto status = cli.parse(argc, argv)) return *status;

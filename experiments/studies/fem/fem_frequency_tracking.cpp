@@ -10,12 +10,13 @@
 // Then each integrator with safety factors 0.9 (default), 0.95, 0.97 and 1:
 // sub-steps, rollbacks, and whether the run completed.
 //
-// Usage: fem_frequency_tracking
+// Usage: fem_frequency_tracking (no options; --help)
 #include <cstdio>
 #include <exception>
 #include <string>
 #include <vector>
 
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/fem/clamped_bar.hpp"
 #include <icd/fem/simulator.hpp>
 #include <icd/mesh/core/primitives.hpp>
@@ -27,7 +28,12 @@ using namespace icd::fem;
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  icd::experiments::Cli cli("fem_frequency_tracking",
+                            "  Prints how the per-frame omega_max re-estimate tracks the truth and "
+                            "the\n  safety margin per integrator (see the top of "
+                            "fem_frequency_tracking.cpp).");
+  if (const auto status = cli.parse(argc, argv)) return *status;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   BoxMeshOptions bo;
   bo.nx = 40;

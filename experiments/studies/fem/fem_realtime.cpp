@@ -41,7 +41,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/common/timing.hpp"
 #include "experiments/studies/fem/clamped_bar.hpp"
 #include <icd/fem/lane_loops.hpp>
@@ -88,10 +88,10 @@ double cpu_per_call(Op&& op) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  using icd::experiments::CommandLine;
+  using icd::experiments::Cli;
   bool block = false;
   int threads = 1;
-  CommandLine cli("fem_realtime", "  Prints the table (about 2 min for the bar).");
+  Cli cli("fem_realtime", "  Prints the table (about 2 min for the bar).");
   cli.argument("MESH", "bar (40 x 4 x 4 cells, default) or block (10 x 8 x 8)", false,
                [&block](const std::string& v) {
                  if (v != "bar" && v != "block")
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
                })
       .argument("THREADS", "threads of the force evaluation (default 1)", false,
                 [&threads](const std::string& v) {
-                  threads = CommandLine::parse_integer<int>(v, 1, 256);
+                  threads = Cli::parse_integer<int>(v, 1, 256);
                 });
   if (const auto status = cli.parse(argc, argv)) return *status;
   BoxMeshOptions bo;

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/paper/contact_moment.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
   std::string budgets_text = "1e-4,1e-3,1e-2,1e-1";
   int max_frames = 200, after = 3;
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "fig9",
       "  Default: experiments/scenes/bunny_dragon.json, critical times 1e-4,1e-3,1e-2,1e-1 s,\n"
       "  3 frames after first contact (uninterrupted run). Writes DIR/budget_<t>/*.vtu and\n"

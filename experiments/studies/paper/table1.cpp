@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
   bool time_budgets_given = false;
   int max_frames = 200, after = 3;
   double paper_scale = 1;  // our critical time x paper_scale = the paper's row we sit beside
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "table1",
       "  Runs each scene once per critical time (default 1e-4,1e-3,1e-2,1e-1,1 s) and\n"
       "  records the list sizes N frames (--after, default 3) after first contact.\n"
@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
                 time_budgets_given = true;
                 std::stringstream ss(v);
                 for (std::string t; std::getline(ss, t, ',');)
-                  budgets.push_back(icd::experiments::CommandLine::parse_real(t, 0.0));
+                  budgets.push_back(icd::experiments::Cli::parse_real(t, 0.0));
                 if (budgets.empty()) throw std::invalid_argument("needs at least one time");
               })
       .custom("--test-budgets", "a,b,...",

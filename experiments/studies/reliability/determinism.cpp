@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/reliability/soak_scene.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
   int frames = 60, vtu_every = 10;
   long long budget = 2000;
   fs::path out = fs::temp_directory_path() / "icd_determinism";
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "determinism", "  Two runs of the scene compared file by file, then 1 and 2 FEM threads.");
   cli.text("--scene", scene_path, "FILE", "scene (default two_spheres.json)")
       .integer("--frames", frames, "N", "frames (default 60)", 1)

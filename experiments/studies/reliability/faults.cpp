@@ -18,7 +18,7 @@
 #include <typeinfo>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/runner/json.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
@@ -119,7 +119,7 @@ Outcome run_case(const Case& c, int frames) {
 
 int main(int argc, char** argv) {
   int frames = 120;
-  icd::experiments::CommandLine cli("faults", "  Fault cases of the full loop, each reported.");
+  icd::experiments::Cli cli("faults", "  Fault cases of the full loop, each reported.");
   cli.integer("--frames", frames, "N", "frames per case (default 120)", 1);
   if (const auto status = cli.parse(argc, argv)) return *status;
   std::vector<Case> cases;

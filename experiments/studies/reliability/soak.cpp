@@ -35,7 +35,7 @@
 #include <fstream>
 #include <string>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/reliability/soak_scene.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
@@ -63,13 +63,12 @@ struct Args {
 };
 
 /// The options, bound to the fields of `a`.
-icd::experiments::CommandLine command_line(Args& a) {
-  icd::experiments::CommandLine cli("soak", "  See the comment at the top of soak.cpp.");
+void add_options(icd::experiments::Cli& cli, Args& a) {
   cli.integer("--frames", a.frames, "N", "frames (default 100000)", 1)
       .integer("--every", a.every, "K", "report every K frames (default 1000)", 1)
       .custom("--budget-tests", "B", "sphere tests per query, -1: none (default 2000)",
               [&a](const std::string& v) {
-                a.budget_tests = icd::experiments::CommandLine::parse_integer<long long>(v, -1);
+                a.budget_tests = icd::experiments::Cli::parse_integer<long long>(v, -1);
                 a.budget_given = true;
               })
       .text("--scene", a.scene, "FILE", "soak this scene instead of the ball between walls")
@@ -80,7 +79,6 @@ icd::experiments::CommandLine command_line(Args& a) {
             0.0)
       .integer("--relaunch", a.relaunch, "K", "relaunch every K frames, 0: never (default 0)", 0)
       .text("--csv", a.csv, "FILE", "also write the rows as CSV");
-  return cli;
 }
 
 // Each deformable object gets its initial speed towards the centroid of the
@@ -112,7 +110,9 @@ double relaunch(icd::runner::World& world) {
 int main(int argc, char** argv) {
   using namespace icd;
   Args a;
-  if (const auto status = command_line(a).parse(argc, argv)) return *status;
+  icd::experiments::Cli cli("soak", "  See the comment at the top of soak.cpp.");
+  add_options(cli, a);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     runner::Scene scene;
     if (a.scene.empty()) {

@@ -31,7 +31,7 @@
 #include <Eigen/Geometry>
 
 #include <icd/collision/traversal.hpp>
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/spheretree/approach.hpp"
 #include "experiments/studies/spheretree/tree_report.hpp"
 #include <icd/mesh/io/surface_reader.hpp>
@@ -73,7 +73,7 @@ int run(int argc, char** argv) {
   unsigned seed = 1;
   double step = 0.5;
   int parent_filter = 0;
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "contact_tightness",
       "  False contacts of sphere trees on two copies of a mesh approaching each other.");
   cli.argument("MESH", mesh_path, "surface mesh (OFF, OBJ, PLY, STL) the trees were built for",
@@ -85,7 +85,7 @@ int run(int argc, char** argv) {
               [&](const std::string& v) {
                 gaps.clear();
                 for (const std::string& g : split(v, ',')) {
-                  gaps.push_back(icd::experiments::CommandLine::parse_real(g, 0.0));
+                  gaps.push_back(icd::experiments::Cli::parse_real(g, 0.0));
                   if (!(gaps.back() > 0)) throw std::invalid_argument("must be > 0, got " + g);
                 }
                 if (gaps.empty()) throw std::invalid_argument("needs at least one gap");

@@ -19,7 +19,7 @@
 #include <iostream>
 #include <string>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/spheretree/tree_report.hpp"
 #include <icd/mesh/io/surface_reader.hpp>
 #include <icd/mesh/spheres/evaluation.hpp>
@@ -31,7 +31,7 @@ int run(int argc, char** argv) {
   std::string name = "tree";
   icd::mesh::EvaluationOptions evaluation;
   bool dense = true, centred = false;
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "evaluate_sph", "  Evaluates a .sph sphere tree against its surface mesh (issue 5 metrics).");
   cli.argument("MESH", mesh_path, "surface mesh (OFF, OBJ, PLY, STL) the tree was built for", true)
       .argument("TREE", tree_path, ".sph sphere tree in the mesh's coordinates", true);

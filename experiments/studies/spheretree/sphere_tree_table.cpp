@@ -41,7 +41,7 @@
 #include <icd/collision/octree_tree.hpp>
 #include <icd/collision/sph_io.hpp>
 #include <icd/collision/sphere_tree.hpp>
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/studies/spheretree/tree_report.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
@@ -158,8 +158,8 @@ int run(int argc, char** argv) {
   bool fit_probes = false;
   double perturb = 0;
   icd::mesh::EvaluationOptions evaluation;
-  using icd::experiments::CommandLine;
-  CommandLine cli(
+  using icd::experiments::Cli;
+  Cli cli(
       "sphere_tree_table",
       "  Builds and evaluates the trees, writes .sph and VTU files into RESULTS_DIR\n"
       "  (see the comment at the top of sphere_tree_table.cpp and\n"
@@ -209,7 +209,7 @@ int run(int argc, char** argv) {
             std::vector<int> caps;
             std::stringstream list(v);
             for (std::string item; std::getline(list, item, ',');)
-              caps.push_back(CommandLine::parse_integer<int>(item, 1));
+              caps.push_back(Cli::parse_integer<int>(item, 1));
             if (caps.size() < 2 || caps.front() != 1)
               throw std::invalid_argument(
                   "expects a list of positive counts starting with 1 (the root), got '" + v + "'");
@@ -222,7 +222,7 @@ int run(int argc, char** argv) {
       .integer("--threads", options.threads, "N", "worker threads (0: all cores)", 0)
       .custom("--flat", "N", "diagnostic: one level of at most N spheres under the root",
               [&](const std::string& v) {
-                const int n = CommandLine::parse_integer<int>(v, 1);
+                const int n = Cli::parse_integer<int>(v, 1);
                 options.depth = 1;
                 options.branching = std::max(2, n);
                 options.max_spheres_per_level = {1, n};

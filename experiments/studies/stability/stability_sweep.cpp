@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -231,7 +231,7 @@ int main(int argc, char** argv) {
   int frames = 30;
   double max_seconds = 30;
   bool quick = false;
-  icd::experiments::CommandLine cli(
+  icd::experiments::Cli cli(
       "stability_sweep",
       "  Runs every case for N frames (default 30 = 0.5 simulated second), at most S s of\n"
       "  wall time each (default 30); --quick runs the extreme cases only.");

@@ -1,5 +1,6 @@
-// The experiment programs' option parser: values land in their variables,
-// and every kind of bad command line is an error that names the option.
+// The programs' command line (experiments/common/cli.hpp, on CLI11): values
+// land in their variables, --help and --version apply nothing, and every
+// kind of bad command line is an error that names the option.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -7,11 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/command_line.hpp"
+#include "experiments/common/cli.hpp"
 
 namespace {
 
-using icd::experiments::CommandLine;
+using icd::experiments::Cli;
+using Outcome = Cli::Outcome;
 
 struct Values {
   std::filesystem::path out = "default";
@@ -24,8 +26,8 @@ struct Values {
   std::vector<double> list;
 };
 
-CommandLine make(Values& v) {
-  CommandLine cli("prog", "Defaults: reps 5.");
+// Declares the options of `v` on `cli`.
+void declare(Cli& cli, Values& v) {
   cli.path("--out", v.out, "DIR", "output folder")
       .text("--budgets", v.budgets, "a,b", "critical times")
       .integer("--reps", v.reps, "N", "repetitions", 1, 100)
@@ -34,29 +36,36 @@ CommandLine make(Values& v) {
       .flag("--quick", v.quick, "extreme cases only")
       .boolean("--octree", v.octree, "also the octree baseline")
       .custom("--item", "X", "appended to a list",
-              [&v](const std::string& s) { v.list.push_back(CommandLine::parse_real(s, 0.0)); });
-  return cli;
+              [&v](const std::string& s) { v.list.push_back(Cli::parse_real(s, 0.0)); });
+}
+
+// apply(args) on a fresh command line with the options of `v`.
+Outcome apply(Values& v, const std::vector<std::string>& args) {
+  Cli cli("prog", "Defaults: reps 5.");
+  declare(cli, v);
+  return cli.apply(args);
 }
 
 // The message of the std::invalid_argument that apply() throws ("" if none).
 std::string error_of(const std::vector<std::string>& args) {
   Values v;
   try {
-    make(v).apply(args);
+    apply(v, args);
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
   return "";
 }
 
-TEST(CommandLine, AppliesEveryKindOfOptionAndKeepsDefaults) {
+TEST(Cli, AppliesEveryKindOfOptionAndKeepsDefaults) {
   Values v;
-  EXPECT_TRUE(make(v).apply({}));
+  EXPECT_EQ(apply(v, {}), Outcome::Run);
   EXPECT_EQ(v.out, "default");
   EXPECT_EQ(v.reps, 5);
-  EXPECT_TRUE(make(v).apply({"--out", "dir/x", "--reps", "7", "--queries", "123456789012",
+  EXPECT_EQ(apply(v, {"--out", "dir/x", "--reps", "7", "--queries", "123456789012",
                              "--max-seconds", "2.5e-1", "--quick", "--budgets", "1e-4,1", "--item",
-                             "3", "--item", "0.5", "--reps", "8", "--octree", "0"}));
+                             "3", "--item", "0.5", "--reps", "8", "--octree", "0"}),
+            Outcome::Run);
   EXPECT_EQ(v.out, "dir/x");
   EXPECT_EQ(v.reps, 8);  // the later value wins
   EXPECT_EQ(v.queries, 123456789012LL);
@@ -65,18 +74,24 @@ TEST(CommandLine, AppliesEveryKindOfOptionAndKeepsDefaults) {
   EXPECT_EQ(v.budgets, "1e-4,1");
   EXPECT_EQ(v.list, (std::vector<double>{3.0, 0.5}));
   EXPECT_FALSE(v.octree);
-  EXPECT_TRUE(make(v).apply({"--octree", "1"}));
+  EXPECT_EQ(apply(v, {"--octree=1"}), Outcome::Run);
   EXPECT_TRUE(v.octree);
 }
 
-TEST(CommandLine, HelpStopsBeforeLaterOptions) {
+TEST(Cli, HelpAndVersionApplyNothingEvenBesideABadValue) {
   Values v;
-  EXPECT_FALSE(make(v).apply({"--reps", "2", "--help", "--reps", "3"}));
-  EXPECT_EQ(v.reps, 2);
-  EXPECT_FALSE(make(v).apply({"-h"}));
+  EXPECT_EQ(apply(v, {"--reps", "2", "--help", "--reps", "3"}), Outcome::Help);
+  EXPECT_EQ(v.reps, 5);
+  EXPECT_EQ(apply(v, {"-h"}), Outcome::Help);
+  EXPECT_EQ(apply(v, {"--reps", "0", "--help"}), Outcome::Help);
+  EXPECT_EQ(apply(v, {"--frobnicate", "--version"}), Outcome::Version);
+  EXPECT_EQ(v.reps, 5);
+  EXPECT_EQ(Cli::version_line(), std::string("icd ") + ICD_VERSION_STRING + "\n");
+  // After "--" the words are arguments, not options.
+  EXPECT_NE(error_of({"--", "--help"}), "");
 }
 
-TEST(CommandLine, EveryBadCommandLineNamesTheOptionAndTheProblem) {
+TEST(Cli, EveryBadCommandLineNamesTheOptionAndTheProblem) {
   struct Case {
     std::vector<std::string> args;
     std::string expected;  // a part of the message
@@ -84,7 +99,7 @@ TEST(CommandLine, EveryBadCommandLineNamesTheOptionAndTheProblem) {
   const std::vector<Case> cases = {
       {{"--frobnicate"}, "unknown option '--frobnicate'"},
       {{"out"}, "unexpected argument 'out'"},
-      {{"-"}, "unknown option '-'"},
+      {{"-"}, "unexpected argument '-'"},
       {{"--reps"}, "--reps needs a value"},
       {{"--reps", "12x"}, "--reps expects a whole number, got '12x'"},
       {{"--reps", ""}, "--reps expects a whole number, got ''"},
@@ -109,31 +124,32 @@ TEST(CommandLine, EveryBadCommandLineNamesTheOptionAndTheProblem) {
   }
 }
 
-TEST(CommandLine, PositionalArgumentsBindInOrderAnywhereAmongTheOptions) {
+TEST(Cli, PositionalArgumentsBindInOrderAnywhereAmongTheOptions) {
   std::filesystem::path dir;
   int threads = 1;
   bool quick = false;
-  auto make_positional = [&] {
-    CommandLine cli("prog");
+  auto declare_positional = [&](Cli& cli) {
     cli.argument("DIR", dir, "output folder", true)
         .argument("THREADS", "worker threads", false,
-                  [&threads](const std::string& v) {
-                    threads = CommandLine::parse_integer<int>(v, 1, 64);
-                  })
+                  [&threads](const std::string& v) { threads = Cli::parse_integer<int>(v, 1, 64); })
         .flag("--quick", quick, "quick");
-    return cli;
   };
-  EXPECT_TRUE(make_positional().apply({"--quick", "out/a", "--quick", "4"}));
+  auto apply_positional = [&](const std::vector<std::string>& args) {
+    Cli cli("prog");
+    declare_positional(cli);
+    return cli.apply(args);
+  };
+  EXPECT_EQ(apply_positional({"--quick", "out/a", "--quick", "4"}), Outcome::Run);
   EXPECT_EQ(dir, "out/a");
   EXPECT_EQ(threads, 4);
   EXPECT_TRUE(quick);
   threads = 1;
-  EXPECT_TRUE(make_positional().apply({"out/b"}));  // the optional one keeps its default
+  EXPECT_EQ(apply_positional({"out/b"}), Outcome::Run);  // the optional one keeps its default
   EXPECT_EQ(dir, "out/b");
   EXPECT_EQ(threads, 1);
   auto error = [&](const std::vector<std::string>& args) -> std::string {
     try {
-      make_positional().apply(args);
+      apply_positional(args);
     } catch (const std::invalid_argument& e) {
       return e.what();
     }
@@ -141,20 +157,25 @@ TEST(CommandLine, PositionalArgumentsBindInOrderAnywhereAmongTheOptions) {
   };
   EXPECT_EQ(error({}), "missing DIR");
   EXPECT_EQ(error({"--quick"}), "missing DIR");
+  EXPECT_EQ(error({"--slow"}), "unknown option '--slow'");  // before the missing DIR
   EXPECT_EQ(error({"d", "0"}), "THREADS must be in [1, 64], got '0'");
   EXPECT_EQ(error({"d", "2x"}), "THREADS expects a whole number, got '2x'");
   EXPECT_EQ(error({"d", "2", "extra"}), "unexpected argument 'extra'");
   EXPECT_EQ(error({"d", "--slow"}), "unknown option '--slow'");
-  EXPECT_FALSE(make_positional().apply({"--help"}));  // help needs no DIR
-  const std::string usage = make_positional().usage();
-  EXPECT_NE(usage.find("usage: prog DIR [THREADS] [--quick]"), std::string::npos) << usage;
+  EXPECT_EQ(apply_positional({"--help"}), Outcome::Help);  // help needs no DIR
+  Cli cli("prog");
+  declare_positional(cli);
+  const std::string usage = cli.usage();
+  EXPECT_NE(usage.find("Usage: prog [OPTIONS] DIR [THREADS]"), std::string::npos) << usage;
   EXPECT_NE(usage.find("  THREADS"), std::string::npos) << usage;
 }
 
-TEST(CommandLine, UsageListsEveryOptionAndTheSummary) {
+TEST(Cli, UsageListsEveryOptionAndTheSummary) {
   Values v;
-  const std::string usage = make(v).usage();
-  for (const char* part : {"usage: prog", "[--out DIR]", "[--reps N]", "[--quick]",
+  Cli cli("prog", "Defaults: reps 5.");
+  declare(cli, v);
+  const std::string usage = cli.usage();
+  for (const char* part : {"Usage: prog", "--out DIR", "--reps N", "--quick", "--version",
                            "critical times", "extreme cases only", "Defaults: reps 5."})
     EXPECT_NE(usage.find(part), std::string::npos) << part << " missing from\n" << usage;
 }
