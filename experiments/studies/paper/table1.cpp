@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
               [&](const std::string& v) {
                 std::stringstream ss(v);
                 for (std::string t; std::getline(ss, t, ',');)
-                  test_budgets.push_back(icd::experiments::CommandLine::parse_real(t, 1.0));
+                  test_budgets.push_back(icd::experiments::Cli::parse_real(t, 1.0));
                 if (test_budgets.empty()) throw std::invalid_argument("needs at least one count");
               })
       .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1)
