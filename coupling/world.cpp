@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include <icd/collision/aabb_tree.hpp>
@@ -60,6 +63,27 @@ auto naming(const RuntimeObject& a, const RuntimeObject& b, F&& f) {
 
 }  // namespace
 
+template <class F>
+void World::for_each_object(F&& f) {
+  const int n = static_cast<int>(m_objects.size());
+  if (!m_pool || n <= 1) {
+    for (int k = 0; k < n; ++k) f(k);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(static_cast<size_t>(n));
+  // Objects differ in cost: each worker takes the next object; each
+  // object's work is the same on any worker, so no result depends on it.
+  m_pool->run(n, [&](int k) {
+    try {
+      f(k);
+    } catch (...) {
+      errors[static_cast<size_t>(k)] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
 World::World(std::vector<WorldObject> objects, WorldSettings settings)
     : m_settings(std::move(settings)) {
   validate(m_settings);
@@ -67,6 +91,11 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
   setups.reserve(objects.size());
   for (const WorldObject& w : objects) setups.push_back(w.setup);
   m_plan = make_plan(setups, m_settings);
+  m_threads = m_settings.threads > 0
+                  ? m_settings.threads
+                  : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  if (m_threads > 1 && objects.size() > 1)
+    m_pool = std::make_unique<WorkerPool>(std::min<int>(m_threads, static_cast<int>(objects.size())));
   const CollisionSpec& cs = m_settings.collision;
   m_objects.reserve(objects.size());
   for (size_t i = 0; i < objects.size(); ++i) {
@@ -118,6 +147,13 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
   for (RuntimeObject& o : m_objects)
     o.node_mass =
         o.sim ? o.sim->model().mass() : Eigen::VectorXd::Constant(o.rest.rows(), kImmovableMass);
+  // Fewer deformable objects than threads: the force loops split too
+  // (bitwise identical for any count, fem::ForceOptions::num_threads).
+  int deformable = 0;
+  for (const RuntimeObject& o : m_objects) deformable += o.sim ? 1 : 0;
+  if (deformable > 0 && deformable < m_threads)
+    for (RuntimeObject& o : m_objects)
+      if (o.sim) o.sim->model().elastic().set_num_threads(m_threads / deformable);
   m_min_node_mass = std::numeric_limits<double>::infinity();
   for (const RuntimeObject& o : m_objects)
     if (o.sim) m_min_node_mass = std::min(m_min_node_mass, o.node_mass.minCoeff());
@@ -232,53 +268,77 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
   Clock::time_point t0 = Clock::now();
   // 1. Deformation: FEM for deformable objects (with last frame's contact
   //    forces), rigid motion for kinematic ones; then out of the obstacles.
+  //    Objects are independent here: one worker each (for_each_object).
   const bool obstacles = !m_settings.obstacles.empty();
   if (obstacles) m_obstacle_near = false;
   if (last) m.obstacle_vertices = 0;
-  for (RuntimeObject& o : m_objects) {
+  const bool track_work = m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
+  for_each_object([&](int k) {
+    RuntimeObject& o = m_objects[static_cast<size_t>(k)];
+    o.near_obstacle = false;
+    o.cycle_substeps = 0;
+    o.cycle_min_step = std::numeric_limits<double>::infinity();
+    o.cycle_obstacle_vertices = 0;
+    o.cycle_obstacle_depth = 0;
     if (o.plan.fem) {
       Eigen::Vector3d lo, hi;
       if (obstacles) {
         lo = o.positions.colwise().minCoeff().transpose();
         hi = o.positions.colwise().maxCoeff().transpose();
       }
-      const bool track_work =
-          m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
       if (o.external_forces.size() > 0)
         o.sim->set_external_forces(m_plan.response ? MatX3d(o.contact_forces + o.external_forces)
                                                    : o.external_forces);
       else if (m_plan.response)
         o.sim->set_external_forces(o.contact_forces);
       // The forces are constant over the cycle: their work is f . x1 - f . x0.
-      if (track_work) m_contact_work -= o.contact_forces.cwiseProduct(o.positions).sum();
+      if (track_work) o.work_before = o.contact_forces.cwiseProduct(o.positions).sum();
       const fem::AdvanceReport rep = naming(o, [&] { return o.sim->advance(h); });
       o.positions = o.sim->positions();
-      if (track_work) m_contact_work += o.contact_forces.cwiseProduct(o.positions).sum();
-      m.substeps += rep.substeps;
-      m.min_step = std::min(m.min_step, rep.step);
+      if (track_work) o.work_after = o.contact_forces.cwiseProduct(o.positions).sum();
+      o.cycle_substeps = rep.substeps;
+      o.cycle_min_step = rep.step;
       if (obstacles) {
         lo = lo.cwiseMin(o.positions.colwise().minCoeff().transpose());
         hi = hi.cwiseMax(o.positions.colwise().maxCoeff().transpose());
-        resolve_obstacles(o, lo, hi, last, m);
+        resolve_obstacles(o, lo, hi);
       }
     } else if (o.plan.kinematic) {
       o.positions.rowwise() += (h * o.setup.velocity).transpose();
     }
+  });
+  // Reduced in object order (the same sums for any thread count).
+  for (RuntimeObject& o : m_objects) {
+    if (!o.plan.fem) continue;
+    if (track_work) {
+      m_contact_work -= o.work_before;
+      m_contact_work += o.work_after;
+    }
+    m.substeps += o.cycle_substeps;
+    m.min_step = std::min(m.min_step, o.cycle_min_step);
+    o.substeps += o.cycle_substeps;
+    o.step = o.cycle_min_step;
+    m_obstacle_near = m_obstacle_near || o.near_obstacle;
+    m.obstacle_depth = std::max(m.obstacle_depth, o.cycle_obstacle_depth);
+    if (last) m.obstacle_vertices += o.cycle_obstacle_vertices;
   }
   m.times.fem += seconds_since(t0);
 
   // 2. Dense meshes follow through the rigid links (only where consumed).
   if (last) {
     t0 = Clock::now();
-    for (RuntimeObject& o : m_objects)
+    for_each_object([&](int k) {
+      RuntimeObject& o = m_objects[static_cast<size_t>(k)];
       if (o.plan.dense_update) update_dense(o);
+    });
     m.times.links += seconds_since(t0);
   }
 
   // 3. Sphere trees follow the coarse nodes (paper 4.4).
   t0 = Clock::now();
   const CollisionSpec& cs = m_settings.collision;
-  for (RuntimeObject& o : m_objects)
+  for_each_object([&](int k) {
+    RuntimeObject& o = m_objects[static_cast<size_t>(k)];
     if (o.plan.sphere_update) {
       if (cs.swept) {  // the spheres at the end of the cycle (actual positions)
         collision::update_spheres(o.asset.spheres, o.rest, o.positions, cs.update);
@@ -306,6 +366,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         std::swap(o.start_spheres, o.end_spheres);  // the next cycle starts at this end
       }
     }
+  });
   // Objects that do not move sweep nothing.
   if (cs.swept)
     for (RuntimeObject& o : m_objects)
@@ -506,7 +567,7 @@ void World::limit_contact_work(double h, FrameMetrics& m) {
 }
 
 void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
-                              const Eigen::Vector3d& hi_in, bool last, FrameMetrics& m) {
+                              const Eigen::Vector3d& hi_in) const {
   // Within reach? The dense surface lies within max_link of the coarse
   // nodes' convex hull (a link origin is a convex combination of three
   // nodes; the link keeps its length), which lies in [lo, hi].
@@ -515,7 +576,7 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
   bool near = false;
   for (const Obstacle& ob : m_settings.obstacles) near = near || ob.lower_bound(lo, hi) <= 0;
   if (!near) return;
-  m_obstacle_near = true;
+  o.near_obstacle = true;
   const int n = static_cast<int>(o.positions.rows());
   MatX3d corr(n, 3), dir = MatX3d::Zero(n, 3);
   o.obstacle_dense.resize(o.asset.links.num_links(), 3);
@@ -537,8 +598,8 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
         if (!(d < -kTolerance)) continue;
         inside = true;
         if (pass == 0) {
-          m.obstacle_depth = std::max(m.obstacle_depth, -d);
-          if (last) ++m.obstacle_vertices;
+          o.cycle_obstacle_depth = std::max(o.cycle_obstacle_depth, -d);
+          ++o.cycle_obstacle_vertices;
         }
         const Eigen::Vector3d need = -d * nrm;
         for (int k = 0; k < 3; ++k) {
@@ -635,13 +696,23 @@ FrameMetrics World::advance(std::optional<double> budget) {
   m.frame = m_frame;
   m.min_step = std::numeric_limits<double>::infinity();
   m.budget = budget ? *budget : m_settings.collision.query.budget_seconds;
+  for (RuntimeObject& o : m_objects) o.substeps = 0;
 
   // Real-time mode: collision detection gets what is left of the frame (of
-  // the first `fraction` of it), shared between the pairs.
+  // the first `fraction` of it), shared between the pairs, but never less
+  // than min_query_budget per query. FEM is never cut.
+  const bool realtime = !budget && m_settings.target_fps > 0;
+  if (realtime) m.deadline = 1.0 / m_settings.target_fps;
+  int floored = 0;  // queries given the minimum budget (the rolled-back trial's included)
   const auto budget_at = [&](double fraction) {
-    if (budget || m_settings.target_fps <= 0 || m_plan.pairs.empty()) return m.budget;
+    if (!realtime || m_plan.pairs.empty()) return m.budget;
     const double left = fraction / m_settings.target_fps - seconds_since(frame_start);
-    return std::max(kMinRealTimeBudget, left / static_cast<double>(m_plan.pairs.size()));
+    const double share = left / static_cast<double>(m_plan.pairs.size());
+    if (share < m_settings.min_query_budget) {
+      floored += static_cast<int>(m_plan.pairs.size());
+      return m_settings.min_query_budget;
+    }
+    return share;
   };
 
   // The contact response is explicit and staggered: forces computed from one
@@ -675,6 +746,7 @@ FrameMetrics World::advance(std::optional<double> budget) {
       for (char hit : m_swept_hit) touched = touched || hit;
     if (!touched) {
       m = trial;
+      m.min_budget_queries = floored;
       return finish_frame(m, frame_start);
     }
     restore(m_snapshot);
@@ -685,6 +757,7 @@ FrameMetrics World::advance(std::optional<double> budget) {
     cycles = std::max({stiff_cycles, motion_cycles(dt), 1});
   }
   run_cycles(m_time, dt, cycles, 0, true, budget_at, m);
+  m.min_budget_queries = floored;
   return finish_frame(m, frame_start);
 }
 
@@ -752,6 +825,25 @@ FrameMetrics World::finish_frame(FrameMetrics& m, Clock::time_point frame_start)
   m_time += 1.0 / m_settings.frame_rate;
   m.time = m_time;
   m.wall = seconds_since(frame_start);
+  if (m.deadline > 0) {
+    m.deadline_met = m.wall <= m.deadline ? 1 : 0;
+    m.lateness = std::max(0.0, m.wall - m.deadline);
+    const double own = m.times.fem + m.times.links + m.times.sphere_update;
+    m.fem_over_deadline = own > m.deadline ? 1 : 0;
+    if (m.fem_over_deadline && !m_deadline_warned) {
+      m_deadline_warned = true;
+      std::ostringstream os;
+      os.precision(3);
+      os << "real-time mode: the deadline of " << 1e3 * m.deadline << " ms per frame (target_fps "
+         << m_settings.target_fps << ") cannot be met: FEM, links and sphere update alone took "
+         << 1e3 * own << " ms in frame " << m.frame << " (FEM " << 1e3 * m.times.fem << " ms, "
+         << m.substeps << " sub-steps over " << m_threads
+         << " thread(s)); FEM is never skipped, so frames run late and collision runs at its "
+            "minimum budget of "
+         << 1e3 * m_settings.min_query_budget << " ms per query";
+      m.deadline_warning = os.str();
+    }
+  }
   return m;
 }
 

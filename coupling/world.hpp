@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <icd/collision/swept_spheres.hpp>
@@ -14,6 +15,7 @@
 #include <icd/coupling/link_evaluator.hpp>
 #include <icd/coupling/stage_plan.hpp>
 #include <icd/coupling/world_settings.hpp>
+#include <icd/coupling/worker_pool.hpp>
 #include <icd/fem/simulator.hpp>
 
 namespace icd::coupling {
@@ -79,6 +81,23 @@ struct FrameMetrics {
   /// Largest penetration / smaller leaf radius of a colliding leaf pair in
   /// the frame (> 1 with deep_pairs).
   double depth_ratio = 0;
+  /// Real-time mode (WorldSettings::target_fps > 0): the frame's deadline,
+  /// 1 / target_fps of wall time, s (0: not in real-time mode).
+  double deadline = 0;
+  /// 1 when the frame's wall time stayed within its deadline, 0 when it did
+  /// not, -1 outside real-time mode.
+  int deadline_met = -1;
+  /// wall - deadline when the deadline was missed, else 0, s.
+  double lateness = 0;
+  /// Queries of the frame that ran at WorldSettings::min_query_budget because
+  /// less than that was left of the frame (collision cut to its minimum).
+  int min_budget_queries = 0;
+  /// 1 when FEM, rigid links and the sphere update alone took longer than
+  /// the deadline: no collision budget could have kept it.
+  int fem_over_deadline = 0;
+  /// Set in the first frame whose FEM alone exceeds the deadline (once per
+  /// World): what it costs and what the deadline is, for the user.
+  std::string deadline_warning;
 };
 
 /// One object at run time.
@@ -111,6 +130,17 @@ struct RuntimeObject {
   double max_link = 0;
   double obstacle_scale = 0;
   MatX3d obstacle_dense;
+  bool near_obstacle = false;  ///< came within reach of an obstacle in the last cycle
+  int substeps = 0;            ///< FEM sub-steps of this object in the last frame
+  double step = 0;             ///< its last FEM sub-step, s (its own stable step)
+  /// Scratch of one cycle's parallel stage, reduced in object order after
+  /// it: contact work terms f . x0 and f . x1 (J), sub-steps, smallest
+  /// step, dense vertices found inside obstacles and the deepest.
+  double work_before = 0, work_after = 0;
+  int cycle_substeps = 0;
+  double cycle_min_step = 0;
+  int cycle_obstacle_vertices = 0;
+  double cycle_obstacle_depth = 0;
 };
 
 /// A simulation: objects, the plan of the stages they need, and the frame loop.
@@ -125,6 +155,8 @@ class World {
 
   const WorldSettings& settings() const { return m_settings; }
   const StagePlan& plan() const { return m_plan; }
+  /// Threads advancing the objects (WorldSettings::threads resolved).
+  int threads() const { return m_threads; }
   std::vector<RuntimeObject>& objects() { return m_objects; }
   const std::vector<RuntimeObject>& objects() const { return m_objects; }
   /// Sets the user loads of object `i` (N per coarse node, #V x 3; an empty
@@ -169,9 +201,9 @@ class World {
   void reset_sweep_start();
   /// Projects object o's dense surface out of the static obstacles (see
   /// coupling/obstacle.hpp); [lo, hi] bounds its coarse nodes over the
-  /// cycle. Sets m_obstacle_near when it came within reach of one.
-  void resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                         bool last, FrameMetrics& m);
+  /// cycle. Sets o.near_obstacle when it came within reach of one, and
+  /// o.cycle_obstacle_vertices / depth. Touches object o only (runs on its worker).
+  void resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
   /// Some object came within reach of an obstacle in the last cycle.
   bool m_obstacle_near = false;
   /// Detection/response cycles a frame of dt needs for a stable penalty.
@@ -203,9 +235,15 @@ class World {
   /// projection moves surface nodes at most about this far (an instantaneous
   /// position change stores elastic energy that comes back as a bounce).
   static constexpr double kObstacleStep = 1e-3;
-  /// Smallest per-query budget in real-time mode when the frame is already
-  /// over (the query then answers with the root pair), s.
-  static constexpr double kMinRealTimeBudget = 1e-6;
+  /// Runs f(k) for every object index k, on m_threads workers (each object
+  /// on one worker; objects are independent, so any assignment gives the
+  /// same results). A failure is rethrown after the loop, the first by
+  /// object order.
+  template <class F>
+  void for_each_object(F&& f);
+  int m_threads = 1;
+  std::unique_ptr<WorkerPool> m_pool;  ///< the workers (none with 1 thread or 1 object)
+  bool m_deadline_warned = false;
   /// Node mass standing for "does not move under contact" (static, rigid objects).
   static constexpr double kImmovableMass = 1e30;
   /// Largest omega h of the staggered penalty (explicit limit 2; smaller

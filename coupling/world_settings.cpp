@@ -19,6 +19,9 @@ void validate(const WorldSettings& s) {
     fail("frame_rate", "must be > 0 and finite", s.frame_rate);
   if (!(s.target_fps >= 0) || !std::isfinite(s.target_fps))
     fail("target_fps", "must be >= 0 and finite (0 = off)", s.target_fps);
+  if (!(s.min_query_budget > 0) || !std::isfinite(s.min_query_budget))
+    fail("min_query_budget", "must be > 0 and finite", s.min_query_budget);
+  if (s.threads < 0 || s.threads > 1024) fail("threads", "must be in 0..1024 (0 = all cores)", s.threads);
   if (!s.gravity.allFinite()) throw ParameterError("WorldSettings: gravity: must be finite");
   const CollisionSpec& c = s.collision;
   collision::validate(c.query);

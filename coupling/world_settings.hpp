@@ -134,8 +134,19 @@ struct WorldSettings {
   double frame_rate = 60;  ///< simulated frames per simulated second
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< m/s^2
   /// Real-time mode: hold this wall-clock frame rate, collision detection
-  /// getting what is left of each frame (0 = off).
+  /// getting what is left of each frame (0 = off). Each frame's deadline is
+  /// 1 / target_fps of wall time; FEM is never skipped (see FrameMetrics::
+  /// deadline_met, lateness, fem_over_deadline).
   double target_fps = 0;
+  /// Real-time mode: the smallest time budget a pair query gets, s (> 0),
+  /// even when the frame is already late: collision is never cut to nothing.
+  double min_query_budget = 1e-4;
+  /// Threads that advance the objects (each object's FEM sub-steps, rigid
+  /// links and sphere update on one worker; contact between them at the
+  /// cycle boundary). With fewer deformable objects than threads, the FEM
+  /// force loop of each splits across the rest. Results are bitwise
+  /// identical for any count. 0: the hardware concurrency.
+  int threads = 0;
   CollisionSpec collision;
   /// Static analytic obstacles (planes, boxes) that deformable objects are
   /// kept out of by projection (coupling/obstacle.hpp).

@@ -32,6 +32,8 @@ Simulator::Simulator(Model model, const SimulatorOptions& options)
   if (options.max_retries < 0) bad("max_retries", options.max_retries, ">= 0");
   if (!(options.frequency_reuse_time >= 0) || !std::isfinite(options.frequency_reuse_time))
     bad("frequency_reuse_time", options.frequency_reuse_time, ">= 0 s");
+  if (!(options.frequency_reuse_strain >= 0))
+    bad("frequency_reuse_strain", options.frequency_reuse_strain, ">= 0 (inf: no trigger)");
   m_state.x = m_model.mesh().rest_positions;
   m_state.v = MatX3d::Zero(m_model.num_nodes(), 3);
   m_energy_floor = 1e-10 * m_model.material().young * m_model.mesh().rest_volume.sum();
@@ -60,8 +62,9 @@ double Simulator::stable_step_limit() {
   if (m_options.integrator == Integrator::BackwardEuler)
     return std::numeric_limits<double>::infinity();
   // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time).
-  const bool fresh =
-      m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
+  const bool fresh = m_estimate_time >= 0 &&
+                     m_time - m_estimate_time < m_options.frequency_reuse_time &&
+                     !deformed_since_estimate();
   m_last_products = 0;
   if (fresh) return m_cached_limit;
   FrequencyOptions fo = m_options.frequency;
@@ -85,11 +88,39 @@ double Simulator::stable_step_limit() {
     m_damping_rate = 0;
   }
   m_estimate_time = m_time;
+  if (m_options.frequency_reuse_time > 0) record_estimate_lengths();
   m_cached_limit = m_frequency.omega_bound <= 0  // all fixed
                        ? std::numeric_limits<double>::infinity()
                        : fem::stable_step_limit(m_options.integrator, m_frequency.omega_bound,
                                                 m_model.damping(), m_damping_rate);
   return m_cached_limit;
+}
+
+void Simulator::record_estimate_lengths() {
+  const MatX4i& T = m_model.elastic().mesh().tets;
+  if (m_edges.empty() && T.rows() > 0) {
+    for (int e = 0; e < T.rows(); ++e)
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b)
+          m_edges.emplace_back(std::min(T(e, a), T(e, b)), std::max(T(e, a), T(e, b)));
+    std::sort(m_edges.begin(), m_edges.end());
+    m_edges.erase(std::unique(m_edges.begin(), m_edges.end()), m_edges.end());
+  }
+  m_estimate_lengths.resize(static_cast<Eigen::Index>(m_edges.size()));
+  for (size_t k = 0; k < m_edges.size(); ++k)
+    m_estimate_lengths[static_cast<Eigen::Index>(k)] =
+        (m_state.x.row(m_edges[k].first) - m_state.x.row(m_edges[k].second)).norm();
+}
+
+bool Simulator::deformed_since_estimate() const {
+  if (m_estimate_lengths.size() != static_cast<Eigen::Index>(m_edges.size())) return true;
+  const double tol = m_options.frequency_reuse_strain;
+  for (size_t k = 0; k < m_edges.size(); ++k) {
+    const double l0 = m_estimate_lengths[static_cast<Eigen::Index>(k)];
+    const double l = (m_state.x.row(m_edges[k].first) - m_state.x.row(m_edges[k].second)).norm();
+    if (!(std::abs(l - l0) <= tol * l0)) return true;
+  }
+  return false;
 }
 
 double Simulator::total_energy() {

@@ -1,6 +1,7 @@
 #pragma once
 /// Running a scene end to end: progress, per-range summaries, per-frame CSV,
 /// optional VTU/PVD time series. Shared by icd-run, icd-main and the tests.
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <vector>
@@ -94,6 +95,16 @@ std::vector<FrameMetrics> run_scene(const Scene& scene, const RunOptions& option
 /// `options` picks the encoding (ASCII by default, which read_vtu reads).
 void write_contact_spheres(World& world, size_t pair, int side, const std::filesystem::path& path,
                            const VtuOptions& options = {});
+
+/// Real-time mode over a run: frames with a deadline, how many met it, the
+/// worst lateness (s), frames where FEM alone exceeded it, and what was cut.
+struct RealTimeSummary {
+  int frames = 0, met = 0, fem_over = 0;
+  double worst_lateness = 0;
+  int min_budget_queries = 0, interrupted = 0;
+  int64_t untested = 0;  ///< untested sphere pairs left at the frames' ends (PAIRLIST)
+};
+RealTimeSummary summarize_real_time(const std::vector<FrameMetrics>& frames);
 
 /// The per-frame CSV (header + one row per frame).
 std::string metrics_csv(const std::vector<FrameMetrics>& frames);

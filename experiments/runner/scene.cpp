@@ -312,6 +312,8 @@ Scene parse_scene(const Json& json, const std::string& source,
   s.world.frame_rate = f.number("frame_rate", s.world.frame_rate, 0, 1e5, true);
   s.world.gravity = f.vec3("gravity", s.world.gravity, 1e4);
   s.world.target_fps = f.number("target_fps", s.world.target_fps, 0, 1e5);
+  s.world.min_query_budget = f.number("min_query_budget", s.world.min_query_budget, 0, 1, true);
+  s.world.threads = f.integer("threads", s.world.threads, 0, 1024);
   const Json* objects = f.get("objects");
   if (!objects || !objects->is_array() || objects->as_array().empty())
     f.fail("objects", "must be a non-empty array of objects");

@@ -109,8 +109,8 @@ Scene overlapping_scene(double target_fps) {
 // target leaves most of a 2 s frame to the query (which then completes, also
 // in a sanitizer build: the first of the frame's contact cycles gets its share
 // of the frame, which a 0.5 s frame made too short under ASan); an
-// impossible target leaves nothing, so every query gets the minimum budget and
-// answers interrupted -- and the simulation carries on without NaN.
+// impossible target leaves nothing, so every query gets the minimum budget
+// (WorldSettings::min_query_budget, here 1 us) and answers interrupted -- and the simulation carries on without NaN.
 TEST(RealTime, CollisionGetsWhatIsLeftOfTheFrame) {
   World slow = make_world(overlapping_scene(0.5), "", "");
   const FrameMetrics s = slow.step();
@@ -118,7 +118,9 @@ TEST(RealTime, CollisionGetsWhatIsLeftOfTheFrame) {
   EXPECT_LE(s.budget, 2.0);
   EXPECT_EQ(s.interrupted, 0);
 
-  World fast = make_world(overlapping_scene(1e5), "", "");
+  Scene tiny = overlapping_scene(1e5);
+  tiny.world.min_query_budget = 1e-6;  // the stated minimum (default 0.1 ms)
+  World fast = make_world(tiny, "", "");
   for (int f = 0; f < 3; ++f) {
     const FrameMetrics m = fast.step();
     EXPECT_EQ(m.budget, 1e-6);  // the 10 us frame is over before the query starts

@@ -269,6 +269,7 @@ UnstableRun unstable_run(EnergyCheck check, double overshoot, int max_retries) {
   o.energy_check = check;
   o.max_retries = max_retries;
   o.frequency_reuse_time = 1e9;
+  o.frequency_reuse_strain = std::numeric_limits<double>::infinity();  // frozen: no re-estimate
   UnstableRun u{std::make_unique<Simulator>(
       test::cantilever(1, test::material(MaterialModel::StVK, 1e7, 0.3), 0.0), o)};
   const int n = u.sim->model().num_nodes();

@@ -4,6 +4,8 @@
 #include <icd/fem/stable_step.hpp>
 
 #include <gtest/gtest.h>
+#include <cstdio>
+#include <limits>
 #include <Eigen/Eigenvalues>
 
 #include <icd/fem/integrators.hpp>
@@ -237,7 +239,8 @@ struct SqueezeFrame {
   AdvanceReport rep;
   double omega_start = 0, omega_end = 0;
 };
-std::vector<SqueezeFrame> squeeze(Integrator integ, double reuse_time, int frames, double frame) {
+std::vector<SqueezeFrame> squeeze(Integrator integ, double reuse_time, int frames, double frame,
+                                  double k = 150 /* 1/s */) {
   const TetMesh m = test::box(3, 3, 3, {0.3, 0.3, 0.3});
   const Material mat = test::material(MaterialModel::StableNeoHookean, 1e6, 0.45);
   Model model(m.V, m.T, mat);
@@ -245,9 +248,9 @@ std::vector<SqueezeFrame> squeeze(Integrator integ, double reuse_time, int frame
   SimulatorOptions o;
   o.integrator = integ;
   o.frequency_reuse_time = reuse_time;
+  if (reuse_time >= 1e9) o.frequency_reuse_strain = std::numeric_limits<double>::infinity();  // frozen
   Simulator sim(std::move(model), o);
   MatX3d v(m.V.rows(), 3);
-  const double k = 150;  // 1/s
   for (int i = 0; i < m.V.rows(); ++i)
     v.row(i) = k * Eigen::Vector3d(0.5 * (m.V(i, 0) - 0.15), 0.5 * (m.V(i, 1) - 0.15),
                                    -(m.V(i, 2) - 0.15));
@@ -300,6 +303,45 @@ TEST(StableStep, AutomaticStepStaysBelowTheTrueLimitWhileTheObjectStiffens) {
     }
     EXPECT_GT(worst, 1.05) << to_string(integ) << ": omega_max " << omega_min << " .. "
                            << omega_max;
+  }
+}
+
+// Amortised estimates (as coupling::World uses them: one estimate reused
+// for a whole frame, frequency_reuse_time, while the frame is advanced in
+// several detection/response cycles): one estimate per 10 ms reused over
+// ten advance() calls of 1 ms (each about one stable step), through the
+// same hard squeeze. Oracle: the dense generalized eigensolve at every
+// cycle's start and end state; no cycle's step may exceed the integrator's
+// limit for either (without the deformation trigger,
+// SimulatorOptions::frequency_reuse_strain = inf, symplectic Euler stepped
+// 13% above it). A gentle squeeze (30x slower) must reuse most estimates,
+// else nothing would be amortised.
+TEST(StableStep, AmortisedEstimateNeverStepsAboveTheTrueLimitOfAnyCycle) {
+  const double cycle = 1e-3;
+  const int cycles = 30;
+  for (Integrator integ : {Integrator::SymplecticEuler, Integrator::RK4}) {
+    int reused = 0;
+    double worst = 0, omega_lo = 1e300, omega_hi = 0;
+    for (const SqueezeFrame& pf : squeeze(integ, 1e-2, cycles, cycle)) {
+      const double truth = std::max(pf.omega_start, pf.omega_end);
+      EXPECT_EQ(pf.rep.retries, 0) << to_string(integ);
+      EXPECT_LE(pf.rep.step, stable_step_limit(integ, truth, {})) << to_string(integ);
+      worst = std::max(worst, pf.rep.step / stable_step_limit(integ, truth, {}));
+      reused += pf.rep.frequency_products == 0;
+      omega_lo = std::min(omega_lo, pf.omega_start);
+      omega_hi = std::max(omega_hi, pf.omega_start);
+    }
+    EXPECT_GT(omega_hi, 1.15 * omega_lo) << to_string(integ);  // the object did stiffen
+    int gentle_reused = 0;
+    for (const SqueezeFrame& pf : squeeze(integ, 1e-2, cycles, cycle, 5)) {
+      EXPECT_LE(pf.rep.step, stable_step_limit(integ, std::max(pf.omega_start, pf.omega_end), {}));
+      gentle_reused += pf.rep.frequency_products == 0;
+    }
+    EXPECT_GE(gentle_reused, cycles / 2) << to_string(integ);
+    std::printf("%s: estimates reused in %d of %d cycles (hard), %d (gentle)\n", to_string(integ),
+                reused, cycles, gentle_reused);
+    std::printf("%s: largest step / true limit %.3f, omega_max %.0f .. %.0f rad/s\n",
+                to_string(integ), worst, omega_lo, omega_hi);
   }
 }
 
