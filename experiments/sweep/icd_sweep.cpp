@@ -4,6 +4,7 @@
 // (--emit-slurm, then --case K per array task and --gather). The gathered
 // results.csv is byte-identical whichever backend ran the cases.
 // See experiments/sweep/README.md.
+#include "experiments/common/cli.hpp"
 #include <unistd.h>
 
 #include <algorithm>
@@ -234,45 +235,44 @@ int emit_slurm(const Plan& plan, const fs::path& out, const fs::path& self, std:
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{
-      "icd-sweep: runs a parameter study (a sweep file, JSON) as independent cases and gathers\n"
-      "one results.csv (sorted by case id) and results.md into --out. Finished cases are skipped\n"
+  icd::experiments::Cli cli(
+      "icd-sweep",
+      "Runs a parameter study (a sweep file, JSON) as independent cases and gathers one\n"
+      "results.csv (sorted by case id) and results.md into --out. Finished cases are skipped\n"
       "on re-run. Backends: a local process pool (default, -j N), MPI (mpirun -np N icd-sweep\n"
       "SWEEP.json), a Slurm job array (--emit-slurm; then --case K per task, --gather).\n"
-      "Exit status: 0 all cases ok, 1 a case not ok or a bad sweep file, 2 a bad command line.",
-      "icd-sweep"};
+      "Exit status: 0 all cases ok, 1 a case not ok or a bad sweep file, 2 a bad command line.");
+  std::filesystem::path sweep_path;
   std::string sweep_file, out_opt, backend = "auto";
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   long long case_k = -1;
   std::size_t chunk = 0;
   bool setup_only = false, gather_only = false, emit = false, list = false, force = false, quiet = false;
-  app.set_version_flag("--version", ICD_VERSION_STRING);
-  app.add_option("sweep", sweep_file, "the sweep file (JSON; see experiments/sweep/README.md)")->required();
-  app.add_option("--out", out_opt, "output folder (default results/sweeps/<sweep name>)");
-  app.add_option("-j,--jobs", jobs, "local backend: cases run at once (default: the CPU count)")
-      ->check(CLI::Range(1, 4096));
-  app.add_option("--backend", backend, "local, mpi, or auto (mpi when started by mpirun/srun)")
-      ->check(CLI::IsMember({"auto", "local", "mpi"}));
-  app.add_option("--case", case_k, "run only case K (with --chunk C: cases K*C .. K*C+C-1), no gather")
-      ->check(CLI::Range(0LL, 1LL << 40));
-  app.add_option("--chunk", chunk, "cases per --case task / Slurm array task (default 1; --emit-slurm: N/1000 rounded up)")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 30));
-  app.add_flag("--setup", setup_only, "run the sweep file's setup commands only (the Slurm setup step)");
-  app.add_flag("--gather", gather_only, "gather the finished cases' results only (the Slurm gather step)");
-  app.add_flag("--emit-slurm", emit, "write <out>/slurm/{array,gather}.sbatch and submit.sh, run nothing");
-  app.add_flag("--list", list, "print the expanded cases (index, id, parameters), run nothing");
-  app.add_flag("--force", force, "run the finished cases again too");
-  app.add_flag("--quiet", quiet, "no progress lines");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  cli.argument("SWEEP", sweep_path, "the sweep file (JSON; see experiments/sweep/README.md)", true)
+      .text("--out", out_opt, "DIR", "output folder (default results/sweeps/<sweep name>)")
+      .integer("-j,--jobs", jobs, "N", "local backend: cases run at once (default: the CPU count)", 1, 4096)
+      .custom("--backend", "auto|local|mpi", "local, mpi, or auto (mpi when started by mpirun/srun)",
+              [&](const std::string& v) {
+                if (v != "auto" && v != "local" && v != "mpi")
+                  throw std::invalid_argument("must be auto, local or mpi, not '" + v + "'");
+                backend = v;
+              })
+      .integer("--case", case_k, "K",
+               "run only case K (with --chunk C: cases K*C .. K*C+C-1), no gather", 0LL, 1LL << 40)
+      .integer("--chunk", chunk, "C",
+               "cases per --case task / Slurm array task (default 1; --emit-slurm: N/1000 rounded up)",
+               std::size_t{1}, std::size_t{1} << 30)
+      .flag("--setup", setup_only, "run the sweep file's setup commands only (the Slurm setup step)")
+      .flag("--gather", gather_only, "gather the finished cases' results only (the Slurm gather step)")
+      .flag("--emit-slurm", emit, "write <out>/slurm/{array,gather}.sbatch and submit.sh, run nothing")
+      .flag("--list", list, "print the expanded cases (index, id, parameters), run nothing")
+      .flag("--force", force, "run the finished cases again too")
+      .flag("--quiet", quiet, "no progress lines");
+  if (const auto status = cli.parse(argc, argv)) return *status;
+  sweep_file = sweep_path.string();
   const int modes = (case_k >= 0) + setup_only + gather_only + emit + list;
   if (modes > 1) {
-    std::fprintf(stderr, "icd-sweep: --case, --setup, --gather, --emit-slurm and --list exclude each other\n");
-    return 2;
+    return icd::experiments::Cli::fail("icd-sweep", "--case, --setup, --gather, --emit-slurm and --list exclude each other");
   }
   const fs::path self = fs::canonical("/proc/self/exe");
   bool use_mpi = backend == "mpi";
