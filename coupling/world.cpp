@@ -83,6 +83,11 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
     if (cs.layered) collision::enclose_children(o.asset.spheres);
     o.rest = o.asset.coarse.V;
     o.positions = o.rest;
+    if (o.plan.kinematic && o.setup.motion) {  // a scripted object starts at its pose at t = 0
+      o.pose = o.setup.motion(0);
+      o.positions = (o.rest * o.pose.rotation.toRotationMatrix().transpose()).rowwise() +
+                    o.pose.translation.transpose();
+    }
     o.contact_forces = MatX3d::Zero(o.rest.rows(), 3);
     if (o.plan.fem) {
       fem::ModelOptions mo;
@@ -186,9 +191,16 @@ int World::motion_cycles(double dt) const {
     }
   }
   if (!m_settings.collision.swept) return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
+  // Scripted objects: their speed over the coming frame, from their motion
+  // (the last cycle's speed may predate a keyframe).
+  std::vector<double> speed(m_objects.size());
+  for (size_t i = 0; i < m_objects.size(); ++i)
+    speed[i] = m_objects[i].setup.motion && m_objects[i].plan.kinematic
+                   ? std::max(m_objects[i].speed, scripted_motion(m_objects[i], dt) / dt)
+                   : m_objects[i].speed;
   for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
     const auto [i, j] = m_plan.pairs[p];
-    const double motion = (m_objects[i].speed + m_objects[j].speed) * dt;
+    const double motion = (speed[i] + speed[j]) * dt;
     const double step = m_settings.collision.cycle_motion * m_pair_leaf[p];
     if (step > 0) cycles = std::max(cycles, std::ceil(motion / step));
   }
@@ -207,6 +219,51 @@ void World::set_external_forces(int i, const MatX3d& forces) {
     throw ParameterError("object \"" + o.setup.name + "\": external forces must be finite");
   o.external_forces = forces;
   if (forces.size() == 0 && o.sim) o.sim->set_external_forces(MatX3d::Zero(o.rest.rows(), 3));
+}
+
+double World::scripted_motion(const RuntimeObject& o, double dt) const {
+  // Largest node displacement over [m_time, m_time + dt], sampled at 8
+  // points (a keyframe inside the frame bends the path).
+  constexpr int kSamples = 8;
+  double d = 0;
+  MatX3d prev = o.positions;
+  for (int s = 1; s <= kSamples; ++s) {
+    const RigidPose p = o.setup.motion(m_time + dt * s / kSamples);
+    const MatX3d x = (o.rest * p.rotation.toRotationMatrix().transpose()).rowwise() +
+                     p.translation.transpose();
+    d += (x - prev).rowwise().norm().maxCoeff();
+    prev = x;
+  }
+  return d;
+}
+
+void World::set_kinematic_motion(int i, MotionFunction motion) {
+  if (i < 0 || i >= static_cast<int>(m_objects.size()))
+    throw ParameterError("World::set_kinematic_motion: no object " + std::to_string(i));
+  RuntimeObject& o = m_objects[static_cast<size_t>(i)];
+  if (!o.plan.kinematic)
+    throw ParameterError("object \"" + o.setup.name +
+                         "\": only a rigid (kinematic) object can be scripted");
+  o.setup.motion = std::move(motion);
+}
+
+void World::set_kinematic_pose(int i, const RigidPose& pose) {
+  if (!pose.translation.allFinite() || !std::isfinite(pose.rotation.norm()) ||
+      !(pose.rotation.norm() > 0))
+    throw ParameterError("World::set_kinematic_pose: the pose must be finite, with a non-zero quaternion");
+  const RigidPose from = i >= 0 && i < static_cast<int>(m_objects.size())
+                             ? m_objects[static_cast<size_t>(i)].pose
+                             : RigidPose{};
+  RigidPose to = pose;
+  to.rotation.normalize();
+  const double t0 = m_time, t1 = m_time + 1.0 / m_settings.frame_rate;
+  set_kinematic_motion(i, [from, to, t0, t1](double t) {
+    const double s = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    RigidPose p;
+    p.translation = (1 - s) * from.translation + s * to.translation;
+    p.rotation = from.rotation.slerp(s, to.rotation);
+    return p;
+  });
 }
 
 int World::contact_cycles(double dt) const {
@@ -262,7 +319,12 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         resolve_obstacles(o, lo, hi, last, m);
       }
     } else if (o.plan.kinematic) {
-      o.positions.rowwise() += (h * o.setup.velocity).transpose();
+      if (o.setup.motion)
+        o.pose = o.setup.motion(t_end);
+      else
+        o.pose.translation += h * o.setup.velocity;
+      o.positions = (o.rest * o.pose.rotation.toRotationMatrix().transpose()).rowwise() +
+                    o.pose.translation.transpose();
     }
   }
   m.times.fem += seconds_since(t0);
@@ -576,9 +638,11 @@ bool World::contact_free() const {
 void World::save(Snapshot& s) const {
   s.positions.resize(m_objects.size());
   s.velocities.resize(m_objects.size());
+  s.poses.resize(m_objects.size());
   for (size_t i = 0; i < m_objects.size(); ++i) {
     const RuntimeObject& o = m_objects[i];
     s.positions[i] = o.positions;
+    s.poses[i] = o.pose;
     if (o.sim) s.velocities[i] = o.sim->velocities();
   }
   s.fronts = m_fronts;
@@ -597,6 +661,7 @@ void World::restore(const Snapshot& s) {
   for (size_t i = 0; i < m_objects.size(); ++i) {
     RuntimeObject& o = m_objects[i];
     o.positions = s.positions[i];
+    o.pose = s.poses[i];
     o.contact_forces.setZero();  // the trial started contact-free: no forces
     if (o.sim) {
       o.sim->set_positions(s.positions[i]);

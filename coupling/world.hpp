@@ -111,6 +111,8 @@ struct RuntimeObject {
   double max_link = 0;
   double obstacle_scale = 0;
   MatX3d obstacle_dense;
+  /// Kinematic objects: the current pose (positions = pose * rest).
+  RigidPose pose;
 };
 
 /// A simulation: objects, the plan of the stages they need, and the frame loop.
@@ -131,6 +133,17 @@ class World {
   /// matrix removes them). Throws ParameterError for a wrong shape or a
   /// non-finite entry, naming the object.
   void set_external_forces(int i, const MatX3d& forces);
+  /// Scripts kinematic (rigid) object `i`: from the next cycle on it is
+  /// placed at motion(t) * rest (t: simulated time at the end of each cycle);
+  /// an empty function returns it to its constant velocity from its current
+  /// pose. Throws ParameterError when the object is not rigid.
+  void set_kinematic_motion(int i, MotionFunction motion);
+  /// Moves kinematic object `i` to `pose` (of its rest nodes) over the next
+  /// frame (translation linear, rotation slerp, from its current pose), then
+  /// holds it there: a probe driven frame by frame (haptics, Python).
+  void set_kinematic_pose(int i, const RigidPose& pose);
+  /// Simulated time at the end of the last frame, s.
+  double time() const { return m_time; }
 
   /// The last query of each collision pair (same order as plan().pairs).
   const std::vector<collision::CollisionResult>& results() const { return m_results; }
@@ -165,6 +178,8 @@ class World {
   /// collision.cycle_motion leaf radii relative to each other per cycle,
   /// from each object's last measured sphere speed.
   int motion_cycles(double dt) const;
+  /// Largest node displacement of scripted object o over the next dt, m.
+  double scripted_motion(const RuntimeObject& o, double dt) const;
   /// Spheres at the current (actual) positions: start of the next sweep.
   void reset_sweep_start();
   /// Projects object o's dense surface out of the static obstacles (see
@@ -182,6 +197,7 @@ class World {
   /// State a rolled-back frame returns to.
   struct Snapshot {
     std::vector<MatX3d> positions, velocities;
+    std::vector<RigidPose> poses;
     std::vector<std::vector<collision::NodePair>> fronts;
     std::vector<collision::CollisionResult> complete;
     std::vector<double> complete_time, complete_depth;
