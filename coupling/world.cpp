@@ -168,7 +168,7 @@ void World::reset_sweep_start() {
   if (!m_settings.collision.swept) return;
   for (RuntimeObject& o : m_objects)
     if (o.plan.sphere_update) {
-      collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+      update_spheres(o);
       if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
       o.start_spheres = o.asset.spheres.spheres;
     }
@@ -279,6 +279,24 @@ int World::contact_cycles(double dt) const {
                     kMaxContactCycles);
 }
 
+void World::update_spheres(RuntimeObject& o) const {
+  if (o.plan.kinematic) {
+    // Rigid motion: the rest spheres move with the pose, radii unchanged
+    // (the paper's ratio update is meant for deformation; under a rotation
+    // its centre, moved by the mean node displacement, drifts and the ratio
+    // of nodes near the centre inflates the radius).
+    const Eigen::Matrix3d r = o.pose.rotation.toRotationMatrix();
+    collision::SphereTree& t = o.asset.spheres;
+    for (size_t k = 0; k < t.spheres.size(); ++k) {
+      const collision::Sphere& s0 = t.rest_spheres[k];
+      const Eigen::Vector3d c = r * s0.center() + o.pose.translation;
+      t.spheres[k] = {c.x(), c.y(), c.z(), s0.r + m_settings.collision.update.margin};
+    }
+    return;
+  }
+  collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+}
+
 void World::update_dense(RuntimeObject& o) {
   if (o.dense.rows() != o.asset.dense.V.rows()) o.dense.resize(o.asset.dense.V.rows(), 3);
   o.links.apply(o.positions, o.dense);
@@ -343,7 +361,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
   for (RuntimeObject& o : m_objects)
     if (o.plan.sphere_update) {
       if (cs.swept) {  // the spheres at the end of the cycle (actual positions)
-        collision::update_spheres(o.asset.spheres, o.rest, o.positions, cs.update);
+        update_spheres(o);
         if (cs.layered) collision::enclose_children(o.asset.spheres);
         o.end_spheres = o.asset.spheres.spheres;
       }
@@ -360,7 +378,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       } else if (cs.swept) {
         o.motion = collision::sweep_spheres(o.start_spheres, o.end_spheres, o.swept);
       } else {
-        collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+        update_spheres(o);
         if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
       }
       if (cs.swept) {
@@ -582,6 +600,10 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
   MatX3d corr(n, 3), dir = MatX3d::Zero(n, 3);
   o.obstacle_dense.resize(o.asset.links.num_links(), 3);
   const auto& nodes = o.asset.links.nodes;
+  // Fixed nodes stay where they are (a vertex held only by fixed nodes stays
+  // inside; obstacle_depth reports it).
+  std::vector<char> fixed(static_cast<size_t>(n), 0);
+  for (int j : o.setup.fixed_nodes) fixed[static_cast<size_t>(j)] = 1;
   // A few passes: a vertex whose three nodes moved by different amounts
   // moves by their weighted mean plus a small rotation of its link.
   constexpr int kPasses = 6;
@@ -605,7 +627,8 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
         const Eigen::Vector3d need = -d * nrm;
         for (int k = 0; k < 3; ++k) {
           const int j = nodes(v, k);
-          if (need.squaredNorm() > corr.row(j).squaredNorm()) corr.row(j) = need.transpose();
+          if (!fixed[static_cast<size_t>(j)] && need.squaredNorm() > corr.row(j).squaredNorm())
+            corr.row(j) = need.transpose();
         }
       }
     }

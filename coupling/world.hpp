@@ -164,6 +164,9 @@ class World {
   using Clock = std::chrono::steady_clock;
   FrameMetrics advance(std::optional<double> budget_seconds);
   void update_dense(RuntimeObject& o);
+  /// The sphere tree of o follows its coarse nodes (rigidly, with its pose,
+  /// for a kinematic object).
+  void update_spheres(RuntimeObject& o) const;
   /// Exact reference, frame counter and wall time at the end of step().
   FrameMetrics finish_frame(FrameMetrics& m, Clock::time_point frame_start);
   /// One detection/response cycle of length h (s) inside a frame, ending at
