@@ -4,6 +4,7 @@
 #include <exception>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <icd/config.hpp>
 #include <icd/mesh/core/input_file.hpp>
@@ -13,10 +14,13 @@ namespace {
 
 void usage() {
   std::printf(
-      "usage: icd-run SCENE.json [--out DIR] [--frames N] [--target-fps F] [--dry-run] [--quiet]\n"
+      "usage: icd-run SCENE.json [--out DIR] [--frames N] [--target-fps F] [--set KEY=VALUE]...\n"
+      "               [--dry-run] [--quiet]\n"
       "  --out DIR    results folder (default: results/<scene name as a file name>)\n"
       "  --frames N   override the scene's frame count (1 to 100000000)\n"
       "  --target-fps F  real-time mode at F frames per second (0 = off; overrides the scene)\n"
+      "  --set KEY=VALUE  override a scene field (repeatable; KEY dotted, array indices as\n"
+      "               numbers, e.g. objects.1.material.young=2e5; VALUE JSON, else a string)\n"
       "  --dry-run    print the stages the scene needs and check its input files, run nothing\n"
       "  --quiet      no progress bar\n");
 }
@@ -28,6 +32,7 @@ int main(int argc, char** argv) {
   int frames = -1;
   double target_fps = -1;
   bool dry = false, quiet = false;
+  std::vector<std::string> overrides;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc) {
@@ -49,6 +54,8 @@ int main(int argc, char** argv) {
                      icd::escape_bytes(argv[i]).c_str());
         return 2;
       }
+    } else if (a == "--set" && i + 1 < argc) {
+      overrides.push_back(argv[++i]);
     } else if (a == "--dry-run") {
       dry = true;
     } else if (a == "--quiet") {
@@ -69,7 +76,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    const icd::runner::Scene scene = icd::runner::load_scene(scene_path);
+    const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
     std::printf("scene \"%s\": %zu objects, %d frames at %g Hz\n", scene.name.c_str(),
                 scene.objects.size(), frames >= 0 ? frames : scene.frames, scene.world.frame_rate);
     for (const std::string& line : icd::runner::describe_plan(scene))
