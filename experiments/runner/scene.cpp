@@ -111,7 +111,9 @@ void merge_into(Json& base, const Json& over) {
 
 Json read_with_includes(const std::filesystem::path& path, std::vector<std::filesystem::path>& chain) {
   const std::string source = path.string();
-  std::filesystem::path id = std::filesystem::weakly_canonical(path);
+  std::error_code ec;
+  std::filesystem::path id = std::filesystem::weakly_canonical(path, ec);
+  if (ec) id = std::filesystem::absolute(path, ec).lexically_normal();
   for (const auto& c : chain)
     if (c == id) {
       std::string list;
@@ -696,6 +698,15 @@ coupling::WorldSettings world_settings(const Scene& scene) {
 
 Json parse_json(std::string_view text, const std::string& source) {
   text = strip_utf8_bom(text);
+  if (text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') || (text[0] == '\xfe' && text[1] == '\xff')))
+    throw InputError(located(source, text, 0) +
+                     ": unexpected character '" + escape_bytes(text.substr(0, 1)) +
+                     "': a UTF-16 byte-order mark (scene files are UTF-8)");
+  // nlohmann-json ends the input at a NUL byte (anything after it would be
+  // silently ignored): refuse it.
+  if (const size_t nul = text.find('\0'); nul != std::string_view::npos)
+    throw InputError(located(source, text, nul) +
+                     ": unexpected character '\\x00' (a NUL byte; not a JSON text file?)");
   ParseGuard guard(source);
   try {
     return Json::parse(text, std::ref(guard), /*allow_exceptions=*/true, /*ignore_comments=*/true);

@@ -73,6 +73,11 @@ TEST(SceneJson, MalformedInputsGiveLocatedErrors) {
       {"\n\n  ]", "t:3:3:"},
       {"{\"a\": 1 /* unterminated", "comment"},
   };
+  // nlohmann stops at a NUL byte; the reader refuses it instead of ignoring the rest.
+  for (const std::string text : {std::string("{\"a\": 1}\0{\"b\"", 13), std::string("\"a\0b\"", 5)}) {
+    const std::string msg = input_error([&] { parse_json(text, "t"); });
+    EXPECT_NE(msg.find("unexpected character '\\x00'"), std::string::npos) << msg;
+  }
   for (const auto& c : cases) {
     const std::string msg = input_error([&] { parse_json(c.text, "t"); });
     EXPECT_NE(msg.find(c.expect), std::string::npos) << c.text << " -> " << msg;
