@@ -112,6 +112,11 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
     if (cs.layered) collision::enclose_children(o.asset.spheres);
     o.rest = o.asset.coarse.V;
     o.positions = o.rest;
+    if (o.plan.kinematic && o.setup.motion) {  // a scripted object starts at its pose at t = 0
+      o.pose = o.setup.motion(0);
+      o.positions = (o.rest * o.pose.rotation.toRotationMatrix().transpose()).rowwise() +
+                    o.pose.translation.transpose();
+    }
     o.contact_forces = MatX3d::Zero(o.rest.rows(), 3);
     if (o.plan.fem) {
       fem::ModelOptions mo;
@@ -199,7 +204,7 @@ void World::reset_sweep_start() {
   if (!m_settings.collision.swept) return;
   for (RuntimeObject& o : m_objects)
     if (o.plan.sphere_update) {
-      collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+      update_spheres(o);
       if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
       o.start_spheres = o.asset.spheres.spheres;
     }
@@ -222,9 +227,16 @@ int World::motion_cycles(double dt) const {
     }
   }
   if (!m_settings.collision.swept) return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
+  // Scripted objects: their speed over the coming frame, from their motion
+  // (the last cycle's speed may predate a keyframe).
+  std::vector<double> speed(m_objects.size());
+  for (size_t i = 0; i < m_objects.size(); ++i)
+    speed[i] = m_objects[i].setup.motion && m_objects[i].plan.kinematic
+                   ? std::max(m_objects[i].speed, scripted_motion(m_objects[i], dt) / dt)
+                   : m_objects[i].speed;
   for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
     const auto [i, j] = m_plan.pairs[p];
-    const double motion = (m_objects[i].speed + m_objects[j].speed) * dt;
+    const double motion = (speed[i] + speed[j]) * dt;
     const double step = m_settings.collision.cycle_motion * m_pair_leaf[p];
     if (step > 0) cycles = std::max(cycles, std::ceil(motion / step));
   }
@@ -245,6 +257,51 @@ void World::set_external_forces(int i, const MatX3d& forces) {
   if (forces.size() == 0 && o.sim) o.sim->set_external_forces(MatX3d::Zero(o.rest.rows(), 3));
 }
 
+double World::scripted_motion(const RuntimeObject& o, double dt) const {
+  // Largest node displacement over [m_time, m_time + dt], sampled at 8
+  // points (a keyframe inside the frame bends the path).
+  constexpr int kSamples = 8;
+  double d = 0;
+  MatX3d prev = o.positions;
+  for (int s = 1; s <= kSamples; ++s) {
+    const RigidPose p = o.setup.motion(m_time + dt * s / kSamples);
+    const MatX3d x = (o.rest * p.rotation.toRotationMatrix().transpose()).rowwise() +
+                     p.translation.transpose();
+    d += (x - prev).rowwise().norm().maxCoeff();
+    prev = x;
+  }
+  return d;
+}
+
+void World::set_kinematic_motion(int i, MotionFunction motion) {
+  if (i < 0 || i >= static_cast<int>(m_objects.size()))
+    throw ParameterError("World::set_kinematic_motion: no object " + std::to_string(i));
+  RuntimeObject& o = m_objects[static_cast<size_t>(i)];
+  if (!o.plan.kinematic)
+    throw ParameterError("object \"" + o.setup.name +
+                         "\": only a rigid (kinematic) object can be scripted");
+  o.setup.motion = std::move(motion);
+}
+
+void World::set_kinematic_pose(int i, const RigidPose& pose) {
+  if (!pose.translation.allFinite() || !std::isfinite(pose.rotation.norm()) ||
+      !(pose.rotation.norm() > 0))
+    throw ParameterError("World::set_kinematic_pose: the pose must be finite, with a non-zero quaternion");
+  const RigidPose from = i >= 0 && i < static_cast<int>(m_objects.size())
+                             ? m_objects[static_cast<size_t>(i)].pose
+                             : RigidPose{};
+  RigidPose to = pose;
+  to.rotation.normalize();
+  const double t0 = m_time, t1 = m_time + 1.0 / m_settings.frame_rate;
+  set_kinematic_motion(i, [from, to, t0, t1](double t) {
+    const double s = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    RigidPose p;
+    p.translation = (1 - s) * from.translation + s * to.translation;
+    p.rotation = from.rotation.slerp(s, to.rotation);
+    return p;
+  });
+}
+
 int World::contact_cycles(double dt) const {
   if (!m_plan.response) return 1;
   // Conservative: the largest node stiffness (at least k) on the lightest
@@ -256,6 +313,24 @@ int World::contact_cycles(double dt) const {
   const double omega = std::sqrt(k / m_min_node_mass);
   return std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1,
                     kMaxContactCycles);
+}
+
+void World::update_spheres(RuntimeObject& o) const {
+  if (o.plan.kinematic) {
+    // Rigid motion: the rest spheres move with the pose, radii unchanged
+    // (the paper's ratio update is meant for deformation; under a rotation
+    // its centre, moved by the mean node displacement, drifts and the ratio
+    // of nodes near the centre inflates the radius).
+    const Eigen::Matrix3d r = o.pose.rotation.toRotationMatrix();
+    collision::SphereTree& t = o.asset.spheres;
+    for (size_t k = 0; k < t.spheres.size(); ++k) {
+      const collision::Sphere& s0 = t.rest_spheres[k];
+      const Eigen::Vector3d c = r * s0.center() + o.pose.translation;
+      t.spheres[k] = {c.x(), c.y(), c.z(), s0.r + m_settings.collision.update.margin};
+    }
+    return;
+  }
+  collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
 }
 
 void World::update_dense(RuntimeObject& o) {
@@ -304,7 +379,12 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         resolve_obstacles(o, lo, hi);
       }
     } else if (o.plan.kinematic) {
-      o.positions.rowwise() += (h * o.setup.velocity).transpose();
+      if (o.setup.motion)
+        o.pose = o.setup.motion(t_end);
+      else
+        o.pose.translation += h * o.setup.velocity;
+      o.positions = (o.rest * o.pose.rotation.toRotationMatrix().transpose()).rowwise() +
+                    o.pose.translation.transpose();
     }
   });
   // Reduced in object order (the same sums for any thread count).
@@ -341,7 +421,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
     RuntimeObject& o = m_objects[static_cast<size_t>(k)];
     if (o.plan.sphere_update) {
       if (cs.swept) {  // the spheres at the end of the cycle (actual positions)
-        collision::update_spheres(o.asset.spheres, o.rest, o.positions, cs.update);
+        update_spheres(o);
         if (cs.layered) collision::enclose_children(o.asset.spheres);
         o.end_spheres = o.asset.spheres.spheres;
       }
@@ -358,7 +438,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       } else if (cs.swept) {
         o.motion = collision::sweep_spheres(o.start_spheres, o.end_spheres, o.swept);
       } else {
-        collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+        update_spheres(o);
         if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
       }
       if (cs.swept) {
@@ -581,6 +661,10 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
   MatX3d corr(n, 3), dir = MatX3d::Zero(n, 3);
   o.obstacle_dense.resize(o.asset.links.num_links(), 3);
   const auto& nodes = o.asset.links.nodes;
+  // Fixed nodes stay where they are (a vertex held only by fixed nodes stays
+  // inside; obstacle_depth reports it).
+  std::vector<char> fixed(static_cast<size_t>(n), 0);
+  for (int j : o.setup.fixed_nodes) fixed[static_cast<size_t>(j)] = 1;
   // A few passes: a vertex whose three nodes moved by different amounts
   // moves by their weighted mean plus a small rotation of its link.
   constexpr int kPasses = 6;
@@ -604,7 +688,8 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
         const Eigen::Vector3d need = -d * nrm;
         for (int k = 0; k < 3; ++k) {
           const int j = nodes(v, k);
-          if (need.squaredNorm() > corr.row(j).squaredNorm()) corr.row(j) = need.transpose();
+          if (!fixed[static_cast<size_t>(j)] && need.squaredNorm() > corr.row(j).squaredNorm())
+            corr.row(j) = need.transpose();
         }
       }
     }
@@ -637,9 +722,11 @@ bool World::contact_free() const {
 void World::save(Snapshot& s) const {
   s.positions.resize(m_objects.size());
   s.velocities.resize(m_objects.size());
+  s.poses.resize(m_objects.size());
   for (size_t i = 0; i < m_objects.size(); ++i) {
     const RuntimeObject& o = m_objects[i];
     s.positions[i] = o.positions;
+    s.poses[i] = o.pose;
     if (o.sim) s.velocities[i] = o.sim->velocities();
   }
   s.fronts = m_fronts;
@@ -658,6 +745,7 @@ void World::restore(const Snapshot& s) {
   for (size_t i = 0; i < m_objects.size(); ++i) {
     RuntimeObject& o = m_objects[i];
     o.positions = s.positions[i];
+    o.pose = s.poses[i];
     o.contact_forces.setZero();  // the trial started contact-free: no forces
     if (o.sim) {
       o.sim->set_positions(s.positions[i]);

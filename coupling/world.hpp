@@ -141,6 +141,8 @@ struct RuntimeObject {
   double cycle_min_step = 0;
   int cycle_obstacle_vertices = 0;
   double cycle_obstacle_depth = 0;
+  /// Kinematic objects: the current pose (positions = pose * rest).
+  RigidPose pose;
 };
 
 /// A simulation: objects, the plan of the stages they need, and the frame loop.
@@ -163,6 +165,17 @@ class World {
   /// matrix removes them). Throws ParameterError for a wrong shape or a
   /// non-finite entry, naming the object.
   void set_external_forces(int i, const MatX3d& forces);
+  /// Scripts kinematic (rigid) object `i`: from the next cycle on it is
+  /// placed at motion(t) * rest (t: simulated time at the end of each cycle);
+  /// an empty function returns it to its constant velocity from its current
+  /// pose. Throws ParameterError when the object is not rigid.
+  void set_kinematic_motion(int i, MotionFunction motion);
+  /// Moves kinematic object `i` to `pose` (of its rest nodes) over the next
+  /// frame (translation linear, rotation slerp, from its current pose), then
+  /// holds it there: a probe driven frame by frame (haptics, Python).
+  void set_kinematic_pose(int i, const RigidPose& pose);
+  /// Simulated time at the end of the last frame, s.
+  double time() const { return m_time; }
 
   /// The last query of each collision pair (same order as plan().pairs).
   const std::vector<collision::CollisionResult>& results() const { return m_results; }
@@ -183,6 +196,9 @@ class World {
   using Clock = std::chrono::steady_clock;
   FrameMetrics advance(std::optional<double> budget_seconds);
   void update_dense(RuntimeObject& o);
+  /// The sphere tree of o follows its coarse nodes (rigidly, with its pose,
+  /// for a kinematic object).
+  void update_spheres(RuntimeObject& o) const;
   /// Exact reference, frame counter and wall time at the end of step().
   FrameMetrics finish_frame(FrameMetrics& m, Clock::time_point frame_start);
   /// One detection/response cycle of length h (s) inside a frame, ending at
@@ -197,6 +213,8 @@ class World {
   /// collision.cycle_motion leaf radii relative to each other per cycle,
   /// from each object's last measured sphere speed.
   int motion_cycles(double dt) const;
+  /// Largest node displacement of scripted object o over the next dt, m.
+  double scripted_motion(const RuntimeObject& o, double dt) const;
   /// Spheres at the current (actual) positions: start of the next sweep.
   void reset_sweep_start();
   /// Projects object o's dense surface out of the static obstacles (see
@@ -214,6 +232,7 @@ class World {
   /// State a rolled-back frame returns to.
   struct Snapshot {
     std::vector<MatX3d> positions, velocities;
+    std::vector<RigidPose> poses;
     std::vector<std::vector<collision::NodePair>> fronts;
     std::vector<collision::CollisionResult> complete;
     std::vector<double> complete_time, complete_depth;

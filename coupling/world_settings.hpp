@@ -12,6 +12,7 @@
 #include <icd/collision/traversal.hpp>
 #include <icd/coupling/asset_bundle.hpp>
 #include <icd/coupling/contact_response.hpp>
+#include <icd/coupling/kinematic_motion.hpp>
 #include <icd/coupling/obstacle.hpp>
 #include <icd/fem/integrators.hpp>
 #include <icd/fem/material.hpp>
@@ -22,7 +23,7 @@ namespace icd::coupling {
 /// How an object moves.
 enum class ObjectKind {
   Deformable,  ///< explicit FEM on the coarse mesh (paper section 3)
-  Rigid,       ///< kinematic: moves with its initial velocity, no FEM
+  Rigid,       ///< kinematic: follows its motion (or its initial velocity), no FEM
   Static,      ///< never moves: no FEM, no sphere update
 };
 
@@ -36,6 +37,10 @@ struct ObjectSetup {
   std::vector<int> fixed_nodes;  ///< coarse node indices held fixed
   /// Initial velocity of a deformable object, constant velocity of a rigid one, m/s.
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  /// A rigid object with a motion is placed at motion(t) * rest at the end
+  /// of every cycle (t: simulated time, s) instead of moving with
+  /// `velocity` (e.g. KeyframeMotion::function(); World::set_kinematic_motion).
+  MotionFunction motion;
   /// false: the object takes no part in sphere-tree collisions (e.g. a static
   /// box that collides as an analytic obstacle, WorldSettings::obstacles).
   bool sphere_collisions = true;

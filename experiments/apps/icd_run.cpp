@@ -3,6 +3,7 @@
 #include <exception>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "experiments/common/cli.hpp"
 #include "experiments/runner/locations.hpp"
@@ -13,6 +14,7 @@ int main(int argc, char** argv) {
   int frames = -1;
   double target_fps = -1;
   bool dry = false, quiet = false;
+  std::vector<std::string> overrides;
   icd::experiments::Cli cli(
       "icd-run",
       "  Runs a scene file (experiments/scenes/, installed under share/icd/scenes).\n"
@@ -25,11 +27,15 @@ int main(int argc, char** argv) {
       .real("--target-fps", target_fps, "F",
             "real-time mode at F frames per second (0 = off; overrides the scene)", 0.0, 1e5)
       .path("--cache-dir", cache_dir, "DIR", "asset cache folder (see below)")
+      .custom("--set", "KEY=VALUE",
+              "override a scene field (repeatable; KEY dotted, array indices as numbers, e.g. "
+              "objects.1.material.young=2e5; VALUE JSON, else a string)",
+              [&](const std::string& v) { overrides.push_back(v); })
       .flag("--dry-run", dry, "print the stages the scene needs and check its input files, run nothing")
       .flag("--quiet", quiet, "no progress bar");
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
-    const icd::runner::Scene scene = icd::runner::load_scene(scene_path);
+    const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
     std::printf("scene \"%s\": %zu objects, %d frames at %g Hz\n", scene.name.c_str(),
                 scene.objects.size(), frames >= 0 ? frames : scene.frames, scene.world.frame_rate);
     for (const std::string& line : icd::runner::describe_plan(scene))

@@ -188,6 +188,7 @@ World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
                  const std::filesystem::path& tool_dir, const ChildLimits& limits) {
   check_scene_inputs(scene);
   std::vector<coupling::WorldObject> objects;
+  std::vector<MatX3d> loads;
   objects.reserve(scene.objects.size());
   coupling::WorldSettings settings = world_settings(scene);
   for (const ObjectSpec& spec : scene.objects) {
@@ -195,6 +196,7 @@ World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
     o.setup = spec;
     o.asset = load_object_asset(spec, cache_dir, tool_dir, limits);
     place_object(o.asset, spec);
+    loads.push_back(apply_regions(spec, o.setup, o.asset.coarse.V));  // selectors, keyframes
     if (analytic_box(spec)) {
       // A static box collides as what it is, an analytic box obstacle, not
       // through its sphere tree (whose leaves stand out of its faces).
@@ -211,7 +213,10 @@ World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
   }
   for (const std::string& w : scale_warnings(objects))
     std::fprintf(stderr, "[icd] warning: %s\n", w.c_str());
-  return World(std::move(objects), settings);
+  World world(std::move(objects), settings);
+  for (size_t i = 0; i < loads.size(); ++i)
+    if (loads[i].size() > 0) world.set_external_forces(static_cast<int>(i), loads[i]);
+  return world;
 }
 
 std::vector<std::string> scale_warnings(const std::vector<coupling::WorldObject>& objects) {

@@ -1,9 +1,12 @@
 #include "experiments/runner/scene.hpp"
 #include "experiments/runner/locations.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <set>
+#include <string_view>
 
 #include <icd/config.hpp>
 #include <icd/mesh/core/error.hpp>
@@ -12,6 +15,147 @@
 namespace icd::runner {
 namespace {
 
+constexpr int kMaxDepth = 64;
+constexpr int64_t kMaxValues = int64_t{1} << 20;
+constexpr int kMaxIncludeDepth = 8;
+
+// "<source>:<line>:<col>" of byte offset `pos` of `text`.
+std::string located(const std::string& source, std::string_view text, std::size_t pos) {
+  int line = 1, col = 1;
+  for (size_t i = 0; i < pos && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return source + ":" + std::to_string(line) + ":" + std::to_string(col);
+}
+
+// Tracks where the parser is (for duplicate keys), how deep and how many values.
+class ParseGuard {
+  struct Frame {
+    bool object;
+    long index;
+    std::string key;
+    std::set<std::string> keys;
+  };
+
+ public:
+  explicit ParseGuard(const std::string& source) : m_source(source) {}
+
+  bool operator()(int depth, Json::parse_event_t event, Json& parsed) {
+    using E = Json::parse_event_t;
+    if (event == E::object_start || event == E::array_start || event == E::value) {
+      if (++m_values > kMaxValues)
+        throw InputError(m_source + ": more than " + std::to_string(kMaxValues) +
+                         " values (not a scene file?)");
+      if (!m_stack.empty() && !m_stack.back().object) ++m_stack.back().index;
+    }
+    if (event == E::object_start || event == E::array_start) {
+      if (depth >= kMaxDepth)
+        throw InputError(m_source + ": " + path() + ": nesting deeper than " +
+                         std::to_string(kMaxDepth) + " levels");
+      m_stack.push_back({event == E::object_start, -1, {}, {}});
+    } else if (event == E::object_end || event == E::array_end) {
+      if (!m_stack.empty()) m_stack.pop_back();
+    } else if (event == E::key) {
+      Frame& f = m_stack.back();
+      f.key = parsed.get<std::string>();
+      if (!f.keys.insert(f.key).second)
+        throw InputError(m_source + ": " + path() + ": duplicate key \"" + escape_bytes(f.key) +
+                         "\"");
+    }
+    return true;
+  }
+
+ public:
+  /// Path of the value being read when the parser stopped (a number beyond
+  /// the double range: its key was seen, its value event was not).
+  std::string pending_path() const { return path(true); }
+
+ private:
+  std::string path(bool pending = false) const {
+    std::string p;
+    for (size_t i = 0; i < m_stack.size(); ++i) {
+      const Frame& f = m_stack[i];
+      if (f.object && f.key.empty() && f.keys.empty()) break;
+      const long index = f.index + (pending && i + 1 == m_stack.size() ? 1 : 0);
+      if (f.object)
+        p += (p.empty() ? "" : ".") + escape_bytes(f.key);
+      else if (index >= 0)
+        p += "[" + std::to_string(index) + "]";
+    }
+    return p.empty() ? "<root>" : p;
+  }
+
+  const std::string& m_source;
+  std::vector<Frame> m_stack;
+  int64_t m_values = 0;
+};
+
+// Deep merge: `over` wins; objects merge key by key.
+void merge_into(Json& base, const Json& over) {
+  if (!base.is_object() || !over.is_object()) {
+    base = over;
+    return;
+  }
+  for (auto it = over.begin(); it != over.end(); ++it) {
+    auto b = base.find(it.key());
+    if (b == base.end())
+      base[it.key()] = it.value();
+    else
+      merge_into(*b, it.value());
+  }
+}
+
+Json read_with_includes(const std::filesystem::path& path, std::vector<std::filesystem::path>& chain) {
+  const std::string source = path.string();
+  std::error_code ec;
+  std::filesystem::path id = std::filesystem::weakly_canonical(path, ec);
+  if (ec) id = std::filesystem::absolute(path, ec).lexically_normal();
+  for (const auto& c : chain)
+    if (c == id) {
+      std::string list;
+      for (const auto& d : chain) list += escape_bytes(d.string(), 4096) + " -> ";
+      throw InputError(escape_bytes(source, 4096) + ": include: cycle " + list +
+                       escape_bytes(id.string(), 4096));
+    }
+  if (static_cast<int>(chain.size()) > kMaxIncludeDepth)
+    throw InputError(escape_bytes(source, 4096) + ": include: nested more than " +
+                     std::to_string(kMaxIncludeDepth) + " deep");
+  Json j = read_json_file(source);
+  if (!j.is_object() || !j.contains("include")) return j;
+  const Json inc = j["include"];
+  j.erase("include");
+  std::vector<std::string> files;
+  if (inc.is_string()) {
+    files.push_back(inc.get<std::string>());
+  } else if (inc.is_array()) {
+    for (size_t k = 0; k < inc.size(); ++k) {
+      if (!inc[k].is_string())
+        throw InputError(escape_bytes(source, 4096) + ": include[" + std::to_string(k) +
+                         "]: must be a file path (a string)");
+      files.push_back(inc[k].get<std::string>());
+    }
+  } else {
+    throw InputError(escape_bytes(source, 4096) +
+                     ": include: must be a file path or an array of file paths");
+  }
+  chain.push_back(id);
+  Json merged = Json::object();
+  for (const std::string& f : files) {
+    if (f.empty()) throw InputError(escape_bytes(source, 4096) + ": include: empty path");
+    std::filesystem::path p(f);
+    if (p.is_relative()) p = path.parent_path() / p;
+    merge_into(merged, read_with_includes(p, chain));
+  }
+  chain.pop_back();
+  merge_into(merged, j);
+  return merged;
+}
+
 // Reads the fields of one JSON object, remembering the field path for
 // messages, and rejects fields nobody asked for.
 class Fields {
@@ -19,7 +163,7 @@ class Fields {
   Fields(const Json& j, std::string path, const std::string& source)
       : m_path(std::move(path)), m_source(source) {
     if (!j.is_object()) fail(m_path, std::string("must be an object, got ") + j.type_name());
-    m_obj = &j.as_object();
+    m_obj = &j;
   }
 
   [[noreturn]] void fail(const std::string& field, const std::string& what) const {
@@ -32,14 +176,14 @@ class Fields {
   const Json* get(const std::string& key) {
     m_used.insert(key);
     auto it = m_obj->find(key);
-    return it == m_obj->end() ? nullptr : &it->second;
+    return it == m_obj->end() ? nullptr : &*it;
   }
 
   double number(const std::string& key, double def, double lo, double hi, bool lo_open = false) {
     const Json* j = get(key);
     if (!j) return def;
     if (!j->is_number()) fail(path(key), std::string("must be a number, got ") + j->type_name());
-    const double v = j->as_number();
+    const double v = j->get<double>();
     if (!std::isfinite(v))
       fail(path(key), "must be a finite number, got one beyond the double range (about 1.8e308)");
     if (v < lo || v > hi || (lo_open && v == lo))
@@ -55,15 +199,15 @@ class Fields {
   bool boolean(const std::string& key, bool def) {
     const Json* j = get(key);
     if (!j) return def;
-    if (!j->is_bool()) fail(path(key), std::string("must be true or false, got ") + j->type_name());
-    return j->as_bool();
+    if (!j->is_boolean()) fail(path(key), std::string("must be true or false, got ") + j->type_name());
+    return j->get<bool>();
   }
   std::string string(const std::string& key, const std::string& def,
                      const std::vector<std::string>& allowed = {}) {
     const Json* j = get(key);
     if (!j) return def;
     if (!j->is_string()) fail(path(key), std::string("must be a string, got ") + j->type_name());
-    const std::string& s = j->as_string();
+    const std::string& s = j->get_ref<const std::string&>();
     if (!allowed.empty()) {
       bool ok = false;
       std::string list;
@@ -86,22 +230,51 @@ class Fields {
   Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& def, double limit) {
     const Json* j = get(key);
     if (!j) return def;
-    if (!j->is_array() || j->as_array().size() != 3)
-      fail(path(key), "must be an array of 3 numbers");
+    return vec3_of(*j, path(key), limit);
+  }
+  Eigen::Vector3d vec3_of(const Json& j, const std::string& at, double limit) const {
+    if (!j.is_array() || j.size() != 3) fail(at, "must be an array of 3 numbers");
     Eigen::Vector3d v;
     for (int k = 0; k < 3; ++k) {
-      const Json& e = j->as_array()[k];
-      if (!e.is_number()) fail(path(key) + "[" + std::to_string(k) + "]", "must be a number");
-      v[k] = e.as_number();
+      const Json& e = j[static_cast<size_t>(k)];
+      if (!e.is_number()) fail(at + "[" + std::to_string(k) + "]", "must be a number");
+      v[k] = e.get<double>();
       if (!(std::abs(v[k]) <= limit))
-        fail(path(key) + "[" + std::to_string(k) + "]", "magnitude above " + fmt(limit));
+        fail(at + "[" + std::to_string(k) + "]", "magnitude above " + fmt(limit));
     }
     return v;
   }
 
   void finish() const {
-    for (const auto& [key, value] : *m_obj)
-      if (!m_used.count(key)) fail(path(escape_bytes(key)), "unknown field");
+    for (auto it = m_obj->begin(); it != m_obj->end(); ++it)
+      if (!m_used.count(it.key())) {
+        std::string hint;  // the closest known field, if it is a likely typo
+        size_t best = 3;
+        for (const std::string& k : m_used) {
+          const size_t d = edit_distance(it.key(), k);
+          if (d < best && d < k.size()) {
+            best = d;
+            hint = " (did you mean \"" + k + "\"?)";
+          }
+        }
+        fail(path(escape_bytes(it.key())), "unknown field" + hint);
+      }
+  }
+
+  static size_t edit_distance(const std::string& a, const std::string& b) {
+    if (a.size() > 64 || b.size() > 64) return std::max(a.size(), b.size());
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      size_t diag = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        const size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1])});
+        diag = up;
+      }
+    }
+    return row[b.size()];
   }
 
   static std::string fmt(double v) {
@@ -111,13 +284,120 @@ class Fields {
   }
 
  private:
-  const Json::Object* m_obj = nullptr;
+  const Json* m_obj = nullptr;
   std::string m_path;
   const std::string& m_source;
   std::set<std::string> m_used;
 };
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// One selector {"box": ...} | {"plane": ...} | {"near": ...}, or an array of them.
+std::vector<RegionSelector> parse_regions(const Json& j, const std::string& at,
+                                          const std::string& source) {
+  std::vector<RegionSelector> out;
+  if (j.is_array()) {
+    if (j.empty()) throw InputError(source + ": " + at + ": must not be an empty array");
+    for (size_t k = 0; k < j.size(); ++k) {
+      const std::string item = at + "[" + std::to_string(k) + "]";
+      if (!j[k].is_object()) throw InputError(source + ": " + item + ": must be a region object");
+      auto r = parse_regions(j[k], item, source);
+      out.insert(out.end(), r.begin(), r.end());
+    }
+    return out;
+  }
+  Fields f(j, at, source);
+  const Json *box = f.get("box"), *plane = f.get("plane"), *near = f.get("near");
+  if ((box != nullptr) + (plane != nullptr) + (near != nullptr) != 1)
+    f.fail(at, "needs exactly one of \"box\", \"plane\" or \"near\"");
+  f.finish();
+  RegionSelector r;
+  if (box) {
+    Fields b(*box, f.path("box"), source);
+    r.type = RegionSelector::Type::Box;
+    if (!b.get("min") || !b.get("max")) b.fail(f.path("box"), "needs \"min\" and \"max\"");
+    r.a = b.vec3("min", r.a, 1e6);
+    r.b = b.vec3("max", r.b, 1e6);
+    if (!(r.a.array() <= r.b.array()).all()) b.fail(b.path("max"), "must be >= min in every coordinate");
+    b.finish();
+    r.field = source + ": " + f.path("box");
+  } else if (plane) {
+    Fields p(*plane, f.path("plane"), source);
+    r.type = RegionSelector::Type::Plane;
+    if (!p.get("point") || !p.get("normal")) p.fail(f.path("plane"), "needs \"point\" and \"normal\"");
+    r.a = p.vec3("point", r.a, 1e6);
+    r.b = p.vec3("normal", r.b, 1e6);
+    if (!(r.b.norm() > 0)) p.fail(p.path("normal"), "must be a non-zero vector");
+    r.b.normalize();
+    r.distance = p.number("tolerance", 0, 0, 1e6);
+    p.finish();
+    r.field = source + ": " + f.path("plane");
+  } else {
+    Fields n(*near, f.path("near"), source);
+    r.type = RegionSelector::Type::Near;
+    if (!n.get("point") || !n.get("distance")) n.fail(f.path("near"), "needs \"point\" and \"distance\"");
+    r.a = n.vec3("point", r.a, 1e6);
+    r.distance = n.number("distance", 0, 0, 1e6);
+    n.finish();
+    r.field = source + ": " + f.path("near");
+  }
+  out.push_back(r);
+  return out;
+}
+
+MotionSpec parse_motion(const Json& j, const std::string& at, const std::string& source) {
+  Fields f(j, at, source);
+  f.string("interpolation", "linear", {"linear"});
+  const Json* keys = f.get("keyframes");
+  if (!keys || !keys->is_array() || keys->empty())
+    f.fail(f.path("keyframes"), "must be a non-empty array of keyframes");
+  if (keys->size() > 100000) f.fail(f.path("keyframes"), "more than 100000 keyframes");
+  MotionSpec m;
+  for (size_t k = 0; k < keys->size(); ++k) {
+    Fields key((*keys)[k], f.path("keyframes") + "[" + std::to_string(k) + "]", source);
+    coupling::Keyframe kf;
+    if (!key.get("t") || !key.get("position"))
+      key.fail(f.path("keyframes") + "[" + std::to_string(k) + "]", "needs \"t\" and \"position\"");
+    kf.t = key.number("t", 0, 0, 1e9);
+    if (k > 0 && !(kf.t > m.keys.back().t))
+      key.fail(key.path("t"), "must be later than the previous key's (" + Fields::fmt(m.keys.back().t) +
+                                  "), got " + Fields::fmt(kf.t));
+    kf.position = key.vec3("position", kf.position, 1e6);
+    if (const Json* rot = key.get("rotation")) {
+      Fields r(*rot, key.path("rotation"), source);
+      const Json* q = r.get("quaternion");
+      const Json* axis = r.get("axis");
+      const bool angle = r.get("angle_deg") != nullptr;
+      if ((q != nullptr) == (axis != nullptr || angle))
+        r.fail(key.path("rotation"),
+               "needs either \"quaternion\": [w, x, y, z] or \"axis\": [x, y, z] with \"angle_deg\"");
+      if (q) {
+        if (!q->is_array() || q->size() != 4) r.fail(r.path("quaternion"), "must be [w, x, y, z], four numbers");
+        double c[4];
+        for (size_t i = 0; i < 4; ++i) {
+          if (!(*q)[i].is_number() || !std::isfinite((*q)[i].get<double>()) ||
+              std::abs((*q)[i].get<double>()) > 1e6)
+            r.fail(r.path("quaternion") + "[" + std::to_string(i) + "]", "must be a finite number");
+          c[i] = (*q)[i].get<double>();
+        }
+        kf.rotation = Eigen::Quaterniond(c[0], c[1], c[2], c[3]);
+        if (!(kf.rotation.norm() > 1e-12)) r.fail(r.path("quaternion"), "must not be zero");
+        kf.rotation.normalize();
+      } else {
+        if (!axis || !angle) r.fail(key.path("rotation"), "needs both \"axis\" and \"angle_deg\"");
+        const Eigen::Vector3d ax = r.vec3("axis", Eigen::Vector3d::UnitZ(), 1e6);
+        if (!(ax.norm() > 0)) r.fail(r.path("axis"), "must be a non-zero vector");
+        const double deg = r.number("angle_deg", 0, -1e6, 1e6);
+        kf.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, ax.normalized()));
+      }
+      r.finish();
+    }
+    key.finish();
+    m.keys.push_back(kf);
+  }
+  f.finish();
+  return m;
+}
 
 fem::Material parse_material(Fields& f) {
   fem::Material m;  // fields left out keep fem::Material's defaults
@@ -186,11 +466,10 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
     const Json* ray = m.get("rayleigh");
     if (ray) {
       const Eigen::Vector3d def(0, 0, 0);
-      if (!ray->is_array() || ray->as_array().size() != 2 || !ray->as_array()[0].is_number() ||
-          !ray->as_array()[1].is_number())
+      if (!ray->is_array() || ray->size() != 2 || !(*ray)[0].is_number() || !(*ray)[1].is_number())
         m.fail(m.path("rayleigh"), "must be [alpha, beta], two numbers");
-      o.damping.alpha = ray->as_array()[0].as_number();
-      o.damping.beta = ray->as_array()[1].as_number();
+      o.damping.alpha = (*ray)[0].get<double>();
+      o.damping.beta = (*ray)[1].get<double>();
       if (!(o.damping.alpha >= 0) || !(o.damping.beta >= 0) || o.damping.alpha > 1e6 ||
           o.damping.beta > 1)
         m.fail(m.path("rayleigh"), "needs 0 <= alpha <= 1e6 (1/s) and 0 <= beta <= 1 (s)");
@@ -204,14 +483,42 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
                                                : fem::Integrator::BackwardEuler;
   if (const Json* fixed = f.get("fixed_nodes")) {
     if (!fixed->is_array()) f.fail(f.path("fixed_nodes"), "must be an array of node indices");
-    for (size_t k = 0; k < fixed->as_array().size(); ++k) {
-      const Json& e = fixed->as_array()[k];
-      if (!e.is_number() || e.as_number() < 0 || e.as_number() != std::floor(e.as_number()) ||
-          e.as_number() > 1e9)
+    for (size_t k = 0; k < fixed->size(); ++k) {
+      const Json& e = (*fixed)[k];
+      const double v = e.is_number() ? e.get<double>() : -1;
+      if (!e.is_number() || v < 0 || v != std::floor(v) || v > 1e9)
         f.fail(f.path("fixed_nodes") + "[" + std::to_string(k) + "]",
                "must be a non-negative integer node index");
-      o.fixed_nodes.push_back(static_cast<int>(e.as_number()));
+      o.fixed_nodes.push_back(static_cast<int>(v));
     }
+  }
+  if (const Json* fixed = f.get("fixed")) o.fixed_regions = parse_regions(*fixed, f.path("fixed"), source);
+  if (const Json* loads = f.get("loads")) {
+    if (!loads->is_array()) f.fail(f.path("loads"), "must be an array of loads");
+    if (o.kind != ObjectKind::Deformable)
+      f.fail(f.path("loads"), "only a deformable object takes loads");
+    for (size_t k = 0; k < loads->size(); ++k) {
+      const std::string at = f.path("loads") + "[" + std::to_string(k) + "]";
+      Fields l((*loads)[k], at, source);
+      LoadSpec ls;
+      const Json* region = l.get("region");
+      if (!region) l.fail(at, "needs a \"region\"");
+      ls.region = parse_regions(*region, l.path("region"), source);
+      const bool per_node = l.get("force_per_node") != nullptr, total = l.get("total_force") != nullptr;
+      if (per_node == total)
+        l.fail(at, "needs exactly one of \"force_per_node\" and \"total_force\" (N)");
+      ls.total = total;
+      ls.force = l.vec3(total ? "total_force" : "force_per_node", ls.force, 1e9);
+      l.finish();
+      o.loads.push_back(ls);
+    }
+  }
+  if (const Json* motion = f.get("motion")) {
+    if (o.kind != ObjectKind::Rigid)
+      f.fail(f.path("motion"), "only a rigid (\"kind\": \"rigid\") object follows a motion");
+    if (o.velocity.norm() > 0)
+      f.fail(f.path("motion"), "a rigid object moves with its \"velocity\" or its \"motion\", not both");
+    o.motion = parse_motion(*motion, f.path("motion"), source);
   }
   f.finish();
   return o;
@@ -314,12 +621,13 @@ Scene parse_scene(const Json& json, const std::string& source,
   s.world.target_fps = f.number("target_fps", s.world.target_fps, 0, 1e5);
   s.world.min_query_budget = f.number("min_query_budget", s.world.min_query_budget, 0, 1, true);
   s.world.threads = f.integer("threads", s.world.threads, 0, 1024);
+  if (f.get("include"))
+    f.fail("include", "includes are resolved when a scene is read from a file (load_scene)");
   const Json* objects = f.get("objects");
-  if (!objects || !objects->is_array() || objects->as_array().empty())
+  if (!objects || !objects->is_array() || objects->empty())
     f.fail("objects", "must be a non-empty array of objects");
-  for (size_t i = 0; i < objects->as_array().size(); ++i)
-    s.objects.push_back(
-        parse_object(objects->as_array()[i], "objects[" + std::to_string(i) + "]", source));
+  for (size_t i = 0; i < objects->size(); ++i)
+    s.objects.push_back(parse_object((*objects)[i], "objects[" + std::to_string(i) + "]", source));
   std::set<std::string> names;
   for (size_t i = 0; i < s.objects.size(); ++i)
     if (!names.insert(s.objects[i].name).second)
@@ -328,10 +636,24 @@ Scene parse_scene(const Json& json, const std::string& source,
   if (const Json* c = f.get("collision")) s.world.collision = parse_collision(*c, source);
   if (const Json* obs = f.get("obstacles")) {
     if (!obs->is_array()) f.fail("obstacles", "must be an array of obstacles");
-    for (size_t k = 0; k < obs->as_array().size(); ++k) {
+    for (size_t k = 0; k < obs->size(); ++k) {
       const std::string path = "obstacles[" + std::to_string(k) + "]";
-      Fields o(obs->as_array()[k], path, source);
+      const Json& entry = (*obs)[k];
       coupling::Obstacle ob;
+      if (entry.is_object() && entry.contains("plane")) {  // {"plane": {"point", "normal"}}
+        Fields w(entry, path, source);
+        Fields o(*w.get("plane"), path + ".plane", source);
+        w.finish();
+        ob.type = coupling::Obstacle::Type::Plane;
+        ob.point = o.vec3("point", ob.point, 1e6);
+        ob.normal = o.vec3("normal", ob.normal, 1e6);
+        if (!(ob.normal.norm() > 0)) o.fail(o.path("normal"), "must be a non-zero vector");
+        ob.normal.normalize();
+        o.finish();
+        s.world.obstacles.push_back(ob);
+        continue;
+      }
+      Fields o(entry, path, source);
       const std::string type = o.string("type", "plane", {"plane", "box"});
       if (type == "plane") {
         ob.type = coupling::Obstacle::Type::Plane;
@@ -374,9 +696,144 @@ coupling::WorldSettings world_settings(const Scene& scene) {
   return w;
 }
 
-Scene load_scene(const std::filesystem::path& path) {
-  const Json j = read_json_file(path.string());
+Json parse_json(std::string_view text, const std::string& source) {
+  text = strip_utf8_bom(text);
+  if (text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') || (text[0] == '\xfe' && text[1] == '\xff')))
+    throw InputError(located(source, text, 0) +
+                     ": unexpected character '" + escape_bytes(text.substr(0, 1)) +
+                     "': a UTF-16 byte-order mark (scene files are UTF-8)");
+  // nlohmann-json ends the input at a NUL byte (anything after it would be
+  // silently ignored): refuse it.
+  if (const size_t nul = text.find('\0'); nul != std::string_view::npos)
+    throw InputError(located(source, text, nul) +
+                     ": unexpected character '\\x00' (a NUL byte; not a JSON text file?)");
+  ParseGuard guard(source);
+  try {
+    return Json::parse(text, std::ref(guard), /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const Json::parse_error& e) {
+    // "[json.exception.parse_error.101] parse error at line 1, column 5: syntax error ..."
+    std::string what = e.what();
+    const size_t colon = what.find(": ");
+    if (colon != std::string::npos) what = what.substr(colon + 2);
+    const size_t at = e.byte > 0 ? e.byte - 1 : 0;
+    throw InputError(located(source, text, at) + ": " + escape_bytes(what, 300));
+  } catch (const Json::out_of_range& e) {
+    if (e.id != 406) throw;
+    // A number beyond the double range (nlohmann refuses it while parsing):
+    // name the field, as the field readers do for an infinite value.
+    throw InputError(source + ": " + guard.pending_path() +
+                     ": must be a finite number, got one beyond the double range (about 1.8e308)");
+  }
+}
+
+Json read_json_file(const std::string& path) {
+  return parse_json(read_input_file(path, file_limits::kScene, "scene file"), path);
+}
+
+Json read_scene_json(const std::filesystem::path& path) {
+  std::vector<std::filesystem::path> chain;
+  return read_with_includes(path, chain);
+}
+
+void apply_overrides(Json& json, const std::vector<std::string>& overrides) {
+  for (const std::string& o : overrides) {
+    const std::string shown = "--set " + escape_bytes(o, 300);
+    const size_t eq = o.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(shown + ": expected key=value (e.g. objects.1.material.young=2e5)");
+    const std::string key = o.substr(0, eq), text = o.substr(eq + 1);
+    Json value = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (value.is_discarded()) value = text;  // not JSON: a string
+    Json* at = &json;
+    std::string path;
+    size_t start = 0;
+    while (true) {
+      const size_t dot = key.find('.', start);
+      const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+      if (part.empty()) throw InputError(shown + ": empty part in the key");
+      if (at->is_array()) {
+        const bool digits = part.find_first_not_of("0123456789") == std::string::npos && part.size() < 10;
+        if (!digits)
+          throw InputError(shown + ": " + (path.empty() ? "<root>" : path) +
+                           " is an array: expected an index, got \"" + escape_bytes(part) + "\"");
+        const size_t idx = std::stoul(part);
+        if (idx >= at->size())
+          throw InputError(shown + ": " + path + "[" + part + "]: index past the end (" + path +
+                           " has " + std::to_string(at->size()) + " entries)");
+        path += "[" + part + "]";
+        at = &(*at)[idx];
+      } else if (at->is_object() || at->is_null()) {
+        if (at->is_null()) *at = Json::object();
+        path += (path.empty() ? "" : ".") + part;
+        at = &(*at)[part];
+      } else {
+        throw InputError(shown + ": " + path + " is a " + at->type_name() +
+                         ", not an object or an array");
+      }
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    *at = std::move(value);
+  }
+}
+
+Scene load_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  Json j = read_scene_json(path);
+  apply_overrides(j, overrides);
   return parse_scene(j, path.string(), path.parent_path());
+}
+
+bool RegionSelector::contains(const Eigen::Vector3d& x) const {
+  switch (type) {
+    case Type::Box:
+      return (x.array() >= a.array()).all() && (x.array() <= b.array()).all();
+    case Type::Plane:
+      return (x - a).dot(b) <= distance;
+    case Type::Near:
+      return (x - a).norm() <= distance;
+  }
+  return false;
+}
+
+std::vector<int> select_nodes(const std::vector<RegionSelector>& regions, const MatX3d& positions) {
+  std::vector<char> in(static_cast<size_t>(positions.rows()), 0);
+  for (const RegionSelector& r : regions) {
+    int count = 0;
+    for (Eigen::Index v = 0; v < positions.rows(); ++v)
+      if (r.contains(positions.row(v).transpose())) {
+        in[static_cast<size_t>(v)] = 1;
+        ++count;
+      }
+    if (count == 0) {
+      const Eigen::Vector3d lo = positions.colwise().minCoeff(), hi = positions.colwise().maxCoeff();
+      throw InputError(r.field + ": selects no coarse node (the object's " +
+                       std::to_string(positions.rows()) + " coarse nodes span [" +
+                       Fields::fmt(lo.x()) + ", " + Fields::fmt(lo.y()) + ", " + Fields::fmt(lo.z()) +
+                       "] to [" + Fields::fmt(hi.x()) + ", " + Fields::fmt(hi.y()) + ", " +
+                       Fields::fmt(hi.z()) + "])");
+    }
+  }
+  std::vector<int> out;
+  for (size_t v = 0; v < in.size(); ++v)
+    if (in[v]) out.push_back(static_cast<int>(v));
+  return out;
+}
+
+MatX3d apply_regions(const ObjectSpec& spec, coupling::ObjectSetup& setup, const MatX3d& coarse) {
+  if (!spec.fixed_regions.empty()) {
+    std::set<int> fixed(setup.fixed_nodes.begin(), setup.fixed_nodes.end());
+    for (int v : select_nodes(spec.fixed_regions, coarse))
+      if (fixed.insert(v).second) setup.fixed_nodes.push_back(v);
+  }
+  if (spec.motion) setup.motion = coupling::KeyframeMotion(spec.motion->keys, spec.position).function();
+  if (spec.loads.empty()) return {};
+  MatX3d forces = MatX3d::Zero(coarse.rows(), 3);
+  for (const LoadSpec& l : spec.loads) {
+    const std::vector<int> nodes = select_nodes(l.region, coarse);
+    const Eigen::Vector3d f = l.total ? Eigen::Vector3d(l.force / static_cast<double>(nodes.size())) : l.force;
+    for (int v : nodes) forces.row(v) += f.transpose();
+  }
+  return forces;
 }
 
 }  // namespace icd::runner

@@ -11,12 +11,47 @@
 
 #include <Eigen/Core>
 
+#include <icd/coupling/kinematic_motion.hpp>
 #include <icd/coupling/primitive_asset.hpp>
 #include <icd/coupling/world_settings.hpp>
 
-#include "experiments/runner/json.hpp"
+#include <nlohmann/json.hpp>
 
 namespace icd::runner {
+
+/// A parsed JSON document (nlohmann::json: objects keep their keys sorted).
+using Json = nlohmann::json;
+
+/// Parses `text` as a scene document: JSON with // and /* */ comments, a
+/// leading UTF-8 byte-order mark skipped. Throws icd::InputError
+/// "<source>:<line>:<col>: <what>" on malformed input (raw bytes shown as
+/// \xNN) and "<source>: <field path>: duplicate key \"k\"" for a key given
+/// twice in one object; refuses nesting deeper than 64 and more than 2^20
+/// values. A number beyond the double range is kept as +-infinity (+-0 when
+/// it underflows), for the reader of the field to refuse with its name.
+Json parse_json(std::string_view text, const std::string& source);
+
+/// Reads and parses a file (parse_json); InputError names the file when it
+/// is missing, not a regular file (a folder, /dev/zero) or larger than
+/// icd::file_limits::kScene (checked before reading). No includes.
+Json read_json_file(const std::string& path);
+
+/// Reads a scene file with its includes: a top-level "include" (a path, or
+/// an array of paths, relative to the including file) names files whose
+/// documents are deep-merged under this one (objects merged key by key,
+/// anything else replaced; the including file wins; later includes win over
+/// earlier ones). Includes nest up to 8 deep; a cycle is an error naming the
+/// chain.
+Json read_scene_json(const std::filesystem::path& path);
+
+/// Applies "dotted.path=value" overrides to a scene document (after its
+/// includes): the path's parts are object keys or array indices
+/// ("objects.1.material.young=2e5"); the value is parsed as JSON, or taken
+/// as a string when it is not JSON ("name=probe run"). Missing object keys
+/// are created (an unknown one is then refused by parse_scene as in a file);
+/// an index past the end of an array, a path through a number or a string,
+/// or an override without '=' throws InputError naming the override.
+void apply_overrides(Json& json, const std::vector<std::string>& overrides);
 
 using coupling::CollisionSpec;
 using coupling::InterruptedResponse;
@@ -34,6 +69,43 @@ struct PreprocessSpec {
   std::string tree_fit = "light";
 };
 
+/// A region of an object's coarse nodes, selected after meshing and
+/// placement (in world coordinates, m).
+struct RegionSelector {
+  enum class Type {
+    Box,    ///< min <= x <= max, componentwise
+    Plane,  ///< (x - point) . normal <= tolerance (the negative side, normal unit)
+    Near,   ///< |x - point| <= distance
+  };
+  Type type = Type::Box;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();  ///< box min; plane or near point
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();  ///< box max; plane normal
+  double distance = 0;                          ///< near: distance; plane: tolerance
+  std::string field;  ///< "<file>: <field path>" for messages
+
+  bool contains(const Eigen::Vector3d& x) const;
+};
+
+/// The coarse nodes of `positions` (#V x 3) in any of `regions`, sorted.
+/// Throws InputError "<file>: <field>: selects no coarse node ..." for a
+/// region that matches none.
+std::vector<int> select_nodes(const std::vector<RegionSelector>& regions, const MatX3d& positions);
+
+/// A load on a region of a deformable object's coarse nodes: a force on each
+/// selected node, or a total force spread equally over them.
+struct LoadSpec {
+  std::vector<RegionSelector> region;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< N
+  bool total = false;  ///< force is the total over the region (else per node)
+};
+
+/// Keyframes of a rigid object's scripted motion; "position" places the
+/// object's "position" point (its bounding-box centre), "rotation" turns it
+/// about that point from its placed orientation.
+struct MotionSpec {
+  std::vector<coupling::Keyframe> keys;
+};
+
 /// One object of the scene: its role and physics (coupling::ObjectSetup)
 /// and where its geometry comes from.
 struct ObjectSpec : coupling::ObjectSetup {
@@ -47,7 +119,18 @@ struct ObjectSpec : coupling::ObjectSetup {
   /// "collider": a static box primitive collides as an analytic box obstacle
   /// ("analytic", default) or through its sphere tree ("spheres").
   bool analytic_collider = true;
+  /// "fixed": regions whose coarse nodes are held fixed (with fixed_nodes).
+  std::vector<RegionSelector> fixed_regions;
+  std::vector<LoadSpec> loads;       ///< "loads"
+  std::optional<MotionSpec> motion;  ///< "motion" (rigid objects)
 };
+
+/// Resolves the object's regions on its placed coarse nodes: appends the
+/// fixed regions' nodes to setup.fixed_nodes (no duplicates), sets
+/// setup.motion from the keyframes (pivot: spec.position), and returns the
+/// loads as forces per coarse node (#V x 3; empty when there are none).
+/// Throws InputError naming the field for a region that selects no node.
+MatX3d apply_regions(const ObjectSpec& spec, coupling::ObjectSetup& setup, const MatX3d& coarse);
 
 /// What the run writes.
 struct OutputSpec {
@@ -81,10 +164,11 @@ Scene parse_scene(const Json& json, const std::string& source,
 /// meshes kept up to date when the output writes them.
 coupling::WorldSettings world_settings(const Scene& scene);
 
-/// Reads and parses a scene file (read_json_file: a regular file of at most
-/// 64 MiB); relative paths resolve against its folder, then against the
-/// repository root (so shipped scenes find data/). The paths are only
-/// resolved here: check_scene_inputs (run.hpp) checks that they exist.
-Scene load_scene(const std::filesystem::path& path);
+/// Reads and parses a scene file (read_scene_json: regular files of at most
+/// 64 MiB, with their includes), after the `overrides` (apply_overrides);
+/// relative paths resolve against its folder, then against the repository
+/// root (so shipped scenes find data/). The paths are only resolved here:
+/// check_scene_inputs (run.hpp) checks that they exist.
+Scene load_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides = {});
 
 }  // namespace icd::runner

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "experiments/runner/json.hpp"
+#include "experiments/runner/scene.hpp"
 #include "experiments/runner/run.hpp"
 
 namespace icd::runner {

@@ -7,7 +7,6 @@
 #include <string>
 #include <string_view>
 
-#include "experiments/runner/json.hpp"
 #include "experiments/runner/scene.hpp"
 #include "tests/fuzz/fuzz_common.hpp"
 

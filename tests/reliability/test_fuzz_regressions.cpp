@@ -15,7 +15,6 @@
 #include <vector>
 
 #include <icd/collision/sph_io.hpp>
-#include "experiments/runner/json.hpp"
 #include "experiments/runner/scene.hpp"
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/io/surface_reader.hpp>

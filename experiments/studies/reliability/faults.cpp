@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "experiments/common/cli.hpp"
-#include "experiments/runner/json.hpp"
+#include "experiments/runner/scene.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/core/error.hpp>

@@ -3,7 +3,7 @@
 #include <limits>
 #include <sstream>
 
-#include "experiments/runner/json.hpp"
+#include "experiments/runner/scene.hpp"
 
 namespace icd::reliability {
 
