@@ -1,6 +1,7 @@
 // icd-main: the project's main job (README command 1): the default
 // bunny-dragon scene of the paper (experiments/scenes/bunny_dragon.json),
 // preprocessing the real meshes on first use.
+#include <vector>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
   std::filesystem::path scene_path = icd::runner::scenes_dir() / "bunny_dragon.json";
   std::filesystem::path cache_dir = icd::runner::default_cache_dir();
   int frames = -1;
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli("icd-main",
                                     "  The project's main job: the paper's bunny-dragon scene.");
   cli.path("--out", out, "DIR", "results folder (default: results/main)")
@@ -23,9 +25,10 @@ int main(int argc, char** argv) {
       .path("--cache-dir", cache_dir, "DIR",
             "asset cache folder (default: " + cache_dir.string() + ", see README Programs)")
       .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000);
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
-    const icd::runner::Scene scene = icd::runner::load_scene(scene_path);
+    const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
     std::printf("scene \"%s\" (%s)\n", scene.name.c_str(), scene_path.c_str());
     for (const std::string& line : icd::runner::describe_plan(scene))
       std::printf("  %s\n", line.c_str());

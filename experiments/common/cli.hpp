@@ -131,6 +131,15 @@ class Cli {
     return add(name, value_name, help, std::move(apply));
   }
 
+  /// The scene overrides every program that reads a scene takes:
+  /// `--set KEY=VALUE` (repeatable, applied in order; see runner::load_scene).
+  Cli& scene_overrides(std::vector<std::string>& target) {
+    return custom("--set", "KEY=VALUE",
+                  "override a scene field (repeatable; KEY dotted, array indices as numbers, e.g. "
+                  "objects.1.material.young=2e5; VALUE JSON, else a string)",
+                  [&target](const std::string& v) { target.push_back(v); });
+  }
+
   /// `v` as a whole number in [min, max] (all of it: "12x" is not 12);
   /// throws std::invalid_argument naming what is wrong.
   template <class Int>

@@ -2,6 +2,10 @@
 // and icd.World: a simulation built from objects or from a scene file,
 // stepped frame by frame, with positions, velocities and loads read and set,
 // and an optional callback before each frame (a scripted or haptic probe).
+#include <optional>
+#include <string>
+#include <vector>
+
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
@@ -20,6 +24,7 @@
 #endif
 
 #include "bindings.hpp"
+#include "experiments/runner/locations.hpp"
 #include "experiments/runner/run.hpp"
 #include "experiments/runner/scene.hpp"
 
@@ -203,13 +208,17 @@ void bind_coupling(py::module_& m) {
            py::arg("objects"), py::arg("settings") = coupling::WorldSettings{})
       .def_static(
           "from_scene",
-          [](const std::filesystem::path& scene_file) {
-            const runner::Scene scene = runner::load_scene(scene_file);
+          [](const std::filesystem::path& scene_file, const std::vector<std::string>& overrides,
+             std::optional<std::filesystem::path> cache_dir) {
+            const runner::Scene scene = runner::load_scene(scene_file, overrides);
             return std::make_unique<World>(runner::make_world(
-                scene, std::filesystem::path(ICD_SOURCE_DIR) / "assets", ICD_TOOL_DIR));
+                scene, cache_dir ? *cache_dir : runner::default_cache_dir(), ICD_TOOL_DIR));
           },
-          py::arg("path"),
-          "A World from a scene file (raw meshes are preprocessed into the asset cache).")
+          py::arg("path"), py::arg("overrides") = std::vector<std::string>{},
+          py::arg("cache_dir") = py::none(),
+          "A World from a scene file. overrides: [\"key=value\", ...] as icd-run's --set; "
+          "cache_dir: the asset cache (default: $ICD_CACHE_DIR, else as the programs: see "
+          "experiments/runner/locations.hpp), where raw meshes are preprocessed into.")
       .def_property_readonly("num_objects", [](World& w) { return w.objects().size(); })
       .def_property_readonly("names",
                              [](World& w) {

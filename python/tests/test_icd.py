@@ -97,6 +97,19 @@ class ModuleTest(unittest.TestCase):
         # Contact forces are equal and opposite: total momentum stays zero.
         self.assertLess(np.linalg.norm(p0 + p1), 1e-9 * m.sum())
 
+    def test_scene_overrides_as_icd_run_set(self):
+        scene = pathlib.Path(__file__).resolve().parents[2] / "experiments/scenes/two_spheres.json"
+        with tempfile.TemporaryDirectory() as cache:
+            moving = icd.World.from_scene(str(scene), cache_dir=cache)
+            still = icd.World.from_scene(
+                str(scene), overrides=["objects.0.velocity=[0,0,0]", "objects.1.velocity=[0, 0, 0]"],
+                cache_dir=cache)
+            # The scene's own velocities (0.6 m/s towards each other) against none.
+            self.assertAlmostEqual(float(moving.velocities(0)[:, 0].mean()), 0.6, places=9)
+            self.assertLess(float(np.abs(still.velocities(0)[:, 0]).max()), 1e-12)
+            with self.assertRaisesRegex(Exception, "velocty"):
+                icd.World.from_scene(str(scene), overrides=["objects.0.velocty=[0,0,0]"], cache_dir=cache)
+
     def test_external_force_accelerates_as_newton_says(self):
         ball = icd.make_primitive("sphere", radius=0.1, subdivisions=1, cells=3)
         w = icd.World([icd.WorldObject("b", ball, young=1e6)])

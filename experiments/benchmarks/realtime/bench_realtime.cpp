@@ -8,6 +8,7 @@
 // usage: bench_realtime [--frames N] [SCENE.json ...]
 //   default scenes: experiments/scenes/bunny_dragon.json (the main job) and
 //   experiments/scenes/many_objects.json; default 120 frames each.
+#include "experiments/common/cli.hpp"
 #include <time.h>
 
 #include <algorithm>
@@ -71,8 +72,9 @@ FrameMetrics timed_step(World& w, Series& s) {
   return m;
 }
 
-void run_scene(const std::filesystem::path& path, int frames, const std::filesystem::path& tools) {
-  icd::runner::Scene scene = icd::runner::load_scene(path);
+void run_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides, int frames,
+               const std::filesystem::path& tools) {
+  icd::runner::Scene scene = icd::runner::load_scene(path, overrides);
   const std::filesystem::path cache = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
   const double dt = 1.0 / scene.world.frame_rate;
   std::printf("\n== %s: %zu objects, %d frames of %.2f ms simulated, load before %s\n",
@@ -134,24 +136,16 @@ void run_scene(const std::filesystem::path& path, int frames, const std::filesys
 int main(int argc, char** argv) {
   int frames = 120;
   std::vector<std::filesystem::path> scenes;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--frames" && i + 1 < argc) {
-      frames = std::atoi(argv[++i]);
-      if (frames < 1 || frames > 100000) {
-        std::fprintf(stderr, "bench_realtime: --frames must be in 1..100000, got %s\n", argv[i]);
-        return 2;
-      }
-    } else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_realtime [--frames N] [SCENE.json ...]\n");
-      return 0;
-    } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "bench_realtime: unknown option %s\n", a.c_str());
-      return 2;
-    } else {
-      scenes.emplace_back(a);
-    }
-  }
+  std::vector<std::string> overrides;
+  icd::experiments::Cli cli(
+      "bench_realtime",
+      "  Each scene stepped with 1 thread (the previous path) and 2 threads, interleaved frame by\n"
+      "  frame, then in real-time mode at 60 Hz; wall and CPU time per frame (medians).\n"
+      "  Default scenes: experiments/scenes/bunny_dragon.json and many_objects.json.");
+  cli.arguments("SCENE", scenes, "scene files (JSON)", false)
+      .integer("--frames", frames, "N", "frames per configuration (default 120)", 1, 100000)
+      .scene_overrides(overrides);
+  if (const auto status = cli.parse(argc, argv)) return *status;
   if (scenes.empty()) {
     const std::filesystem::path root(ICD_SOURCE_DIR);
     scenes = {root / "experiments/scenes/bunny_dragon.json",
@@ -163,7 +157,7 @@ int main(int argc, char** argv) {
               std::max(1u, static_cast<unsigned>(std::thread::hardware_concurrency())),
               loadavg().c_str());
   try {
-    for (const auto& s : scenes) run_scene(s, frames, tools);
+    for (const auto& s : scenes) run_scene(s, overrides, frames, tools);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_realtime: %s\n", e.what());
     return 1;

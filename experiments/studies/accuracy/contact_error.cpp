@@ -200,6 +200,7 @@ int main(int argc, char** argv) {
   std::string budgets_text = "1e-6,3e-6,1e-5,3e-5,1e-4,3e-4,1e-3,3e-3,1e-2";
   std::string tests_text = "30,100,300,1000,3000,10000,30000,100000";
   int reps = 5, after = 3, max_frames = 200;
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli(
       "contact_error",
       "  Default scene experiments/scenes/bunny_dragon.json; writes DIR/contact_error.csv.");
@@ -210,11 +211,12 @@ int main(int argc, char** argv) {
       .integer("--reps", reps, "N", "repetitions per budget (default 5)", 1)
       .integer("--after", after, "N", "frames after first contact (default 3)", 0)
       .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1);
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     const std::vector<double> budgets = experiments::parse_list(budgets_text, "--budgets");
     const std::vector<double> test_budgets = experiments::parse_list(tests_text, "--test-budgets");
-    Scene scene = load_scene(scene_path);
+    Scene scene = load_scene(scene_path, overrides);
     scene.output = OutputSpec{};
     scene.world.target_fps = 0;
     scene.world.collision.query.budget_tests = -1;

@@ -125,6 +125,7 @@ int main(int argc, char** argv) {
   fs::path res_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
   std::string cells_text = "2,3,4,6,8";
   int frames = 60, reps = 5, fine = 12;
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli(
       "deformation_error",
       "  Defaults: bunny_dragon.json for the links, two_spheres.json with cells 2,3,4,6,8\n"
@@ -136,11 +137,12 @@ int main(int argc, char** argv) {
       .path("--resolution-scene", res_path, "FILE", "scene of the resolution experiment")
       .text("--cells", cells_text, "a,b,...", "coarse resolutions (cells per side)")
       .integer("--fine", fine, "N", "reference resolution (cells per side)", 1);
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     const std::vector<double> cells = experiments::parse_list(cells_text, "--cells");
-    auto prepare = [](const fs::path& p) {
-      Scene s = load_scene(p);
+    auto prepare = [&overrides](const fs::path& p) {
+      Scene s = load_scene(p, overrides);
       s.output = OutputSpec{};
       s.world.target_fps = 0;
       return s;

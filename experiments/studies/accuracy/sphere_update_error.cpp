@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
   fs::path out = "results/sphere_update";
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
   int frames = 60, every = 1, reps = 5;
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli(
       "sphere_update_error",
       "  Default scene experiments/scenes/two_spheres.json (octree trees, so the rebuilt tree\n"
@@ -68,12 +69,13 @@ int main(int argc, char** argv) {
       .integer("--frames", frames, "N", "frames", 1)
       .integer("--every", every, "N", "compare every N-th frame", 1)
       .integer("--reps", reps, "N", "timing repetitions (default 5)", 1);
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   std::ostringstream csv;
   csv << "scene,frame,object,method,seconds,uncovered_fraction,max_gap,tightness,leaf_spheres,"
          "max_displacement\n";
   try {
-    Scene scene = load_scene(scene_path);
+    Scene scene = load_scene(scene_path, overrides);
     scene.output = OutputSpec{};
     scene.world.target_fps = 0;
     World world = make_world(scene, fs::path(ICD_SOURCE_DIR) / "assets",

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
   std::string budgets_text = "1e-4,1e-3,1e-2,1e-1";
   int max_frames = 200, after = 3;
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli(
       "fig9",
       "  Default: experiments/scenes/bunny_dragon.json, critical times 1e-4,1e-3,1e-2,1e-1 s,\n"
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
       .text("--budgets", budgets_text, "a,b,...", "critical times (s)")
       .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1)
       .integer("--after", after, "N", "frames after first contact (default 3)", 0);
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   const fs::path cache = fs::path(ICD_SOURCE_DIR) / "assets";
   const fs::path tools = fs::canonical("/proc/self/exe").parent_path();
@@ -49,7 +51,7 @@ int main(int argc, char** argv) {
               "objects,spheres,failure\n";
   try {
     const std::vector<double> budgets = experiments::parse_list(budgets_text, "--budgets");
-    Scene scene = load_scene(scene_path);
+    Scene scene = load_scene(scene_path, overrides);
     scene.output = OutputSpec{};
     scene.world.target_fps = 0;
     scene.world.collision.query.budget_tests = -1;

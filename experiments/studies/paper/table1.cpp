@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
   bool time_budgets_given = false;
   int max_frames = 200, after = 3;
   double paper_scale = 1;  // our critical time x paper_scale = the paper's row we sit beside
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli(
       "table1",
       "  Runs each scene once per critical time (default 1e-4,1e-3,1e-2,1e-1,1 s) and\n"
@@ -113,6 +114,7 @@ int main(int argc, char** argv) {
       .real("--paper-scale", paper_scale, "F",
             "the paper's row at critical time x F sits beside ours (default 1)", 0.0)
       .integer("--after", after, "N", "frames after first contact (default 3)", 0);
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   if (!test_budgets.empty() && !time_budgets_given) budgets.clear();
   std::vector<std::pair<bool, double>> all;  // (tests?, budget)
@@ -127,7 +129,7 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   try {
     for (const fs::path& sp : scenes) {
-      Scene scene = load_scene(sp);
+      Scene scene = load_scene(sp, overrides);
       scene.output = OutputSpec{};
       scene.output.csv = false;
       scene.world.target_fps = 0;

@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
   int frames = 60, vtu_every = 10;
   long long budget = 2000;
   fs::path out = fs::temp_directory_path() / "icd_determinism";
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli(
       "determinism", "  Two runs of the scene compared file by file, then 1 and 2 FEM threads.");
   cli.text("--scene", scene_path, "FILE", "scene (default two_spheres.json)")
@@ -112,9 +113,10 @@ int main(int argc, char** argv) {
                -1LL)
       .integer("--vtu-every", vtu_every, "K", "VTU output every K frames (default 10)", 0)
       .path("--out", out, "DIR", "scratch folder");
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
-    runner::Scene scene = runner::load_scene(scene_path);
+    runner::Scene scene = runner::load_scene(scene_path, overrides);
     reliability::use_test_budget(scene, budget);
     scene.frames = frames;
     scene.output.csv = true;

@@ -24,6 +24,7 @@
 // which for an interrupted query are springs between coarse spheres assumed
 // colliding, a number the objects never receive in full (see the runner's
 // collision.passive). Both ratios to the initial energy are reported.
+#include <vector>
 #include <unistd.h>
 
 #include <algorithm>
@@ -110,8 +111,10 @@ double relaunch(icd::runner::World& world) {
 int main(int argc, char** argv) {
   using namespace icd;
   Args a;
+  std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli("soak", "  See the comment at the top of soak.cpp.");
   add_options(cli, a);
+  cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   try {
     runner::Scene scene;
@@ -121,7 +124,7 @@ int main(int argc, char** argv) {
       o.speed = a.speed;
       scene = reliability::make_contact_box_scene(o);
     } else {
-      scene = runner::load_scene(a.scene);
+      scene = runner::load_scene(a.scene, overrides);
       if (a.budget_given) reliability::use_test_budget(scene, a.budget_tests);
     }
     runner::World world = runner::make_world(scene, std::filesystem::path(ICD_SOURCE_DIR) / "assets", ICD_TOOL_DIR);
