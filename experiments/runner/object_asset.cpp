@@ -1,8 +1,14 @@
 #include "experiments/runner/object_asset.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 #include <icd/coupling/primitive_asset.hpp>
@@ -12,6 +18,38 @@
 #include "experiments/runner/child_process.hpp"
 
 namespace icd::runner {
+
+namespace {
+
+/// An exclusive advisory lock (flock) on `path`, held while the object lives:
+/// processes preprocessing the same mesh into the same cache (a sweep's
+/// parallel cases) take turns instead of writing one folder together.
+class CacheLock {
+ public:
+  explicit CacheLock(const std::filesystem::path& path) {
+    m_fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (m_fd < 0)
+      throw InputError("cannot open the asset cache lock " + escape_bytes(path.string(), 4096));
+    if (::flock(m_fd, LOCK_EX | LOCK_NB) != 0) {
+      std::fprintf(stderr, "[icd] waiting for another process preprocessing into %s\n",
+                   escape_bytes(path.parent_path().string(), 4096).c_str());
+      while (::flock(m_fd, LOCK_EX) != 0) {
+        if (errno != EINTR) {
+          ::close(m_fd);
+          throw InputError("cannot lock the asset cache lock " + escape_bytes(path.string(), 4096));
+        }
+      }
+    }
+  }
+  ~CacheLock() { ::close(m_fd); }  // closing releases the lock
+  CacheLock(const CacheLock&) = delete;
+  CacheLock& operator=(const CacheLock&) = delete;
+
+ private:
+  int m_fd = -1;
+};
+
+}  // namespace
 
 void place_object(ObjectAsset& asset, const ObjectSpec& spec) {
   coupling::place_asset(asset, {spec.size, spec.position, spec.rotation_deg});
@@ -98,6 +136,12 @@ ObjectAsset load_object_asset(const ObjectSpec& spec, const std::filesystem::pat
   std::snprintf(hash, sizeof hash, "%016llx",
                 static_cast<unsigned long long>(coupling::fnv1a64(key.data(), key.size())));
   const std::filesystem::path folder = cache_dir / (spec.mesh.stem().string() + "-" + hash);
+  std::optional<CacheLock> lock;
+  if (!std::filesystem::exists(folder / coupling::kBundleDataFile)) {
+    std::filesystem::create_directories(cache_dir);
+    lock.emplace(folder.string() + ".lock");
+  }
+  // Checked again under the lock: another process may have just written it.
   if (!std::filesystem::exists(folder / coupling::kBundleDataFile)) {
     const std::filesystem::path tool = tool_dir / "icd-preprocess";
     if (!std::filesystem::exists(tool))
