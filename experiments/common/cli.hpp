@@ -15,8 +15,8 @@
 /// Values are converted after the whole line is read: `--help` or
 /// `--version` anywhere applies nothing; a later value of an option replaces
 /// an earlier one, except where a custom option's handler accumulates.
-#include <CLI/CLI.hpp>
-
+/// CLI11 stays out of this header (experiments/common/cli.cpp): it is
+/// compiled once, not in every program.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -40,13 +41,8 @@ class Cli {
  public:
   /// `program`: the name in messages and the usage; `footer`: lines printed
   /// after the option list (what it does, defaults, outputs; may be empty).
-  explicit Cli(std::string program, std::string footer = {})
-      : m_program(std::move(program)), m_app(std::string{}, m_program) {
-    m_app.allow_extras(true);  // reported by apply() in the one wording
-    m_app.set_help_flag("-h,--help", "print this help and exit");
-    m_version = m_app.add_flag("--version")->description("print the version (icd " ICD_VERSION_STRING ") and exit");
-    if (!footer.empty()) m_app.footer(std::move(footer));
-  }
+  explicit Cli(std::string program, std::string footer = {});
+  ~Cli();
   Cli(const Cli&) = delete;
   Cli& operator=(const Cli&) = delete;
 
@@ -55,13 +51,7 @@ class Cli {
   /// error; an optional one keeps its default. More words than arguments is
   /// an error.
   Cli& argument(const std::string& name, const std::string& help, bool required,
-                std::function<void(const std::string&)> apply) {
-    CLI::Option* o = m_app.add_option(name, CLI::callback_t{}, help, false);
-    o->expected(1)->type_name("");
-    if (required) o->required();
-    m_entries.push_back({o, name, std::move(apply), false});
-    return *this;
-  }
+                std::function<void(const std::string&)> apply);
 
   /// A positional argument naming a file or folder.
   Cli& argument(const std::string& name, std::filesystem::path& target, const std::string& help,
@@ -72,13 +62,7 @@ class Cli {
   /// Positional arguments taking all the remaining words (after the single
   /// ones declared before), appended to `target` in order.
   Cli& arguments(const std::string& name, std::vector<std::filesystem::path>& target,
-                 const std::string& help, bool required) {
-    CLI::Option* o = m_app.add_option(name, CLI::callback_t{}, help, false);
-    o->expected(-1)->type_name("");
-    if (required) o->required();
-    m_entries.push_back({o, name, [&target](const std::string& v) { target.emplace_back(v); }, false});
-    return *this;
-  }
+                 const std::string& help, bool required);
 
   /// Any text.
   Cli& text(const std::string& name, std::string& target, const std::string& value_name,
@@ -117,11 +101,7 @@ class Cli {
   }
 
   /// A switch without a value: sets `target` to true.
-  Cli& flag(const std::string& name, bool& target, const std::string& help) {
-    CLI::Option* o = m_app.add_flag(name)->description(help);
-    m_entries.push_back({o, display_name(name), [&target](const std::string&) { target = true; }, true});
-    return *this;
-  }
+  Cli& flag(const std::string& name, bool& target, const std::string& help);
 
   /// An option whose value `apply` interprets (called once per occurrence,
   /// in order); it throws std::invalid_argument with the reason when the
@@ -159,16 +139,7 @@ class Cli {
   /// `v` as a finite number in [min, max]; throws std::invalid_argument
   /// naming what is wrong (for custom options and comma-separated lists).
   static double parse_real(const std::string& v, double min = -std::numeric_limits<double>::max(),
-                           double max = std::numeric_limits<double>::max()) {
-    double value = 0;
-    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
-    if (ec != std::errc() || end != v.data() + v.size() || !std::isfinite(value))
-      throw std::invalid_argument("expects a finite number, got '" + v + "'");
-    if (value < min || value > max)
-      throw std::invalid_argument("must be in [" + format(min) + ", " + format(max) + "], got '" +
-                                  v + "'");
-    return value;
-  }
+                           double max = std::numeric_limits<double>::max());
 
   /// What the command line `args` (argv[1 ..]) asks for.
   enum class Outcome { Run, Help, Version };
@@ -176,144 +147,31 @@ class Cli {
   /// Reads `args` and applies the values to their variables; throws
   /// std::invalid_argument with "what is wrong" (naming the option or
   /// argument) on any error. After Help or Version nothing was applied.
-  Outcome apply(const std::vector<std::string>& args) {
-    // --help / --version win wherever they stand (before a "--"), even next
-    // to a bad value: they never run anything.
-    for (const std::string& a : args) {
-      if (a == "--") break;
-      if (a == "--help" || a == "-h") return Outcome::Help;
-      if (a == "--version") return Outcome::Version;
-    }
-    std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 reads from the back
-    bool missing_required = false;
-    try {
-      m_app.clear();
-      m_app.parse(reversed);
-    } catch (const CLI::ArgumentMismatch& e) {
-      // "--name: 1 required TEXT missing" and the like: the option's name comes first.
-      const std::string what = e.what();
-      const auto colon = what.find(':');
-      throw std::invalid_argument(colon == std::string::npos ? what
-                                                             : what.substr(0, colon) + " needs a value");
-    } catch (const CLI::RequiredError&) {
-      missing_required = true;  // reported after an unknown option, which explains more
-    } catch (const CLI::ParseError& e) {
-      throw std::invalid_argument(e.what());
-    }
-    const std::vector<std::string> extras = m_app.remaining();
-    if (!extras.empty()) {
-      const std::string& a = extras.front();
-      throw std::invalid_argument(!a.empty() && a[0] == '-' && a != "-"
-                                      ? "unknown option '" + a + "'"
-                                      : "unexpected argument '" + a + "'");
-    }
-    if (missing_required) {
-      for (const Entry& entry : m_entries)
-        if (entry.option->get_required() && entry.option->count() == 0)
-          throw std::invalid_argument("missing " + entry.name);
-      throw std::invalid_argument("a required argument is missing");
-    }
-    for (const Entry& entry : m_entries) {
-      if (entry.option->count() == 0) continue;
-      if (entry.is_flag) {
-        entry.apply({});
-        continue;
-      }
-      for (const std::string& value : entry.option->results()) {
-        try {
-          entry.apply(value);
-        } catch (const std::invalid_argument& e) {
-          throw std::invalid_argument(entry.name + " " + e.what());
-        }
-      }
-    }
-    return Outcome::Run;
-  }
+  Outcome apply(const std::vector<std::string>& args);
 
   /// apply() on the command line: std::nullopt to go on, or the exit status
   /// the program should return (0 after --help or --version, with the text
   /// on stdout; 2 after an error, with the one-line message on stderr).
-  std::optional<int> parse(int argc, char** argv) {
-    std::vector<std::string> args(argv + 1, argv + argc);
-    try {
-      switch (apply(args)) {
-        case Outcome::Run:
-          return std::nullopt;
-        case Outcome::Help:
-          std::fputs(usage().c_str(), stdout);
-          return 0;
-        case Outcome::Version:
-          std::fputs(version_line().c_str(), stdout);
-          return 0;
-      }
-    } catch (const std::invalid_argument& e) {
-      return fail(m_program, e.what());
-    }
-    return 2;
-  }
+  std::optional<int> parse(int argc, char** argv);
 
   /// The help text (description, usage line, options, footer).
-  std::string usage() const { return m_app.help(); }
+  std::string usage() const;
 
   /// "icd <version>\n".
   static std::string version_line() { return "icd " ICD_VERSION_STRING "\n"; }
 
   /// Prints the one error wording on stderr and returns 2.
   /// Control bytes in `what` (from the command line) are written as \xNN.
-  static int fail(const std::string& program, const std::string& what) {
-    std::string text;
-    for (const char c : what) {
-      const auto byte = static_cast<unsigned char>(c);
-      if (byte < 0x20 || byte == 0x7f) {
-        char hex[8];
-        std::snprintf(hex, sizeof hex, "\\x%02x", byte);
-        text += hex;
-      } else {
-        text += c;
-      }
-    }
-    std::fprintf(stderr, "%s: %s (see --help)\n", program.c_str(), text.c_str());
-    return 2;
-  }
-
-  /// The underlying CLI11 app (for what the wrappers above do not cover).
-  CLI::App& app() { return m_app; }
+  static int fail(const std::string& program, const std::string& what);
 
  private:
-  struct Entry {
-    CLI::Option* option;
-    std::string name;
-    std::function<void(const std::string&)> apply;
-    bool is_flag;
-  };
+  struct Impl;  // the CLI11 app and the declared options
 
   Cli& add(const std::string& name, const std::string& value_name, const std::string& help,
-           std::function<void(const std::string&)> apply) {
-    CLI::Option* o = m_app.add_option(name, CLI::callback_t{}, help, false);
-    // Every occurrence takes exactly one value (even one that starts with '-',
-    // e.g. "--after -1"); all occurrences are kept and applied in order.
-    o->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-    o->type_name(value_name.empty() ? "VALUE" : value_name);
-    m_entries.push_back({o, display_name(name), std::move(apply), false});
-    return *this;
-  }
-
-  // "-o,--output" -> "--output": the name used in messages.
-  static std::string display_name(const std::string& names) {
-    const auto comma = names.rfind(',');
-    return comma == std::string::npos ? names : names.substr(comma + 1);
-  }
-
-  static std::string format(double x) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%g", x);
-    return buffer;
-  }
+           std::function<void(const std::string&)> apply);
 
   std::string m_program;
-  CLI::App m_app;
-  CLI::Option* m_version = nullptr;
-  std::vector<Entry> m_entries;
+  std::unique_ptr<Impl> m_impl;
 };
 
 /// The command line of a Google Benchmark program: `--help` prints this
