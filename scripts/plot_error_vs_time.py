@@ -3,10 +3,14 @@
 bin/contact_error, bin/deformation_error and bin/sphere_update_error.
 
 usage: /usr/bin/python3 scripts/plot_error_vs_time.py RESULTS_DIR
-  RESULTS_DIR/contact_error{,_spheres}/contact_error.csv  -> contact_error.png
-  RESULTS_DIR/deformation_error/{links,resolution}.csv -> deformation_error.png
-  RESULTS_DIR/sphere_update/sphere_update.csv -> sphere_update.png
-Missing inputs are reported and skipped. Offscreen (Agg).
+  RESULTS_DIR/contact_error{,_spheres}/results.csv  -> contact_error.png
+  RESULTS_DIR/deformation_{links,error}/results.csv -> deformation_error/deformation_error.png
+  RESULTS_DIR/sphere_update/results.csv -> sphere_update.png
+The inputs are the sweeps' gathered CSVs (scripts/run_experiments.sh; only
+the rows of ok cases are drawn); where a folder has no results.csv, the
+program's own CSV (contact_error.csv, links.csv and resolution.csv,
+sphere_update.csv) is read instead. Missing inputs are reported and skipped.
+Offscreen (Agg).
 """
 import csv
 import os
@@ -20,7 +24,14 @@ import numpy as np
 
 def read(path):
     with open(path) as f:
-        return list(csv.DictReader(f))
+        rows = list(csv.DictReader(f))
+    return [r for r in rows if r.get("status", "ok") == "ok"]  # a sweep's failed cases have no data
+
+
+def pick(d, sub, own):
+    """The sweep's gathered CSV in d/sub, else the program's own CSV there."""
+    p = os.path.join(d, sub, "results.csv")
+    return p if os.path.exists(p) else os.path.join(d, sub, own)
 
 
 def col(rows, key):
@@ -91,7 +102,7 @@ def plot_deformation(links_path, res_path, out):
         axes[1].set_title("mapping error vs time")
         axes[1].legend(fontsize=7)
     if os.path.exists(res_path):
-        rows = read(res_path)
+        rows = sorted(read(res_path), key=lambda r: float(r["cells"]))  # a sweep: sorted by case id
         t = col(rows, "frame_seconds") * 1e3
         axes[2].plot(t, col(rows, "rms_error_pct_bbox"), "o-", label="RMS over frames")
         axes[2].plot(t, col(rows, "max_error_pct_bbox"), "s--", label="max over frames")
@@ -155,20 +166,22 @@ def main():
     d = sys.argv[1]
     done = 0
     for sub in ("contact_error", "contact_error_spheres"):
-        p = os.path.join(d, sub, "contact_error.csv")
+        p = pick(d, sub, "contact_error.csv")
         if os.path.exists(p):
             plot_contact(p, os.path.join(d, sub, "contact_error.png"))
             done += 1
         else:
             print(f"plot_error_vs_time: {p} missing, skipped")
-    links = os.path.join(d, "deformation_error", "links.csv")
-    res = os.path.join(d, "deformation_error", "resolution.csv")
+    links = os.path.join(d, "deformation_links", "results.csv")
+    if not os.path.exists(links):
+        links = os.path.join(d, "deformation_error", "links.csv")
+    res = pick(d, "deformation_error", "resolution.csv")
     if os.path.exists(links) or os.path.exists(res):
         plot_deformation(links, res, os.path.join(d, "deformation_error", "deformation_error.png"))
         done += 1
     else:
         print(f"plot_error_vs_time: {links} missing, skipped")
-    p = os.path.join(d, "sphere_update", "sphere_update.csv")
+    p = pick(d, "sphere_update", "sphere_update.csv")
     if os.path.exists(p):
         plot_sphere_update(p, os.path.join(d, "sphere_update", "sphere_update.png"))
         done += 1

@@ -3,6 +3,12 @@
 and plot of issue 8, the definitions of the metrics, and where and why our
 numbers differ from the paper's.
 
+The parameter studies are read from the sweeps' gathered CSVs,
+RESULTS_DIR/<step>/results.csv (icd-sweep: case_id, the parameters, status,
+exit_status, message, then the program's columns), never from the programs'
+own output folders; a case not ok is listed under its table with its message.
+Fig. 9 (one run, pictures) and the main run are read from their folders.
+
 usage: /usr/bin/python3 scripts/plot_index.py [--readme README.md] RESULTS_DIR SECONDS QUICK [STATUS_ROW...]
 
 Sentences that state a finding (the moment of Fig. 9, identical panels,
@@ -28,6 +34,115 @@ def read_if(d, rel):
     return read(p) if os.path.exists(p) else []
 
 
+def gathered_all(d, step):
+    """Every row of a sweep step's gathered results.csv (ok or not)."""
+    return read_if(d, f"{step}/results.csv")
+
+
+def gathered(d, step):
+    """The rows of the ok cases of a sweep step's gathered results.csv."""
+    return [r for r in gathered_all(d, step) if r["status"] == "ok"]
+
+
+def sweep_problems(d, step):
+    """Generated: the cases of a sweep that are not ok, with their messages."""
+    bad = {}
+    for r in gathered_all(d, step):
+        if r["status"] != "ok":
+            bad.setdefault(r["case_id"], r)
+    if not bad:
+        return ""
+    lines = [f"**{len(bad)} case(s) of the `{step}` sweep not ok** (their rows are missing above; "
+             f"[{step}/results.csv]({step}/results.csv), case folders in `{step}/cases/`):\n"]
+    for cid, r in bad.items():
+        lines.append(f"- `{cid}`: {r['status']}: {r['message'].replace('|', '/')}")
+    return "\n".join(lines) + "\n"
+
+
+def num(v):
+    try:
+        return float(v)
+    except ValueError:
+        return float("nan")
+
+
+def table1_md(rows):
+    """Table 1 as the table1 program writes it (table1.md), from gathered rows."""
+    rows = sorted(rows, key=lambda r: (r["scene"], r["budget_kind"], num(r["critical_time"])))
+    if not rows:
+        return ""
+    out = ["| interaction | critical time (s) or test budget | PAIRLIST ours | paper | COLLISIONLIST ours | "
+           "paper | FPS ours | paper | completed level |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        b = f"{num(r['critical_time']):g}" + (" tests" if r["budget_kind"] == "tests" else "")
+        if r.get("failure"):
+            out.append(f"| {r['scene']} | {b} | FAILED (first contact {r['contact_frame']}): "
+                       f"{r['failure'].replace('|', '/')} | | | | | | |")
+            continue
+        out.append(f"| {r['scene']} | {b} | {r['pair_list']} | {r['paper_pair_list'] or '-'} | "
+                   f"{r['collision_list']} | {r['paper_collision_list'] or '-'} | {num(r['fps']):.1f} | "
+                   f"{r['paper_fps'] or '-'} | {r['completed_level']} |")
+    return "\n".join(out) + "\n"
+
+
+def table1_section(d, step, what):
+    rows = gathered(d, step)
+    text = table1_md(rows) if rows else f"*{what} missing ({step}/results.csv has no ok case; see run.log).*\n"
+    return text + sweep_problems(d, step)
+
+
+STABILITY_GROUPS = ["young", "poisson", "penalty", "velocity", "compression", "implicit"]
+
+
+def stability_md(d):
+    """The stability table from the icd-run sweep's gathered frames.csv rows."""
+    rows = gathered_all(d, "stability")
+    if not rows:
+        return "*Stability table missing (stability/results.csv not produced; see run.log).*\n"
+    cases = {}
+    for r in rows:
+        cases.setdefault(r["case_id"], []).append(r)
+
+    def order(item):
+        r = item[1][0]
+        g = STABILITY_GROUPS.index(r["_group"]) if r["_group"] in STABILITY_GROUPS else len(STABILITY_GROUPS)
+        first = [w for w in r["_case"].replace("=", " ").split() if w[:1].isdigit()]
+        return (g, num(first[0]) if first else 0.0, r["_case"])
+    out = ["| group | case | status | frames | min step (s) | energy drift | max energy gain | "
+           "max penetration (m) | frames/s | message |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for cid, rs in sorted(cases.items(), key=order):
+        r0 = rs[0]
+        if r0["status"] != "ok":
+            out.append(f"| {r0['_group']} | {r0['_case']} | {r0['status']} | | | | | | | "
+                       f"{r0['message'].replace('|', '/')} |")
+            continue
+        e = [num(r["energy"]) for r in rs]
+        steps = [num(r["min_step"]) for r in rs if num(r["min_step"]) > 0]
+        wall = sum(num(r["wall"]) for r in rs)
+        drift = (e[-1] - e[0]) / abs(e[0]) if e[0] else float("nan")
+        gain = max(e) / e[0] - 1 if e[0] > 0 else float("nan")
+        finite = all(x == x and abs(x) != float("inf") for x in e)
+        status, msg = "stable", ""
+        if not finite:
+            status, msg = "unstable", "non-finite energy"
+        elif gain > 1:
+            status, msg = "unstable", f"energy grew to {1 + gain:.3g} x its first-frame value"
+        out.append(f"| {r0['_group']} | {r0['_case']} | {status} | {len(rs)} | "
+                   f"{min(steps) if steps else 0:.3g} | {drift:+.3g} | {gain:.3g} | "
+                   f"{max(num(r['max_penetration']) for r in rs):.3g} | {len(rs) / max(wall, 1e-12):.1f} | {msg} |")
+    return "\n".join(out) + "\n"
+
+
+MODE_ORDER = ["fifo", "fifo_paper_literal", "priority", "priority_cap256", "depth_first"]
+
+
+def contact_rows(d, sub):
+    """The contact_error rows of a sweep, in the program's order (mode, kind, budget)."""
+    rows = gathered(d, sub)
+    return sorted(rows, key=lambda r: (MODE_ORDER.index(r["mode"]) if r["mode"] in MODE_ORDER else 99, r["mode"],
+                                       r["budget_kind"] != "seconds", num(r["budget"])))
+
+
 def fig9_moment(d, sub):
     """Generated: at which frame Fig. 9 is drawn, against Table 1's frames,
     and whether its panels differ."""
@@ -38,7 +153,7 @@ def fig9_moment(d, sub):
     ref = max(man, key=lambda r: float(r["budget"]))  # fig9 takes the moment from this run
     out = [f"Drawn at frame {frame} (first contact at frame {ref['contact_frame']} in the run with the "
            f"largest budget, {float(ref['budget']):g} s)"]
-    t1 = [r for r in read_if(d, "table1/table1.csv") if r["scene"] == man[0]["scene"]]
+    t1 = [r for r in gathered(d, "table1") if r["scene"] == man[0]["scene"]]
     frames = sorted({r["measure_frame"] for r in t1})
     if frames:
         same = frames == [frame]
@@ -64,7 +179,7 @@ def fig9_moment(d, sub):
 
 def contact_findings(d, sub):
     """Generated: saturated recall and large force errors, with their cause in numbers."""
-    rows = read_if(d, f"{sub}/contact_error.csv")
+    rows = contact_rows(d, sub)
     if not rows:
         return ""
     out = []
@@ -91,7 +206,7 @@ def contact_findings(d, sub):
 
 
 def sphere_update_findings(d):
-    rows = read_if(d, "sphere_update/sphere_update.csv")
+    rows = gathered(d, "sphere_update")
     if not rows:
         return ""
     zero = [m for m in dict.fromkeys(r["method"] for r in rows)
@@ -124,7 +239,7 @@ def main_findings(d):
 
 def table1_failures(d, sub):
     """Generated: the runs of a Table 1 variant that failed, from its CSV."""
-    bad = [r for r in read_if(d, f"{sub}/table1.csv") if r.get("failure")]
+    bad = [r for r in gathered(d, sub) if r.get("failure")]
     if not bad:
         return ""
     kind = lambda r: "tests" if r.get("budget_kind") == "tests" else "s"  # noqa: E731
@@ -146,7 +261,8 @@ def failure_banner(status):
 def glance(d):
     """README block: bunny-dragon Table 1 rows, wall clock and test budgets."""
     def rows_of(sub):
-        rows = [r for r in read_if(d, f"{sub}/table1.csv") if r["scene"] == "bunny_dragon"]
+        rows = sorted((r for r in gathered(d, sub) if r["scene"] == "bunny_dragon"),
+                      key=lambda r: num(r["critical_time"]))
         for r in rows:
             if r.get("failure"):
                 r["pair_list"] = r["collision_list"] = r["tests"] = r["completed_level"] = "FAILED"
@@ -196,23 +312,14 @@ def update_readme(path, block):
     print(f"plot_index: updated the results block of {path}")
 
 
-def section_file(d, rel, what):
-    p = os.path.join(d, rel)
-    if os.path.exists(p):
-        with open(p) as f:
-            return f.read()
-    return f"*{what} missing ({rel} not produced; see run.log).*\n"
-
-
 def image(d, rel, alt):
     return f"![{alt}]({rel})\n" if os.path.exists(os.path.join(d, rel)) else f"*{alt}: {rel} missing.*\n"
 
 
 def contact_summary(d, sub):
-    p = os.path.join(d, sub, "contact_error.csv")
-    if not os.path.exists(p):
-        return ""
-    rows = read(p)
+    rows = contact_rows(d, sub)
+    if not rows:
+        return sweep_problems(d, sub)
     lines = ["| mode | budget | time (µs) | force error | recall (exact) | false positives | PAIRLIST+COLLISIONLIST |",
              "|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -225,7 +332,7 @@ def contact_summary(d, sub):
     head = (f"At frame {r0['frame']} of {r0['scene']}: {r0['exact_pairs']} exact intersecting triangle pairs, "
             f"{r0['full_leaf_pairs']} colliding leaf pairs in the uninterrupted traversal, which takes "
             f"{1e6 * float(r0['full_seconds']):.1f} µs.\n\n")
-    return head + "\n".join(lines) + "\n"
+    return head + "\n".join(lines) + "\n" + sweep_problems(d, sub)
 
 
 def main():
@@ -258,21 +365,21 @@ def main():
     md.append("## Table 1: PAIRLIST, COLLISIONLIST and frame rate per critical time\n")
     md.append("Program `bin/table1`: each interaction and critical time is a fresh run from identical initial "
               "conditions, measured 1 frame after the first frame with a contact force (`--after 1`). CSV: "
-              "[table1/table1.csv](table1/table1.csv).\n")
-    md.append(section_file(d, "table1/table1.md", "Table 1"))
+              "[table1/results.csv](table1/results.csv) (sweep `table1`).\n")
+    md.append(table1_section(d, "table1", "Table 1"))
     md.append(table1_failures(d, "table1"))
 
     md.append("The same with every critical time divided by 1000 (1e-7 .. 1e-3 s), which is roughly the speed "
               "ratio between a sphere test here and on the paper's machine: only then are our queries "
               "interrupted, and PAIRLIST (pairs left untested at the interruption) is non-zero. The paper's columns "
               "hold its row at 1000x our critical time. CSV: "
-              "[table1_scaled/table1.csv](table1_scaled/table1.csv).\n")
-    md.append(section_file(d, "table1_scaled/table1.md", "Table 1, scaled critical times"))
+              "[table1_scaled/results.csv](table1_scaled/results.csv).\n")
+    md.append(table1_section(d, "table1_scaled", "Table 1, scaled critical times"))
     md.append(table1_failures(d, "table1_scaled"))
     md.append("The deterministic twin: the same runs with budgets in sphere tests instead of seconds, "
               "so the lists do not depend on the machine or its load (the tables above do). CSV: "
-              "[table1_tests/table1.csv](table1_tests/table1.csv).\n")
-    md.append(section_file(d, "table1_tests/table1.md", "Table 1, test budgets"))
+              "[table1_tests/results.csv](table1_tests/results.csv).\n")
+    md.append(table1_section(d, "table1_tests", "Table 1, test budgets"))
     md.append(table1_failures(d, "table1_tests"))
     md.append("**PAIRLIST in the paper and here.** The paper's PAIRLIST grows with the critical time up to "
               "1,345-1,405 pairs at 1 s, when its traversal must have finished; so it counts every pair that "
@@ -310,13 +417,13 @@ def main():
               "Modes: `fifo` (paper Fig. 7, fast path: children tested when generated), `fifo_paper_literal` "
               "(Fig. 7 literally, clock read every test), `priority` (best first, largest sphere, list capped at "
               "2^14), `priority_cap256` (bounded memory: 256 pairs), `depth_first` (Fig. 4). Time budgets (circles) "
-              "and deterministic test budgets (squares). CSV: [contact_error/contact_error.csv]"
-              "(contact_error/contact_error.csv).\n")
+              "and deterministic test budgets (squares). CSV: [contact_error/results.csv]"
+              "(contact_error/results.csv).\n")
     md.append(image(d, "contact_error/contact_error.png", "contact error vs time"))
     md.append(contact_summary(d, "contact_error"))
     md.append(contact_findings(d, "contact_error"))
     md.append("A deeper contact: two primitive spheres with a soft penalty (20 N/m), 5 frames after first contact, where the "
-              "dense surfaces interpenetrate ([CSV](contact_error_spheres/contact_error.csv)):\n")
+              "dense surfaces interpenetrate ([CSV](contact_error_spheres/results.csv)):\n")
     md.append(image(d, "contact_error_spheres/contact_error.png", "contact error vs time, two spheres"))
     md.append(contact_summary(d, "contact_error_spheres"))
     md.append(contact_findings(d, "contact_error_spheres"))
@@ -326,30 +433,37 @@ def main():
               "bounding-box diagonal, and the time of each mapping. Right: two colliding primitive spheres "
               "simulated with coarse grids of increasing resolution; dense vertices compared one to one with a "
               "fine-grid run at every frame, against the wall time per frame. CSV: "
-              "[links.csv](deformation_error/links.csv), [resolution.csv](deformation_error/resolution.csv).\n")
+              "[links](deformation_links/results.csv), [resolution](deformation_error/results.csv).\n")
     md.append(image(d, "deformation_error/deformation_error.png", "deformation error vs time"))
+    md.append(sweep_problems(d, "deformation_error") + sweep_problems(d, "deformation_links"))
     md.append("### Sphere update (`bin/sphere_update_error`)\n")
     md.append("Two colliding primitive spheres (octree trees, so the rebuild uses the same builder). Per frame and "
               "object: the rest tree updated from the coarse nodes (paper 4.4 radius ratio, and the conservative "
               "displacement bound) vs an octree rebuilt on the deformed dense surface. Coverage: fraction of "
               "deformed dense vertices outside every leaf sphere (grid-based `measure_coverage`); tightness: total "
               "leaf-sphere volume / volume enclosed by the deformed surface (lower is tighter). CSV: "
-              "[sphere_update.csv](sphere_update/sphere_update.csv).\n")
+              "[sphere_update/results.csv](sphere_update/results.csv).\n")
     md.append(image(d, "sphere_update/sphere_update.png", "sphere update vs rebuild"))
     md.append(sphere_update_findings(d))
+    md.append(sweep_problems(d, "sphere_update"))
 
-    md.append("## Stability sweep (`bin/stability_sweep`)\n")
+    md.append("## Stability sweep (sweep `stability`: `icd-run` with scene-field overrides)\n")
     md.append("Two colliding primitive spheres (the full loop: FEM, sphere update, interruptible detection, penalty "
-              "response). Stable = every frame finished with finite positions and energy, and the energy never "
-              "exceeded twice its initial (kinetic + elastic) value; a thrown error is recorded with its message. Energy drift = "
-              "(E_end - E_0) / E_0 with E the mechanical energy (kinetic + elastic) of the deformable objects, E_0 before the first step (damping dissipates, so "
-              "negative is expected). CSV: [stability.csv](stability/stability.csv).\n")
-    md.append(section_file(d, "stability/stability.md", "stability table"))
+              "response), `experiments/sweeps/scenes/stability_base.json` with one case per material, penalty, speed, "
+              "70 % initial compression (`objects.0.initial_compression`) and integrator, as `--set` overrides. "
+              "Not ok = `icd-run` stopped (a health check or a thrown error: the message); stable = it ran every "
+              "frame with finite energy and the energy never exceeded twice its first-frame value. E is the "
+              "`energy` column of `frames.csv` (kinetic + elastic + gravity potential + the penalty springs' energy, "
+              "after each frame); energy drift = (E_last - E_first) / |E_first| (damping dissipates, so negative "
+              "is expected). CSV: [stability/results.csv](stability/results.csv) (one row per case and frame).\n")
+    md.append(stability_md(d))
 
     md.append("## Other engineers' experiments, reused\n")
-    if os.path.exists(os.path.join(d, "fem/fem_error_vs_time.csv")):
+    if os.path.exists(os.path.join(d, "fem/results.csv")):
         md.append("FEM error against run time (cantilever vs Timoshenko and a fine static reference), from "
-                  "`experiments/studies/fem/fem_error_vs_time`: [CSV](fem/fem_error_vs_time.csv)\n")
+                  "`experiments/studies/fem/fem_error_vs_time` (sweep `fem_error_vs_time`, one case): "
+                  "[CSV](fem/results.csv)\n")
+        md.append(sweep_problems(d, "fem"))
         md.append(image(d, "fem/fem_error_vs_time.png", "FEM error vs time"))
     if os.path.exists(os.path.join(d, "collision/accuracy.txt")):
         md.append("Collision accuracy/coverage experiment of the collision module: "

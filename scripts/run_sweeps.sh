@@ -33,9 +33,12 @@ build="${ICD_BUILD_DIR:-$root/build/release}"
 out="${ICD_SWEEPS_DIR:-$root/results/sweeps}"
 if [ ${#names[@]} = 0 ]; then
   if [ $quick = 1 ]; then
-    names=(table1_quick contact_error_spheres_quick stability_quick preprocess_corpus_quick)
+    names=(table1_quick table1_scaled_quick table1_tests_quick contact_error_quick contact_error_spheres_quick
+           deformation_error_quick deformation_links_quick sphere_update_quick stability_quick
+           fem_error_vs_time_quick preprocess_corpus_quick)
   else
-    names=(table1 table1_scaled contact_error contact_error_spheres deformation_error stability preprocess_corpus)
+    names=(table1 table1_scaled table1_tests contact_error contact_error_spheres deformation_error
+           deformation_links sphere_update stability fem_error_vs_time preprocess_corpus)
   fi
 fi
 for n in "${names[@]}"; do
@@ -47,7 +50,7 @@ if [ $build_it = 1 ]; then
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DICD_BUILD_TESTS=OFF -DICD_BUILD_BENCHMARKS=OFF > "$out/build.log" || exit 1
   cmake --build "$build" -j2 --target icd-sweep icd-run icd-preprocess table1 contact_error \
-    deformation_error >> "$out/build.log" || { echo "build failed (see $out/build.log)" >&2; exit 1; }
+    deformation_error sphere_update_error fem_error_vs_time >> "$out/build.log" || { echo "build failed (see $out/build.log)" >&2; exit 1; }
 fi
 sweep="$build/bin/icd-sweep"
 status=0

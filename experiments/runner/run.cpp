@@ -216,6 +216,18 @@ World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
   World world(std::move(objects), settings);
   for (size_t i = 0; i < loads.size(); ++i)
     if (loads[i].size() > 0) world.set_external_forces(static_cast<int>(i), loads[i]);
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    // "initial_compression": the coarse nodes squeezed along x about their
+    // centroid, then released (the first frame starts from this state).
+    const double c = scene.objects[i].initial_compression;
+    RuntimeObject& o = world.objects()[i];
+    if (c <= 0 || !o.sim) continue;
+    const double cx = o.rest.col(0).mean();
+    MatX3d x = o.rest;
+    x.col(0) = (x.col(0).array() - cx) * (1 - c) + cx;
+    o.sim->set_positions(x);
+    o.positions = x;
+  }
   return world;
 }
 

@@ -458,6 +458,9 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
            : kind == "rigid"    ? ObjectKind::Rigid
                                 : ObjectKind::Static;
   o.analytic_collider = f.string("collider", "analytic", {"analytic", "spheres"}) == "analytic";
+  o.initial_compression = f.number("initial_compression", 0, 0, 0.95);
+  if (o.initial_compression > 0 && o.kind != ObjectKind::Deformable)
+    f.fail(f.path("initial_compression"), "only a deformable object can start compressed");
   if (o.kind == ObjectKind::Static && o.velocity.norm() > 0)
     f.fail(f.path("velocity"), "a static object cannot have a velocity");
   if (const Json* mat = f.get("material")) {

@@ -123,6 +123,11 @@ struct ObjectSpec : coupling::ObjectSetup {
   std::vector<RegionSelector> fixed_regions;
   std::vector<LoadSpec> loads;       ///< "loads"
   std::optional<MotionSpec> motion;  ///< "motion" (rigid objects)
+  /// "initial_compression": fraction in [0, 0.95] of the object's x extent
+  /// removed at the start: its coarse nodes are squeezed along x about their
+  /// centroid (velocities unchanged) and then released (deformable objects;
+  /// the stability study's 70 % cases). 0 = none.
+  double initial_compression = 0;
 };
 
 /// Resolves the object's regions on its placed coarse nodes: appends the

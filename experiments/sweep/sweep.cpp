@@ -1,16 +1,11 @@
 #include "experiments/sweep/sweep.hpp"
 
-#include <fcntl.h>
 #include <fnmatch.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <chrono>
-#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <fstream>
@@ -18,7 +13,6 @@
 #include <regex>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -26,6 +20,8 @@
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/core/input_file.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
+
+#include "experiments/runner/child_process.hpp"
 
 namespace fs = std::filesystem;
 using ojson = nlohmann::ordered_json;
@@ -152,7 +148,8 @@ void append_param_args(const ParamValue& p, const Expander& expand, std::vector<
 
 const std::set<std::string> kTopKeys = {"name",   "title",  "program", "args",
                                         "grid",   "cases",  "inputs",  "collect",
-                                        "limits", "accept_exit", "keep_outputs", "comment", "setup"};
+                                        "limits", "accept_exit", "keep_outputs", "comment", "setup",
+                                        "measured"};
 
 std::string last_line(const fs::path& p) {
   std::string s;
@@ -171,87 +168,25 @@ std::string last_line(const fs::path& p) {
 
 // ---- child processes --------------------------------------------------------
 
-struct Spawned {
-  int exit_status = -1, signal = 0;
-  bool timed_out = false, stopped = false;
-};
-
-Spawned spawn_and_wait(const std::vector<std::string>& argv, const fs::path& dir,
-                       const fs::path& out_file, const fs::path& err_file, const Limits& limits) {
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  const std::string dir_s = dir.string(), out_s = out_file.string(), err_s = err_file.string();
-  int pipe_fd[2];
-  if (pipe2(pipe_fd, O_CLOEXEC) != 0)
-    throw InputError("cannot start " + escape_bytes(argv[0]) + ": " + std::strerror(errno));
-  const rlim_t cpu = limits.cpu_seconds > 0 ? static_cast<rlim_t>(std::ceil(limits.cpu_seconds)) : 0;
-  const auto mem = static_cast<rlim_t>(limits.memory_bytes);
-  const pid_t pid = fork();
-  if (pid < 0) {
-    const int e = errno;
-    close(pipe_fd[0]);
-    close(pipe_fd[1]);
-    throw InputError("cannot start " + escape_bytes(argv[0]) + ": " + std::strerror(e));
-  }
-  if (pid == 0) {  // async-signal-safe calls only
-    setpgid(0, 0);  // its own process group: a timeout kills its children too
-    int e = 0;
-    const int in = open("/dev/null", O_RDONLY);
-    const int o = open(out_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int r = open(err_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (in < 0 || o < 0 || r < 0 || dup2(in, 0) < 0 || dup2(o, 1) < 0 || dup2(r, 2) < 0 ||
-        chdir(dir_s.c_str()) != 0)
-      e = errno;
-    if (e == 0) {
-      if (cpu > 0) {
-        const rlimit lim{cpu, cpu + 5};
-        (void)setrlimit(RLIMIT_CPU, &lim);
-      }
-      if (mem > 0) {
-        const rlimit lim{mem, mem};
-        (void)setrlimit(RLIMIT_AS, &lim);
-      }
-      execv(args[0], args.data());
-      e = errno;
-    }
-    (void)!write(pipe_fd[1], &e, sizeof e);
-    _exit(127);
-  }
-  setpgid(pid, pid);  // (also from the parent: no race with a kill below)
-  close(pipe_fd[1]);
-  int exec_errno = 0;
-  ssize_t n;
-  do {
-    n = read(pipe_fd[0], &exec_errno, sizeof exec_errno);
-  } while (n < 0 && errno == EINTR);
-  close(pipe_fd[0]);
-  Spawned s;
-  const auto start = std::chrono::steady_clock::now();
-  int status = 0;
-  for (;;) {
-    const pid_t w = waitpid(pid, &status, WNOHANG);
-    if (w == pid) break;
-    if (w < 0 && errno != EINTR) throw InputError(std::string("waitpid: ") + std::strerror(errno));
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!s.timed_out && !s.stopped) {
-      if (limits.wall_seconds > 0 && elapsed > limits.wall_seconds) {
-        s.timed_out = true;
-        kill(-pid, SIGKILL);
-      } else if (g_stop.load()) {
-        s.stopped = true;
-        kill(-pid, SIGKILL);
-      }
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  kill(-pid, SIGKILL);  // grandchildren left behind, if any
-  if (n == static_cast<ssize_t>(sizeof exec_errno))
-    throw InputError("cannot run " + escape_bytes(argv[0]) + ": " + std::strerror(exec_errno));
-  if (WIFEXITED(status)) s.exit_status = WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) s.signal = WTERMSIG(status);
-  return s;
+/// Runs one case or setup command with the application layer's one spawner
+/// (experiments/runner/child_process): its own process group (a timeout or an
+/// interrupt kills its children too), `dir` as working directory, stdin from
+/// /dev/null, stdout and stderr into files, the sweep's limits (0 = none).
+runner::ChildResult spawn_and_wait(const std::vector<std::string>& argv, const fs::path& dir,
+                                   const fs::path& out_file, const fs::path& err_file,
+                                   const Limits& limits) {
+  runner::ChildLimits l;
+  l.wall_seconds = limits.wall_seconds;
+  l.cpu_seconds = limits.cpu_seconds;
+  l.memory_bytes = limits.memory_bytes;
+  runner::ChildOptions o;
+  o.cwd = dir;
+  o.stdout_file = out_file;
+  o.stderr_file = err_file;
+  o.stdin_null = true;
+  o.own_process_group = true;
+  o.stop = &g_stop;
+  return runner::run_child(argv, l, o);
 }
 
 // ---- CSV --------------------------------------------------------------------
@@ -468,6 +403,27 @@ Plan load_plan(const fs::path& sweep_file, const fs::path& bin_dir) {
       plan.setup.push_back(std::move(cmd));
     }
   }
+  // measured: what the result comparison (compare_results.py) must not
+  // compare; icd-sweep itself only checks its form
+  if (j.contains("measured")) {
+    const ojson& m = j["measured"];
+    const std::string w = field("measured");
+    auto strings = [&](const ojson& v, const std::string& k) {
+      if (!v.is_array() || !std::all_of(v.begin(), v.end(), [](const ojson& x) { return x.is_string(); }))
+        throw InputError(w + "." + k + ": expected a list of column names");
+    };
+    if (!m.is_object()) throw InputError(w + ": expected {\"columns\": [...], \"rows\": {...}, \"stable\": [...]}");
+    for (const auto& [k, v] : m.items()) {
+      if (k == "columns" || k == "stable") {
+        strings(v, k);
+      } else if (k == "rows") {
+        if (!v.is_object() || !std::all_of(v.begin(), v.end(), [](const ojson& x) { return x.is_string(); }))
+          throw InputError(w + ".rows: expected {\"column\": \"value\"}");
+      } else {
+        throw InputError(w + ": unknown field \"" + k + "\" (columns, rows, stable)");
+      }
+    }
+  }
   // collect
   if (j.contains("collect")) {
     const ojson& c = j["collect"];
@@ -508,8 +464,14 @@ Plan load_plan(const fs::path& sweep_file, const fs::path& bin_dir) {
     }
     if (plan.collect.kind == "json") {
       if (plan.collect.columns.empty()) throw InputError(field("collect") + ".fields: JSON pointers required for json");
-      for (const std::string& p : plan.collect.columns)
+      for (const std::string& p : plan.collect.columns) {
         if (p.empty() || p[0] != '/') throw InputError(field("collect") + ".fields: a JSON pointer (\"/a/b\"), got \"" + p + "\"");
+        try {
+          (void)ojson::json_pointer(p);
+        } catch (const ojson::exception& e) {
+          throw InputError(field("collect") + ".fields: \"" + p + "\" is not a JSON pointer: " + e.what());
+        }
+      }
     }
   }
   // explicit cases x grid points
@@ -688,7 +650,7 @@ CaseResult run_case(const Plan& plan, const Case& c, const fs::path& out) {
     info["params"] = c.params;
     info["argv"] = argv;
     write_file_atomically(tmp / "case.json", info.dump(1) + "\n");
-    const Spawned s = spawn_and_wait(argv, tmp, tmp / "stdout.txt", tmp / "stderr.txt", plan.limits);
+    const runner::ChildResult s = spawn_and_wait(argv, tmp, tmp / "stdout.txt", tmp / "stderr.txt", plan.limits);
     r.exit_status = s.exit_status;
     r.signal = s.signal;
     const bool accepted = s.exit_status >= 0 && std::find(plan.accept_exit.begin(), plan.accept_exit.end(),
@@ -757,7 +719,7 @@ void run_setup(const Plan& plan, const fs::path& out) {
     if (fs::is_regular_file(dir / ("done-" + marker), ec)) continue;
     fs::remove_all(dir);
     fs::create_directories(dir / "out");
-    const Spawned s = spawn_and_wait(argv, dir, dir / "stdout.txt", dir / "stderr.txt", plan.limits);
+    const runner::ChildResult s = spawn_and_wait(argv, dir, dir / "stdout.txt", dir / "stderr.txt", plan.limits);
     if (s.exit_status != 0) {
       std::string l = last_line(dir / "stderr.txt");
       if (l.empty()) l = last_line(dir / "stdout.txt");

@@ -98,6 +98,10 @@ TEST(Scene, EachBadFieldGetsAClearError) {
        "collision.parent_filter", "no parent filter"},
       {with_objects(R"({"primitive": {}, "kind": "static", "velocity": [1, 0, 0]})"),
        "objects[0].velocity", "static"},
+      {with_objects(R"({"primitive": {}, "initial_compression": 0.99})"),
+       "objects[0].initial_compression", "must be in [0, 0.95]"},
+      {with_objects(R"({"primitive": {}, "kind": "rigid", "initial_compression": 0.5})"),
+       "objects[0].initial_compression", "deformable"},
       {with_objects(R"({"primitive": {}, "velocity": [1, 0]})"), "objects[0].velocity",
        "array of 3"},
       {with_objects(R"({"primitive": {}, "fixed_nodes": [1, -2]})"), "objects[0].fixed_nodes[1]",
@@ -136,6 +140,30 @@ TEST(Scene, EachBadFieldGetsAClearError) {
 }
 
 // --dry-run plans: each scene runs only the stages it needs.
+// "initial_compression" (the stability study's 70 % cases): the object's
+// coarse nodes start squeezed along x about their centroid, y and z as at
+// rest; the other object is untouched.
+TEST(Scene, InitialCompressionSqueezesTheCoarseNodesAlongX) {
+  const Scene s = parse(with_objects(
+      R"({"name": "a", "primitive": {"type": "sphere", "radius": 0.1, "cells": 3},
+          "position": [-0.3, 0, 0], "initial_compression": 0.7},
+         {"name": "b", "primitive": {"type": "sphere", "radius": 0.1, "cells": 3},
+          "position": [0.3, 0, 0]})"));
+  EXPECT_DOUBLE_EQ(s.objects[0].initial_compression, 0.7);
+  EXPECT_EQ(s.objects[1].initial_compression, 0);
+  World world = make_world(s, "", "");
+  const RuntimeObject& a = world.objects()[0];
+  const RuntimeObject& b = world.objects()[1];
+  const Eigen::RowVector3d rest = a.rest.colwise().maxCoeff() - a.rest.colwise().minCoeff();
+  const Eigen::RowVector3d now = a.positions.colwise().maxCoeff() - a.positions.colwise().minCoeff();
+  EXPECT_NEAR(now.x(), 0.3 * rest.x(), 1e-12);
+  EXPECT_NEAR(now.y(), rest.y(), 1e-12);
+  EXPECT_NEAR(now.z(), rest.z(), 1e-12);
+  EXPECT_NEAR(a.positions.col(0).mean(), a.rest.col(0).mean(), 1e-12);
+  EXPECT_TRUE(a.sim->positions().isApprox(a.positions));
+  EXPECT_TRUE(b.positions.isApprox(b.rest));
+}
+
 TEST(Plan, OneObjectSceneHasNoCollisionPipeline) {
   const Scene s = parse(with_objects(kSphere, R"("output": {"vtu_every": 0})"));
   const coupling::StagePlan p = scene_plan(s);

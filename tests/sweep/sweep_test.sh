@@ -234,6 +234,66 @@ assert all(a[c] == b[c] for a, b in zip(ref, edited) for c in cols), "edited cas
 assert any(a["energy"] != b["energy"] for a, b in zip(edited, base)), "--set changed nothing"
 PY
   ;;
+json_collect)
+  # The JSON collector: fields picked by JSON pointer from a file the case
+  # writes, against the values read back by Python (an independent reader).
+  # Programs are looked up beside icd-sweep, so the test runs a copy of it in a
+  # folder with a small writer program.
+  mkdir -p jbin
+  cp "$sweep" jbin/icd-sweep
+  cat > jbin/writer <<'PY'
+#!/usr/bin/python3
+import json, sys
+out, v, kind = sys.argv[1], float(sys.argv[2]), sys.argv[3]
+d = {"name": kind, "value": v, "nested": {"list": [v, 2 * v, {"deep": "x,\"y\""}]}, "flag": v > 1,
+     "count": int(10 * v), "none": None}
+with open(out + "/r.json", "w") as f:
+    if kind == "broken":
+        f.write('{"name": ')          # not valid JSON
+    else:
+        if kind == "partial":
+            del d["nested"]
+        json.dump(d, f)
+PY
+  chmod +x jbin/writer
+  cat > json.json <<'JSON'
+{"name": "j", "program": "writer", "args": ["{out}"],
+ "grid": {"@value": [0.5, 1.25, 3], "@kind": ["full", "partial", "broken"]},
+ "collect": {"json": "r.json", "fields": ["/name", "/value", "/nested/list/1", "/nested/list/2/deep", "/flag", "/count", "/none"]}}
+JSON
+  jbin/icd-sweep json.json --out j -j2 2> j.log; rc=$?
+  [ "$rc" = 1 ] || fail "json sweep with broken cases: expected exit 1, got $rc: $(cat j.log)"
+  python3 - "$work/j/results.csv" "$work/j/cases" <<'PY' || fail "json collector wrong: $(cat j/results.csv)"
+import csv, glob, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 9, len(rows)
+cols = ["name", "value", "nested/list/1", "nested/list/2/deep", "flag", "count", "none"]
+for r in rows:
+    if r["@kind"] == "full":
+        assert r["status"] == "ok", r
+        # the reference: the case's own r.json read by Python
+        ref = json.load(open(glob.glob(f"{sys.argv[2]}/{r['case_id']}/out/r.json")[0]))
+        want = [ref["name"], ref["value"], ref["nested"]["list"][1], ref["nested"]["list"][2]["deep"],
+                ref["flag"], ref["count"], ref["none"]]
+        for c, w in zip(cols, want):
+            got = r[c]
+            if isinstance(w, str):
+                assert got == w, (c, got, w)          # strings verbatim (commas and quotes survive the CSV)
+            else:
+                assert json.loads(got) == w, (c, got, w)  # numbers, booleans, null as JSON text
+        assert float(r["nested/list/1"]) == 2 * float(r["@value"]), r
+    elif r["@kind"] == "partial":
+        assert r["status"] == "failed" and "no field /nested/list/1" in r["message"], r
+        assert all(r[c] == "" for c in cols), r
+    else:
+        assert r["status"] == "failed" and "r.json: not valid JSON" in r["message"], r
+PY
+  # a field that is not a JSON pointer is refused when the sweep file is read
+  sed 's|"/none"|"none"|' json.json > badptr.json
+  jbin/icd-sweep badptr.json --out jb 2> jb.log; [ $? = 1 ] || fail "a field without / must be refused"
+  grep -q 'badptr.json: "collect".fields: a JSON pointer' jb.log || fail "message: $(cat jb.log)"
+  [ -e jb ] && fail "output folder written for a bad sweep file"
+  ;;
 *) fail "unknown test $test" ;;
 esac
 echo "PASS $test"

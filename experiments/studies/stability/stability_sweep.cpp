@@ -145,6 +145,7 @@ Outcome run_case(const Case& c, int frames, double max_seconds) {
   Scene scene = base_scene();
   scene.frames = frames;
   c.edit(scene);
+  scene.objects[0].initial_compression = c.compression;  // the scene field (run.cpp applies it)
   Outcome out;
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&] {
@@ -155,14 +156,6 @@ Outcome run_case(const Case& c, int frames, double max_seconds) {
     World world = make_world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
                 fs::canonical("/proc/self/exe").parent_path());
     for (const RuntimeObject& o : world.objects()) deformables += o.sim ? 1 : 0;
-    if (c.compression > 0) {
-      RuntimeObject& o = world.objects()[0];
-      const double cx = o.rest.col(0).mean();
-      MatX3d x = o.rest;
-      x.col(0) = (x.col(0).array() - cx) * (1 - c.compression) + cx;
-      o.sim->set_positions(x);
-      o.positions = x;
-    }
     // Reference energy: kinetic + elastic before the first step.
     out.energy0 = mechanical_energy(world);
     out.min_step = std::numeric_limits<double>::infinity();
