@@ -27,9 +27,6 @@ void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_res
   const int32_t* nodes = tree.assoc_nodes.data();
   const double* rest_dist = tree.assoc_rest_dist.data();
   const bool ratio = options.mode == SphereUpdateMode::PaperRatio;
-#ifndef NDEBUG
-  for (int32_t k = 0; k < off[n]; ++k) assert(nodes[k] >= 0 && nodes[k] < coarse_rest.rows());
-#endif
   // The displacements u_j = x_j - X_j, once per coarse node (the spheres share
   // nodes): the same values the per-sphere sums would form, read from one
   // packed array.
@@ -37,6 +34,8 @@ void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_res
   t_u.resize(static_cast<std::size_t>(3 * coarse_rest.rows()));
   double* u = t_u.data();
   for (Eigen::Index j = 0; j < 3 * coarse_rest.rows(); ++j) u[j] = x[j] - X[j];
+  const auto rows = static_cast<uint32_t>(coarse_rest.rows());
+  bool bad_index = false;  // an associated node index out of range (checked once, below)
   double check = 0.0;
   for (int i = 0; i < n; ++i) {
     const int32_t b = off[i], e = off[i + 1];
@@ -50,6 +49,7 @@ void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_res
     double ux = 0, uy = 0, uz = 0;
     for (int32_t k = b; k < e; ++k) {
       const int32_t j = nodes[k];
+      bad_index |= static_cast<uint32_t>(j) >= rows;
       ux += u[3 * j];
       uy += u[3 * j + 1];
       uz += u[3 * j + 2];
@@ -84,6 +84,8 @@ void update_spheres(SphereTree& tree, const Eigen::Ref<const MatX3d>& coarse_res
     s = {cx, cy, cz, r};
     check += s.x + s.y + s.z + s.r;
   }
+  assert(!bad_index && "update_spheres: an associated coarse node index is out of range");
+  (void)bad_index;
   if (!std::isfinite(check)) {
     for (int i = 0; i < n; ++i) {
       const Sphere& s = tree.spheres[i];

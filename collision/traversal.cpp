@@ -197,6 +197,8 @@ class Budget {
   // True when tests number `tests` .. `tests + count - 1` trigger no budget
   // event (no clock read due, test budget not reached): they may run unchecked.
   bool batch_ok(int64_t tests, int64_t count) const { return tests + count <= m_next; }
+  // The test number at which the next budget event falls (see batch_ok).
+  int64_t next_event() const { return m_next; }
 
   // Call before test number `tests` with `pending` pairs that an interruption
   // would have to copy out; returns false (and sets the reason) to stop. The
@@ -556,12 +558,17 @@ void run_plain_fifo(const Trees& t, PairQueue& q, const Budget& budget, Collisio
   std::size_t mask = q.mask(), head = q.head(), size = q.size(), cap = q.capacity();
   int64_t tests = res.tests;
   std::size_t peak = res.peak_list_size;
+  // Everything the loop reads, in locals (nothing inside changes it).
+  const Sphere *const sa = t.sa, *const sb = t.sb;
+  const int32_t *const fca = t.fca, *const cca = t.cca, *const fcb = t.fcb, *const ccb = t.ccb;
+  std::vector<NodePair>& colliding = res.colliding;
+  const int64_t next_event = budget.next_event();
   while (size > 0) {
     const WorkPair p = buf[head];
-    const int32_t ca = t.cca[p.a], cb = t.ccb[p.b];
+    const int32_t ca = cca[p.a], cb = ccb[p.b];
     const bool split_b = p.split_b ? cb > 0 : ca == 0 && cb > 0;
     const int32_t count = split_b ? cb : ca;
-    if (!budget.batch_ok(tests, count)) break;
+    if (tests + count > next_event) break;  // Budget::batch_ok
     head = (head + 1) & mask;
     --size;
     if (size + static_cast<std::size_t>(count) > cap) {
@@ -573,11 +580,11 @@ void run_plain_fifo(const Trees& t, PairQueue& q, const Budget& budget, Collisio
       cap = q.capacity();
     }
     tests += count;
-    const Sphere o = split_b ? t.sa[p.a] : t.sb[p.b];
+    const Sphere o = split_b ? sa[p.a] : sb[p.b];
     const bool other_expandable = (split_b ? ca : cb) > 0;
-    const int32_t first = split_b ? t.fcb[p.b] : t.fca[p.a], end = first + count;
-    const Sphere* kids = split_b ? t.sb : t.sa;
-    const int32_t* kid_count = split_b ? t.ccb : t.cca;
+    const int32_t first = split_b ? fcb[p.b] : fca[p.a], end = first + count;
+    const Sphere* kids = split_b ? sb : sa;
+    const int32_t* kid_count = split_b ? ccb : cca;
     const int32_t next = split_b ? 0 : 1;
     // Pair of child c: (p.a, c) when b is split, else (c, p.b).
     const int32_t keep = split_b ? p.a : p.b;
@@ -602,7 +609,7 @@ void run_plain_fifo(const Trees& t, PairQueue& q, const Budget& budget, Collisio
           buf[tail & mask] = pair(c);
           tail += ov;
         } else if (ov) {
-          res.colliding.push_back(split_b ? NodePair{keep, c} : NodePair{c, keep});
+          colliding.push_back(split_b ? NodePair{keep, c} : NodePair{c, keep});
         }
       }
     }
