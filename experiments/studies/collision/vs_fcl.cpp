@@ -15,7 +15,8 @@
 // Ours: update_spheres (paper ratio and displacement bound), collide (full
 // traversal, fast path, the default request).
 // Timing: every operation runs once per round, all operations of a frame
-// interleaved (ours, near-limit and FCL alternate), `--rounds` rounds per
+// interleaved (ours, near-limit and FCL alternate; ours and the near-limit
+// loop swap who goes first every round), `--rounds` rounds per
 // frame; each run is timed in wall time (steady clock) and CPU time of the
 // thread (CLOCK_THREAD_CPUTIME_ID); the tables give medians over all
 // frames x rounds. The load average is printed at the start and the end.
@@ -145,27 +146,43 @@ int run_scene(const std::string& label, const std::string& file, int frames, int
         outa.resize(a.tree.spheres.size());
         outb.resize(b.tree.spheres.size());
         const long nca = a.coarse_rest.rows(), ncb = b.coarse_rest.rows();
-        l->bound.time([&] {
-          update_spheres(a.tree, a.coarse_rest, xa, cons);
-          update_spheres(b.tree, b.coarse_rest, xb, cons);
-        });
-        l->bound_nl.time([&] {
-          nlu.run(a.tree, a.coarse_rest.data(), xa.data(), nca, false, outa.data());
-          nlu.run(b.tree, b.coarse_rest.data(), xb.data(), ncb, false, outb.data());
-        });
-        frame_ok &= same_spheres(outa, a.tree.spheres) && same_spheres(outb, b.tree.spheres);
-        l->upd.time([&] {
-          update_spheres(a.tree, a.coarse_rest, xa, paper);
-          update_spheres(b.tree, b.coarse_rest, xb, paper);
-        });
-        l->upd_nl.time([&] {
-          nlu.run(a.tree, a.coarse_rest.data(), xa.data(), nca, true, outa.data());
-          nlu.run(b.tree, b.coarse_rest.data(), xb.data(), ncb, true, outb.data());
-        });
-        frame_ok &= same_spheres(outa, a.tree.spheres) && same_spheres(outb, b.tree.spheres);
-        l->trav.time([&] { collide(a.tree, b.tree, CollisionRequest{}, res); });
-        l->trav_nl.time(
-            [&] { nlt.run(a.tree.spheres.data(), l->pa, b.tree.spheres.data(), l->pb); });
+        auto upd_ours = [&](Samples& smp, const SphereUpdateOptions& o) {
+          smp.time([&] {
+            update_spheres(a.tree, a.coarse_rest, xa, o);
+            update_spheres(b.tree, b.coarse_rest, xb, o);
+          });
+        };
+        auto upd_nl = [&](Samples& smp, bool ratio) {
+          smp.time([&] {
+            nlu.run(a.tree, a.coarse_rest.data(), xa.data(), nca, ratio, outa.data());
+            nlu.run(b.tree, b.coarse_rest.data(), xb.data(), ncb, ratio, outb.data());
+          });
+        };
+        for (const bool ratio : {false, true}) {
+          Samples& o = ratio ? l->upd : l->bound;
+          Samples& n = ratio ? l->upd_nl : l->bound_nl;
+          if (r % 2 == 0) {
+            upd_ours(o, ratio ? paper : cons);
+            upd_nl(n, ratio);
+          } else {
+            upd_nl(n, ratio);
+            upd_ours(o, ratio ? paper : cons);
+          }
+          frame_ok &= same_spheres(outa, a.tree.spheres) && same_spheres(outb, b.tree.spheres);
+        }
+        // Ours and the near-limit loop take turns going first (odd rounds: NL first).
+        auto ours = [&] { l->trav.time([&] { collide(a.tree, b.tree, CollisionRequest{}, res); }); };
+        auto nl = [&] {
+          l->trav_nl.time(
+              [&] { nlt.run(a.tree.spheres.data(), l->pa, b.tree.spheres.data(), l->pb); });
+        };
+        if (r % 2 == 0) {
+          ours();
+          nl();
+        } else {
+          nl();
+          ours();
+        }
         frame_ok &= nlt.tests == res.tests && nlt.colliding == res.colliding && res.untested.empty();
         if (r == 0) {
           l->tests.push_back(static_cast<double>(res.tests));
