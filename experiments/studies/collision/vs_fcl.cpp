@@ -23,11 +23,17 @@
 // The near-limit loops are checked on every frame: identical spheres, leaf
 // pairs and test counts, else the program says so and exits 1.
 //
+// Trees: our octree trees over every k-th dense vertex as coarse nodes, or,
+// with --dragon-bundle / --bunny-bundle, the runner's medial-axis tree and
+// coarse tet nodes from an asset bundle (cut to each of --levels).
+//
 // Usage: icd_collision_vs_fcl [--frames N] [--rounds R] [--levels L,..] [--mesh dragon|bunny|both]
+//                             [--dragon-bundle DIR] [--bunny-bundle DIR]
 #include <time.h>
 
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -37,6 +43,8 @@
 #include <fcl/fcl.h>
 
 #include <icd/collision/sphere_update.hpp>
+#include <icd/coupling/asset_bundle.hpp>
+#include <icd/mesh/core/error.hpp>
 #include <icd/collision/traversal.hpp>
 #include "experiments/common/cli.hpp"
 #include "experiments/studies/collision/near_limit.hpp"
@@ -102,6 +110,37 @@ bool same_spheres(const std::vector<Sphere>& x, const std::vector<Sphere>& y) {
   return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(Sphere)) == 0;
 }
 
+// An object from an asset bundle (the runner's medial-axis tree, associated
+// with the coarse tet nodes), scaled and centred as load_object does (longest
+// side 2), its tree cut to `levels` levels.
+Object bundle_object(const icd::coupling::AssetBundle& bundle, const std::string& name,
+                     const Eigen::Vector3d& center, int levels) {
+  const Eigen::RowVector3d lo = bundle.dense.V.colwise().minCoeff(),
+                           hi = bundle.dense.V.colwise().maxCoeff();
+  const double s = 2.0 / (hi - lo).maxCoeff();
+  const Eigen::RowVector3d mid = 0.5 * (lo + hi);
+  auto place = [&](icd::MatX3d& V) {
+    for (int i = 0; i < V.rows(); ++i) V.row(i) = (V.row(i) - mid) * s + center.transpose();
+  };
+  Object o;
+  o.name = name;
+  o.dense = bundle.dense;
+  place(o.dense.V);
+  o.coarse_rest = bundle.coarse.V;
+  place(o.coarse_rest);
+  o.tree = bundle.spheres;
+  truncate_levels(o.tree, levels - 1);
+  for (auto* list : {&o.tree.spheres, &o.tree.rest_spheres})
+    for (Sphere& q : *list) {
+      q.x = (q.x - mid.x()) * s + center.x();
+      q.y = (q.y - mid.y()) * s + center.y();
+      q.z = (q.z - mid.z()) * s + center.z();
+      q.r *= s;
+    }
+  for (double& d : o.tree.assoc_rest_dist) d *= s;
+  return o;
+}
+
 struct Level {
   Object a, b;
   PackedTree pa, pb;
@@ -112,18 +151,38 @@ struct Level {
 };
 
 // Returns the number of frames on which a near-limit loop disagreed.
-int run_scene(const std::string& label, const std::string& file, int frames, int rounds,
-              const std::vector<int>& levels) {
+int run_scene(const std::string& label, const std::string& file, const std::string& bundle_dir,
+              int frames, int rounds, const std::vector<int>& levels) {
   std::vector<std::unique_ptr<Level>> lv;
-  for (int L : levels)
-    lv.push_back(std::make_unique<Level>(load_object(file, {0, 0, 0}, L),
-                                         load_object(file, {0.45, 0.15, 0.05}, L)));
+  const Eigen::Vector3d ca(0, 0, 0), cb(0.45, 0.15, 0.05);
+  std::string trees;
+  if (bundle_dir.empty()) {
+    for (int L : levels)
+      lv.push_back(std::make_unique<Level>(load_object(file, ca, L), load_object(file, cb, L)));
+    trees = "octree sphere trees; coarse nodes: every k-th dense vertex";
+  } else {
+    const icd::coupling::AssetBundle bundle = icd::coupling::read_asset_bundle(bundle_dir);
+    if (bundle.spheres.num_nodes() == 0)
+      throw icd::InputError("bundle " + bundle_dir + " has no sphere tree");
+    for (int L : levels) {
+      if (L > bundle.spheres.num_levels()) {
+        std::printf("(bundle tree has %d levels: level count %d skipped)\n",
+                    bundle.spheres.num_levels(), L);
+        continue;
+      }
+      lv.push_back(std::make_unique<Level>(bundle_object(bundle, label, ca, L),
+                                           bundle_object(bundle, label, cb, L)));
+    }
+    if (lv.empty()) throw icd::InputError("--levels: no level fits the tree of " + bundle_dir);
+    trees = "medial-axis sphere trees of bundle " + bundle_dir + "; coarse nodes: its tet nodes";
+  }
   const Object& a0 = lv[0]->a;
   const Object& b0 = lv[0]->b;
-  std::printf("\n== %s (%s): %ld vertices, %ld triangles per copy; %ld coarse nodes; %d frames x "
-              "%d rounds, interleaved\n",
-              label.c_str(), file.c_str(), (long)a0.dense.V.rows(), (long)a0.dense.F.rows(),
-              (long)a0.coarse_rest.rows(), frames, rounds);
+  std::printf("\n== %s (%s): %ld vertices, %ld triangles per copy; %ld coarse nodes; %s; %d "
+              "frames x %d rounds, interleaved\n",
+              label.c_str(), bundle_dir.empty() ? file.c_str() : bundle_dir.c_str(),
+              (long)a0.dense.V.rows(), (long)a0.dense.F.rows(), (long)a0.coarse_rest.rows(),
+              trees.c_str(), frames, rounds);
   auto ma = make_model(a0.dense), mb = make_model(b0.dense);
   fcl::CollisionObjectd oa(ma, fcl::Transform3d::Identity()), ob(mb, fcl::Transform3d::Identity());
   Samples f_refit, f_first, f_all, f_public;
@@ -258,13 +317,18 @@ int run_scene(const std::string& label, const std::string& file, int frames, int
 int main(int argc, char** argv) {
   int frames = 10, rounds = 3;
   std::string levels_text = "4,5,6", mesh = "both";
+  std::filesystem::path dragon_bundle, bunny_bundle;
   icd::experiments::Cli cli("icd_collision_vs_fcl");
   cli.integer("--frames", frames, "N", "frames (default 10)", 1)
       .integer("--rounds", rounds, "R", "timed rounds per frame (default 3)", 1)
       .text("--levels", levels_text, "L,..",
             "octree sphere-tree levels, comma separated (default 4,5,6: 243, 1100, 4657 spheres "
             "per dragon)")
-      .text("--mesh", mesh, "NAME", "dragon, bunny or both (default both)");
+      .text("--mesh", mesh, "NAME", "dragon, bunny or both (default both)")
+      .path("--dragon-bundle", dragon_bundle, "DIR",
+            "asset bundle of the dragon: use its medial-axis tree (cut to each of --levels) and "
+            "its coarse nodes instead of the octree trees")
+      .path("--bunny-bundle", bunny_bundle, "DIR", "the same for the bunny");
   if (const auto status = cli.parse(argc, argv)) return *status;
   std::vector<int> levels;
   {
@@ -292,8 +356,11 @@ int main(int argc, char** argv) {
               icd::experiments::load_average().c_str());
   int bad = 0;
   try {
-    if (mesh != "bunny") bad += run_scene("dragon", "ChineseDragon-10kv.off", frames, rounds, levels);
-    if (mesh != "dragon") bad += run_scene("bunny", "bunny00.off", frames, rounds, levels);
+    if (mesh != "bunny")
+      bad += run_scene("dragon", "ChineseDragon-10kv.off", dragon_bundle.string(), frames, rounds,
+                       levels);
+    if (mesh != "dragon")
+      bad += run_scene("bunny", "bunny00.off", bunny_bundle.string(), frames, rounds, levels);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
