@@ -16,7 +16,7 @@
 // traversal, fast path, the default request).
 // Timing: every operation runs once per round, all operations of a frame
 // interleaved (ours, near-limit and FCL alternate; ours and the near-limit
-// loop swap who goes first every round), `--rounds` rounds per
+// loop swap who goes first every round, each first in half the runs), `--rounds` rounds per
 // frame; each run is timed in wall time (steady clock) and CPU time of the
 // thread (CLOCK_THREAD_CPUTIME_ID); the tables give medians over all
 // frames x rounds. The load average is printed at the start and the end.
@@ -200,6 +200,9 @@ int run_scene(const std::string& label, const std::string& file, const std::stri
     const icd::MatX3d Va = deform(a0.dense.V, 0.05, t), Vb = deform(b0.dense.V, 0.05, t + 1.0);
     bool frame_ok = true;
     for (int r = 0; r < rounds; ++r) {
+      // Ours and the near-limit loop swap who goes first at every round
+      // (counted over all frames, so that each goes first in half the runs).
+      const bool ours_first = (frame * rounds + r) % 2 == 0;
       for (auto& l : lv) {
         Object &a = l->a, &b = l->b;
         outa.resize(a.tree.spheres.size());
@@ -220,7 +223,7 @@ int run_scene(const std::string& label, const std::string& file, const std::stri
         for (const bool ratio : {false, true}) {
           Samples& o = ratio ? l->upd : l->bound;
           Samples& n = ratio ? l->upd_nl : l->bound_nl;
-          if (r % 2 == 0) {
+          if (ours_first) {
             upd_ours(o, ratio ? paper : cons);
             upd_nl(n, ratio);
           } else {
@@ -229,13 +232,12 @@ int run_scene(const std::string& label, const std::string& file, const std::stri
           }
           frame_ok &= same_spheres(outa, a.tree.spheres) && same_spheres(outb, b.tree.spheres);
         }
-        // Ours and the near-limit loop take turns going first (odd rounds: NL first).
         auto ours = [&] { l->trav.time([&] { collide(a.tree, b.tree, CollisionRequest{}, res); }); };
         auto nl = [&] {
           l->trav_nl.time(
               [&] { nlt.run(a.tree.spheres.data(), l->pa, b.tree.spheres.data(), l->pb); });
         };
-        if (r % 2 == 0) {
+        if (ours_first) {
           ours();
           nl();
         } else {
