@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include <icd/collision/cycle_clock.hpp>
 #include <icd/mesh/core/error.hpp>
@@ -74,6 +75,20 @@ class PairQueue {
   void for_each(F&& f) const {
     for (std::size_t k = 0; k < m_size; ++k) f(m_buf[(m_head + k) & m_mask]);
   }
+  /// Raw appends (after ensure()): write pair k of the batch at
+  /// raw()[(tail() + k) & mask()], then commit(count).
+  WorkPair* raw() { return m_buf.data(); }
+  std::size_t tail() const { return m_head + m_size; }
+  std::size_t mask() const { return m_mask; }
+  void commit(std::size_t count) { m_size += count; }
+  /// State access for the hot loop (run_plain_fifo), which keeps head and
+  /// size in registers and writes them back before anything else runs.
+  std::size_t head() const { return m_head; }
+  std::size_t capacity() const { return m_buf.size(); }
+  void set_state(std::size_t head, std::size_t size) {
+    m_head = head;
+    m_size = size;
+  }
   /// Applies f to the last `count` pairs pushed.
   template <class F>
   void for_last(std::size_t count, F&& f) {
@@ -116,6 +131,10 @@ class PairStack {
   void for_each(F&& f) const {
     for (std::size_t k = m_size; k-- > 0;) f(m_buf[k]);
   }
+  WorkPair* raw() { return m_buf.data(); }
+  std::size_t tail() const { return m_size; }
+  std::size_t mask() const { return ~std::size_t{0}; }
+  void commit(std::size_t count) { m_size += count; }
   template <class F>
   void for_last(std::size_t count, F&& f) {
     for (std::size_t k = m_size - count; k < m_size; ++k) f(m_buf[k]);
@@ -178,6 +197,8 @@ class Budget {
   // True when tests number `tests` .. `tests + count - 1` trigger no budget
   // event (no clock read due, test budget not reached): they may run unchecked.
   bool batch_ok(int64_t tests, int64_t count) const { return tests + count <= m_next; }
+  // The test number at which the next budget event falls (see batch_ok).
+  int64_t next_event() const { return m_next; }
 
   // Call before test number `tests` with `pending` pairs that an interruption
   // would have to copy out; returns false (and sets the reason) to stop. The
@@ -242,6 +263,7 @@ struct Trees {
   const int32_t* lb;
   int cap;
   bool parent_filter;
+  bool uncapped;  // cap deeper than both trees: expandable == has children
   bool expandable_a(int32_t n) const { return cca[n] > 0 && la[n] < cap; }
   bool expandable_b(int32_t n) const { return ccb[n] > 0 && lb[n] < cap; }
   bool overlaps(int32_t a, int32_t b) const { return overlap(sa[a], sb[b]); }
@@ -475,12 +497,142 @@ inline void expand_batch(const Trees& t, const WorkPair& p, const Split& s, List
   }
 }
 
+// expand_batch without the parent filter, as tight as the work allows (the
+// hot loop of a full traversal): the tests counted at once, pairs written
+// branch-free straight into the list's storage, the branch on whether the
+// other node is split further hoisted out of the loop; Uncapped (no depth cap
+// inside the trees): a node is expandable iff it has children, so a pair of
+// two unexpandable nodes is a leaf pair. Same tests, same order, same pairs.
+template <bool SplitB, bool Uncapped, class List>
+inline void expand_plain(const Trees& t, const WorkPair& p, const Split& s, List& list,
+                         CollisionResult& res) {
+  const Sphere o = SplitB ? t.sa[p.a] : t.sb[p.b];
+  const Sphere* kids = SplitB ? t.sb : t.sa;
+  const int32_t* kid_count = SplitB ? t.ccb : t.cca;
+  res.tests += s.end - s.first;
+  WorkPair* buf = list.raw();
+  const std::size_t mask = list.mask(), start = list.tail();
+  std::size_t tail = start;
+  const int32_t next = s.next_split_b ? 1 : 0;
+  auto overlaps = [&](int32_t c) {
+    const Sphere& k = kids[c];
+    const double dx = o.x - k.x, dy = o.y - k.y, dz = o.z - k.z, rr = o.r + k.r;
+    return dx * dx + dy * dy + dz * dz <= rr * rr;
+  };
+  auto pair = [&](int32_t c) {
+    return SplitB ? WorkPair{p.a, c, next, kAllChildren} : WorkPair{c, p.b, next, kAllChildren};
+  };
+  if (s.other_expandable) {
+    for (int32_t c = s.first; c < s.end; ++c) {
+      buf[tail & mask] = pair(c);
+      tail += overlaps(c);
+    }
+  } else {
+    for (int32_t c = s.first; c < s.end; ++c) {
+      const bool ov = overlaps(c);
+      const bool expandable =
+          Uncapped ? kid_count[c] > 0 : (SplitB ? t.expandable_b(c) : t.expandable_a(c));
+      if (expandable) {
+        buf[tail & mask] = pair(c);
+        tail += ov;
+      } else if (ov) {
+        const WorkPair w = pair(c);
+        if constexpr (Uncapped)
+          res.colliding.push_back({w.a, w.b});
+        else
+          settle(t, w.a, w.b, res);
+      }
+    }
+  }
+  list.commit(tail - start);
+}
+
+// The fast path's hot loop for the default query (FIFO, no parent filter, no
+// front, no depth cap inside the trees): run_fast's batches with the queue's
+// head and size, the test count and the peak in registers. Returns when the
+// queue is empty or when the next pair's batch would reach a budget event
+// (that pair is then back at the queue's head, for the general loop). Same
+// tests, same order, same pairs as expand_plain.
+void run_plain_fifo(const Trees& t, PairQueue& q, const Budget& budget, CollisionResult& res) {
+  WorkPair* buf = q.raw();
+  std::size_t mask = q.mask(), head = q.head(), size = q.size(), cap = q.capacity();
+  int64_t tests = res.tests;
+  std::size_t peak = res.peak_list_size;
+  // Everything the loop reads, in locals (nothing inside changes it).
+  const Sphere *const sa = t.sa, *const sb = t.sb;
+  const int32_t *const fca = t.fca, *const cca = t.cca, *const fcb = t.fcb, *const ccb = t.ccb;
+  std::vector<NodePair>& colliding = res.colliding;
+  const int64_t next_event = budget.next_event();
+  while (size > 0) {
+    const WorkPair p = buf[head];
+    const int32_t ca = cca[p.a], cb = ccb[p.b];
+    const bool split_b = p.split_b ? cb > 0 : ca == 0 && cb > 0;
+    const int32_t count = split_b ? cb : ca;
+    if (tests + count > next_event) break;  // Budget::batch_ok
+    head = (head + 1) & mask;
+    --size;
+    if (size + static_cast<std::size_t>(count) > cap) {
+      q.set_state(head, size);
+      q.ensure(static_cast<std::size_t>(count));
+      buf = q.raw();
+      mask = q.mask();
+      head = q.head();
+      cap = q.capacity();
+    }
+    tests += count;
+    const Sphere o = split_b ? sa[p.a] : sb[p.b];
+    const bool other_expandable = (split_b ? ca : cb) > 0;
+    const int32_t first = split_b ? fcb[p.b] : fca[p.a], end = first + count;
+    const Sphere* kids = split_b ? sb : sa;
+    const int32_t* kid_count = split_b ? ccb : cca;
+    const int32_t next = split_b ? 0 : 1;
+    // Pair of child c: (p.a, c) when b is split, else (c, p.b).
+    const int32_t keep = split_b ? p.a : p.b;
+    std::size_t tail = head + size;
+    auto overlaps = [&](int32_t c) {
+      const Sphere& k = kids[c];
+      const double dx = o.x - k.x, dy = o.y - k.y, dz = o.z - k.z, rr = o.r + k.r;
+      return dx * dx + dy * dy + dz * dz <= rr * rr;
+    };
+    auto pair = [&](int32_t c) {
+      return split_b ? WorkPair{keep, c, next, kAllChildren} : WorkPair{c, keep, next, kAllChildren};
+    };
+    if (other_expandable) {
+      for (int32_t c = first; c < end; ++c) {
+        buf[tail & mask] = pair(c);
+        tail += overlaps(c);
+      }
+    } else {
+      for (int32_t c = first; c < end; ++c) {
+        const bool ov = overlaps(c);
+        if (kid_count[c] > 0) {
+          buf[tail & mask] = pair(c);
+          tail += ov;
+        } else if (ov) {
+          colliding.push_back(split_b ? NodePair{keep, c} : NodePair{c, keep});
+        }
+      }
+    }
+    size = tail - head;
+    peak = std::max(peak, size);
+  }
+  q.set_state(head, size);
+  res.tests = tests;
+  res.peak_list_size = peak;
+}
+
 // Fast path: children are tested as they are generated; the list holds only
 // overlapping pairs that still need splitting.
 template <bool Filter, class List>
 void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, CollisionResult& res) {
   bool stopped = false;
   while (!list.empty() && !stopped) {
+    if constexpr (!Filter && std::is_same_v<List, PairQueue>) {
+      if (!record_front && t.uncapped) {
+        run_plain_fifo(t, list, budget, res);
+        if (list.empty()) break;
+      }
+    }
     const WorkPair p = list.pop();
     const Split s(t, p);
     const int64_t most = (s.end - s.first) + (Filter ? s.filter_tests(t) : 0);
@@ -488,10 +640,23 @@ void run_fast(const Trees& t, List& list, Budget& budget, bool record_front, Col
       // Batch: no budget event inside; children tested against the fixed
       // sphere with branch-free pushes of the overlapping ones.
       list.ensure(static_cast<std::size_t>(s.end - s.first));
-      if (s.split_b)
+      if constexpr (!Filter) {
+        if (t.uncapped) {
+          if (s.split_b)
+            expand_plain<true, true>(t, p, s, list, res);
+          else
+            expand_plain<false, true>(t, p, s, list, res);
+        } else {
+          if (s.split_b)
+            expand_plain<true, false>(t, p, s, list, res);
+          else
+            expand_plain<false, false>(t, p, s, list, res);
+        }
+      } else if (s.split_b) {
         expand_batch<true, Filter>(t, p, s, list, res);
-      else
+      } else {
         expand_batch<false, Filter>(t, p, s, list, res);
+      }
       res.peak_list_size = std::max(res.peak_list_size, list.size());
       continue;
     }
@@ -647,7 +812,8 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
                 a.first_child.data(), a.child_count.data(),
                 b.first_child.data(), b.child_count.data(),
                 a.level.data(),       b.level.data(),
-                request.depth_cap,    request.parent_filter && !literal};
+                request.depth_cap,    request.parent_filter && !literal,
+                request.depth_cap >= std::max(a.num_levels(), b.num_levels())};
   // Seeds: the root pair (Fig. 7: p.1 = root of a, p.2 = root of b, split p.2
   // first), or the previous front, splitting the shallower node first.
   std::vector<WorkPair>& seeds = t_seeds;
