@@ -215,6 +215,10 @@ int World::motion_cycles(double dt) const {
   if (m_obstacle_near) {
     // Near an obstacle: each object moves at most cycle_motion of its scale
     // (and of half the thinnest box) per cycle, gravity included.
+    // and a cycle is at most kObstacleCycle long: the support of a resting
+    // node is held over the cycle (the energy its error adds is taken back
+    // from the motion, see resolve_obstacles; a short cycle keeps it small).
+    cycles = std::max(cycles, std::ceil(dt / kObstacleCycle));
     double thin = std::numeric_limits<double>::infinity();
     for (const Obstacle& ob : m_settings.obstacles) thin = std::min(thin, 0.5 * ob.thickness());
     for (const RuntimeObject& o : m_objects) {
@@ -350,6 +354,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
   const bool track_work = m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
   for_each_object([&](int k) {
     RuntimeObject& o = m_objects[static_cast<size_t>(k)];
+    const bool was_near = o.near_obstacle;
     o.near_obstacle = false;
     o.cycle_substeps = 0;
     o.cycle_min_step = std::numeric_limits<double>::infinity();
@@ -361,22 +366,34 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         lo = o.positions.colwise().minCoeff().transpose();
         hi = o.positions.colwise().maxCoeff().transpose();
       }
+      const bool supported = o.obstacle_support.size() > 0;
       if (o.external_forces.size() > 0)
         o.sim->set_external_forces(m_plan.response ? MatX3d(o.contact_forces + o.external_forces)
                                                    : o.external_forces);
       else if (m_plan.response)
         o.sim->set_external_forces(o.contact_forces);
+      else if (supported)
+        o.sim->set_external_forces(MatX3d::Zero(o.rest.rows(), 3));
+      if (obstacles && was_near && obstacle_support(o))
+        o.sim->set_external_forces(o.sim->model().external_forces() + o.obstacle_support);
+      else
+        o.obstacle_support.resize(0, 3);
       // The forces are constant over the cycle: their work is f . x1 - f . x0.
       if (track_work) o.work_before = o.contact_forces.cwiseProduct(o.positions).sum();
+      double support_work = 0;
+      if (o.obstacle_support.size() > 0)
+        support_work = -o.obstacle_support.cwiseProduct(o.positions).sum();
       const fem::AdvanceReport rep = naming(o, [&] { return o.sim->advance(h); });
       o.positions = o.sim->positions();
       if (track_work) o.work_after = o.contact_forces.cwiseProduct(o.positions).sum();
+      if (o.obstacle_support.size() > 0)
+        support_work += o.obstacle_support.cwiseProduct(o.positions).sum();
       o.cycle_substeps = rep.substeps;
       o.cycle_min_step = rep.step;
       if (obstacles) {
         lo = lo.cwiseMin(o.positions.colwise().minCoeff().transpose());
         hi = hi.cwiseMax(o.positions.colwise().maxCoeff().transpose());
-        resolve_obstacles(o, lo, hi);
+        resolve_obstacles(o, lo, hi, support_work);
       }
     } else if (o.plan.kinematic) {
       if (o.setup.motion)
@@ -647,7 +664,7 @@ void World::limit_contact_work(double h, FrameMetrics& m) {
 }
 
 void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
-                              const Eigen::Vector3d& hi_in) const {
+                              const Eigen::Vector3d& hi_in, double support_work) const {
   // Within reach? The dense surface lies within max_link of the coarse
   // nodes' convex hull (a link origin is a convex combination of three
   // nodes; the link keeps its length), which lies in [lo, hi].
@@ -657,6 +674,7 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
   for (const Obstacle& ob : m_settings.obstacles) near = near || ob.lower_bound(lo, hi) <= 0;
   if (!near) return;
   o.near_obstacle = true;
+  const double e_before = mechanical_energy(*o.sim, m_settings.gravity);
   const int n = static_cast<int>(o.positions.rows());
   MatX3d corr(n, 3), dir = MatX3d::Zero(n, 3);
   o.obstacle_dense.resize(o.asset.links.num_links(), 3);
@@ -701,15 +719,59 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
       }
     moved = true;
   }
-  if (!moved) return;
-  // Inelastic: the moved nodes lose their velocity into the obstacle.
   MatX3d vel = o.sim->velocities();
-  for (int j = 0; j < n; ++j) {
-    const double vn = vel.row(j).dot(dir.row(j));
-    if (vn < 0) vel.row(j) -= vn * dir.row(j);
+  if (moved) {
+    // Inelastic: the moved nodes lose their velocity into the obstacle.
+    for (int j = 0; j < n; ++j) {
+      const double vn = vel.row(j).dot(dir.row(j));
+      if (vn < 0) vel.row(j) -= vn * dir.row(j);
+    }
+    o.sim->set_positions(o.positions);
+    o.sim->set_velocities(vel);
   }
-  o.sim->set_positions(o.positions);
-  o.sim->set_velocities(vel);
+  // Never a source of energy. Moving nodes out stores elastic energy (only
+  // some nodes move) and lifts the object against gravity, and a support
+  // held constant over the cycle does work on a node that lifts off. What
+  // they added beyond what the removed velocity took away is taken from the
+  // kinetic energy (every velocity scaled alike); what it cannot pay now is
+  // paid by the next cycles.
+  const double e_after = moved ? mechanical_energy(*o.sim, m_settings.gravity) : e_before;
+  const double excess = e_after - e_before + support_work + o.obstacle_debt;
+  if (!(excess > 0)) {
+    o.obstacle_debt = 0;
+    return;
+  }
+  const double kinetic = o.sim->model().kinetic_energy(vel);
+  const double paid = std::min(excess, kinetic);
+  if (paid > 0) o.sim->set_velocities(vel * std::sqrt(std::max(0.0, (kinetic - paid) / kinetic)));
+  o.obstacle_debt = excess - paid;
+}
+
+bool World::obstacle_support(RuntimeObject& o) const {
+  o.obstacle_dense.resize(o.asset.links.num_links(), 3);
+  o.links.apply(o.positions, o.obstacle_dense);
+  const int n = static_cast<int>(o.positions.rows());
+  MatX3d normal = MatX3d::Zero(n, 3);
+  const auto& nodes = o.asset.links.nodes;
+  bool any = false;
+  for (int v = 0; v < o.obstacle_dense.rows(); ++v) {
+    const Eigen::Vector3d p = o.obstacle_dense.row(v).transpose();
+    for (const Obstacle& ob : m_settings.obstacles) {
+      Eigen::Vector3d nrm;
+      if (!(ob.signed_distance(p, &nrm) < kObstacleContact)) continue;
+      any = true;
+      for (int k = 0; k < 3; ++k) normal.row(nodes(v, k)) = nrm.transpose();
+    }
+  }
+  if (!any) return false;
+  MatX3d f(n, 3);
+  o.sim->model().total_force(o.positions, o.sim->velocities(), f);
+  o.obstacle_support = MatX3d::Zero(n, 3);
+  for (int j = 0; j < n; ++j) {
+    const double fn = f.row(j).dot(normal.row(j));
+    if (fn < 0) o.obstacle_support.row(j) = -fn * normal.row(j);
+  }
+  return true;
 }
 
 bool World::contact_free() const {
@@ -738,7 +800,15 @@ void World::save(Snapshot& s) const {
   s.contact_work = m_contact_work;
   s.passive_allowance = m_passive_allowance;
   s.start_spheres.resize(m_objects.size());
-  for (size_t i = 0; i < m_objects.size(); ++i) s.start_spheres[i] = m_objects[i].start_spheres;
+  s.obstacle_debt.resize(m_objects.size());
+  s.obstacle_support.resize(m_objects.size());
+  s.near_obstacle.resize(m_objects.size());
+  for (size_t i = 0; i < m_objects.size(); ++i) {
+    s.start_spheres[i] = m_objects[i].start_spheres;
+    s.obstacle_debt[i] = m_objects[i].obstacle_debt;
+    s.obstacle_support[i] = m_objects[i].obstacle_support;
+    s.near_obstacle[i] = m_objects[i].near_obstacle;
+  }
 }
 
 void World::restore(const Snapshot& s) {
@@ -761,7 +831,12 @@ void World::restore(const Snapshot& s) {
   m_contact_work = s.contact_work;
   m_passive_allowance = s.passive_allowance;
   m_penalty_energy = 0;  // the trial started contact-free
-  for (size_t i = 0; i < m_objects.size(); ++i) m_objects[i].start_spheres = s.start_spheres[i];
+  for (size_t i = 0; i < m_objects.size(); ++i) {
+    m_objects[i].start_spheres = s.start_spheres[i];
+    m_objects[i].obstacle_debt = s.obstacle_debt[i];
+    m_objects[i].obstacle_support = s.obstacle_support[i];
+    m_objects[i].near_obstacle = s.near_obstacle[i];
+  }
   // The rolled-back interval started contact-free: so do its queries.
   for (collision::CollisionResult& r : m_results) {
     r.colliding.clear();

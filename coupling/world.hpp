@@ -131,6 +131,12 @@ struct RuntimeObject {
   double obstacle_scale = 0;
   MatX3d obstacle_dense;
   bool near_obstacle = false;  ///< came within reach of an obstacle in the last cycle
+  /// Support of the obstacles for the coming cycle (#coarse nodes x 3, N;
+  /// empty when none): see World::obstacle_support.
+  MatX3d obstacle_support;
+  /// Energy the obstacles added (support work, projection) that the
+  /// kinetic energy could not pay for yet (J): paid by the next cycles.
+  double obstacle_debt = 0;
   int substeps = 0;            ///< FEM sub-steps of this object in the last frame
   double step = 0;             ///< its last FEM sub-step, s (its own stable step)
   /// Scratch of one cycle's parallel stage, reduced in object order after
@@ -221,7 +227,19 @@ class World {
   /// coupling/obstacle.hpp); [lo, hi] bounds its coarse nodes over the
   /// cycle. Sets o.near_obstacle when it came within reach of one, and
   /// o.cycle_obstacle_vertices / depth. Touches object o only (runs on its worker).
-  void resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
+  /// `support_work` is the work the support did in the cycle (J): with the
+  /// projection's energy change, what they added is taken back from the
+  /// object's kinetic energy (the obstacles are never a source of energy).
+  void resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                         double support_work) const;
+  /// Sets o.obstacle_support for the coming cycle (its FEM loads, without
+  /// the support, already set on o.sim): on each coarse node of a dense
+  /// vertex touching an obstacle (within kObstacleContact of it), the
+  /// obstacle pushes back the inward normal part of the node's total force,
+  /// so resting nodes do not accelerate into it and the projection after
+  /// the cycle has (almost) nothing to do. Frictionless and unilateral.
+  /// Returns whether any node is supported. Touches object o only.
+  bool obstacle_support(RuntimeObject& o) const;
   /// Some object came within reach of an obstacle in the last cycle.
   bool m_obstacle_near = false;
   /// Detection/response cycles a frame of dt needs for a stable penalty.
@@ -235,7 +253,9 @@ class World {
     std::vector<RigidPose> poses;
     std::vector<std::vector<collision::NodePair>> fronts;
     std::vector<collision::CollisionResult> complete;
-    std::vector<double> complete_time, complete_depth;
+    std::vector<double> complete_time, complete_depth, obstacle_debt;
+    std::vector<MatX3d> obstacle_support;
+    std::vector<char> near_obstacle;
     double node_stiffness = 0;
     double contact_scale = 1;
     double contact_work = 0, passive_allowance = -1;
@@ -254,6 +274,11 @@ class World {
   /// projection moves surface nodes at most about this far (an instantaneous
   /// position change stores elastic energy that comes back as a bounce).
   static constexpr double kObstacleStep = 1e-3;
+  /// A dense vertex this close to an obstacle (m) is resting on it: its
+  /// coarse nodes get the obstacle's support (obstacle_support()).
+  static constexpr double kObstacleContact = 1e-4;
+  /// Longest cycle near an obstacle, s.
+  static constexpr double kObstacleCycle = 1e-3;
   /// Runs f(k) for every object index k, on m_threads workers (each object
   /// on one worker; objects are independent, so any assignment gives the
   /// same results). A failure is rethrown after the loop, the first by
