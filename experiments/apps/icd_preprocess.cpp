@@ -178,6 +178,13 @@ void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, doubl
               r.simplify.output_faces, r.simplify.collapsed_edges);
   std::printf("-- coarse tet mesh (cell size %.4g, %d mesher pass(es))\n%s", r.cell_size,
               r.mesher_passes, r.quality.to_string().c_str());
+  std::printf("-- %s\n", r.stable_step.to_string(c.options.stable_step).c_str());
+  const std::string fem_warnings =
+      icd::mesh::fem_quality_warnings(r.stable_step, r.quality.min_dihedral_deg);
+  if (!fem_warnings.empty())
+    std::printf("-- WARNING: tets not fit for explicit FEM: %s (raise --sliver-bound or "
+                "--coarse-tets)\n",
+                fem_warnings.c_str());
   std::printf("-- rigid links: %d dense vertices on %d coarse surface nodes\n", b.links.num_links(),
               static_cast<int>(b.surface_nodes.size()));
   if (c.options.sphere_builder != icd::mesh::SphereBuilder::none) {

@@ -293,6 +293,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   r.bbox_diagonal /= s;
   r.repair.volume /= s3;
   r.quality = tet_quality(b.coarse);
+  r.stable_step = stable_step_report(b.coarse, o.stable_step);
   return r;
 }
 
