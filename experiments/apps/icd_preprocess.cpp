@@ -33,13 +33,14 @@ std::string help_footer(const PreprocessOptions& d) {
       defaults, sizeof defaults,
       "  Defaults: --coarse-tets %d, --simplify-faces %d, --max-hole-edges %d,\n"
       "  --max-hole-diameter %g, --max-surface-change %g, --radius-edge %g,\n"
-      "  --facet-distance %g, --feature-angle %g, --sliver-bound %g, --spheres medial,\n"
-      "  --sphere-depth %d, --sphere-branching %d, --sphere-fit light, --assoc-nearest %d,\n"
-      "  --time-limit %g, --memory-limit %g.\n",
+      "  --facet-distance %g, --feature-angle %g, --sliver-bound %g, --step-target %g,\n"
+      "  --spheres medial, --sphere-depth %d, --sphere-branching %d, --sphere-fit light,\n"
+      "  --assoc-nearest %d,"
+      " --time-limit %g, --memory-limit %g.\n",
       d.tetrahedralize.target_tets, d.simplify.target_faces, d.repair.max_hole_edges,
       d.repair.max_hole_diameter, d.repair.max_surface_change, d.tetrahedralize.radius_edge_bound,
       d.tetrahedralize.facet_distance_factor, d.tetrahedralize.feature_angle_deg,
-      d.tetrahedralize.sliver_bound_deg, d.spheres.depth, d.spheres.branching,
+      d.tetrahedralize.sliver_bound_deg, d.tetrahedralize.step_cleanup.target_ratio, d.spheres.depth, d.spheres.branching,
       d.association.k_nearest, d.limits.cpu_seconds, d.limits.memory_mb);
   return std::string(
              "  Prepares a deformable object: repairs the dense surface INPUT (.off .obj .ply\n"
@@ -99,6 +100,9 @@ std::variant<Command, int> parse(int argc, char** argv) {
             "protect edges sharper than DEG (0: none)")
       .real("--sliver-bound", o.tetrahedralize.sliver_bound_deg, "DEG",
             "dihedral angle targeted by perturb/exude")
+      .real("--step-target", o.tetrahedralize.step_cleanup.target_ratio, "R",
+            "collapse the nodes that hold the explicit-FEM stable step below R x that of "
+            "near-regular tets (0: off)")
       .custom("--spheres", "KIND",
               "sphere-tree builder: medial (adaptive medial axis), octree, none",
               [&](const std::string& k) {
