@@ -33,13 +33,14 @@ std::string help_footer(const PreprocessOptions& d) {
       defaults, sizeof defaults,
       "  Defaults: --coarse-tets %d, --simplify-faces %d, --max-hole-edges %d,\n"
       "  --max-hole-diameter %g, --max-surface-change %g, --radius-edge %g,\n"
-      "  --facet-distance %g, --feature-angle %g, --sliver-bound %g, --spheres medial,\n"
-      "  --sphere-depth %d, --sphere-branching %d, --sphere-fit light, --assoc-nearest %d,\n"
-      "  --time-limit %g, --memory-limit %g.\n",
+      "  --facet-distance %g, --feature-angle %g, --sliver-bound %g, --step-target %g,\n"
+      "  --spheres medial, --sphere-depth %d, --sphere-branching %d, --sphere-fit light,\n"
+      "  --assoc-nearest %d,"
+      " --time-limit %g, --memory-limit %g.\n",
       d.tetrahedralize.target_tets, d.simplify.target_faces, d.repair.max_hole_edges,
       d.repair.max_hole_diameter, d.repair.max_surface_change, d.tetrahedralize.radius_edge_bound,
       d.tetrahedralize.facet_distance_factor, d.tetrahedralize.feature_angle_deg,
-      d.tetrahedralize.sliver_bound_deg, d.spheres.depth, d.spheres.branching,
+      d.tetrahedralize.sliver_bound_deg, d.tetrahedralize.step_cleanup.target_ratio, d.spheres.depth, d.spheres.branching,
       d.association.k_nearest, d.limits.cpu_seconds, d.limits.memory_mb);
   return std::string(
              "  Prepares a deformable object: repairs the dense surface INPUT (.off .obj .ply\n"
@@ -99,6 +100,9 @@ std::variant<Command, int> parse(int argc, char** argv) {
             "protect edges sharper than DEG (0: none)")
       .real("--sliver-bound", o.tetrahedralize.sliver_bound_deg, "DEG",
             "dihedral angle targeted by perturb/exude")
+      .real("--step-target", o.tetrahedralize.step_cleanup.target_ratio, "R",
+            "collapse the nodes that hold the explicit-FEM stable step below R x that of "
+            "near-regular tets (0: off)")
       .custom("--spheres", "KIND",
               "sphere-tree builder: medial (adaptive medial axis), octree, none",
               [&](const std::string& k) {
@@ -178,6 +182,13 @@ void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, doubl
               r.simplify.output_faces, r.simplify.collapsed_edges);
   std::printf("-- coarse tet mesh (cell size %.4g, %d mesher pass(es))\n%s", r.cell_size,
               r.mesher_passes, r.quality.to_string().c_str());
+  std::printf("-- %s\n", r.stable_step.to_string(c.options.stable_step).c_str());
+  const std::string fem_warnings =
+      icd::mesh::fem_quality_warnings(r.stable_step, r.quality.min_dihedral_deg);
+  if (!fem_warnings.empty())
+    std::printf("-- WARNING: tets not fit for explicit FEM: %s (raise --sliver-bound or "
+                "--coarse-tets)\n",
+                fem_warnings.c_str());
   std::printf("-- rigid links: %d dense vertices on %d coarse surface nodes\n", b.links.num_links(),
               static_cast<int>(b.surface_nodes.size()));
   if (c.options.sphere_builder != icd::mesh::SphereBuilder::none) {

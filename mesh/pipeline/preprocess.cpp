@@ -1,6 +1,7 @@
 #include <icd/mesh/pipeline/preprocess.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <utility>
 
@@ -212,6 +213,17 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     r.cell_size = tet.cell_size / s;
     r.mesher_passes = tet.passes;
     for (const std::string& n : tet.notes) r.notes.push_back("tetrahedralize: " + n);
+    if (tet.step_cleanup.ratio_before > 0) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "tetrahedralize: stable-step post-pass collapsed %d node(s) (node estimate of "
+                    "the step ratio %.3f -> %.3f, volume %+.2f %%, %d node(s) left above the "
+                    "target; --step-target)",
+                    tet.step_cleanup.collapses, tet.step_cleanup.ratio_before,
+                    tet.step_cleanup.ratio_after, 100.0 * tet.step_cleanup.volume_change,
+                    tet.step_cleanup.stuck);
+      r.notes.push_back(buf);
+    }
     b.surface_nodes = boundary_nodes(b.coarse.F);
     t.done(std::to_string(b.coarse.T.rows()) + " tets, " + std::to_string(b.surface_nodes.size()) +
            " surface nodes, " + std::to_string(tet.passes) + " pass(es)" +
@@ -293,6 +305,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   r.bbox_diagonal /= s;
   r.repair.volume /= s3;
   r.quality = tet_quality(b.coarse);
+  r.stable_step = stable_step_report(b.coarse, o.stable_step);
   return r;
 }
 

@@ -13,6 +13,7 @@
 #include <icd/coupling/rigid_links.hpp>
 #include <icd/mesh/core/types.hpp>
 #include <icd/mesh/pipeline/bounded.hpp>
+#include <icd/mesh/pipeline/fem_step.hpp>
 #include <icd/mesh/pipeline/repair.hpp>
 #include <icd/mesh/pipeline/simplify.hpp>
 #include <icd/mesh/pipeline/tetrahedralize.hpp>
@@ -69,6 +70,9 @@ struct PreprocessOptions {
   collision::OctreeTreeOptions octree;  ///< octree builder options (levels = depth + 1)
   collision::NodeAssociationOptions association;
   bool compute_hausdorff = true;  ///< dense vs coarse surface distance for the summary
+  /// Material, damping and integrator of the stable-step figure of the
+  /// summary (a scene object's defaults).
+  StableStepOptions stable_step;
   /// CPU-time and memory limits of every stage (each runs in a child
   /// process, bounded.hpp); tetrahedralize.limits is set from it.
   StageLimits limits;
@@ -104,6 +108,9 @@ struct PreprocessResult {
   RepairReport repair;
   SimplifyReport simplify;
   TetQuality quality;      ///< of bundle.coarse
+  /// Stable step of bundle.coarse (model units as metres) against near-regular
+  /// tets of the same mean volume (fem_step.hpp).
+  StableStepReport stable_step;
   double cell_size = 0.0;  ///< Mesh_3 cell size that was kept
   int mesher_passes = 0;
   int sphere_levels = 0;

@@ -201,6 +201,7 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
   std::vector<std::string> failures;
   // One bounded pass; false (and a note) when it failed.
   const auto attempt = [&](double size, bool optimise, TetMesh& out) {
+    res.step_cleanup = {};
     StageLimits pl = o.limits;
     pl.cpu_seconds = std::min(o.limits.cpu_seconds - spent, o.pass_share * o.limits.cpu_seconds);
     if (pl.cpu_seconds < 0.5) {
@@ -223,10 +224,21 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
             if (m.T.rows() == 0) throw InputError("the mesher produced no tetrahedron");
             const std::string problem = boundary_problem(m);
             if (!problem.empty()) throw InputError(problem);
-            return serialize(m);
+            StepCleanupReport cleanup;
+            if (optimise) {
+              cleanup = raise_stable_step(m, o.step_cleanup);
+              if (!boundary_problem(m).empty())  // raise_stable_step keeps it: a bug if not
+                throw InputError("the stable-step post-pass broke the boundary: " +
+                                 boundary_problem(m));
+            }
+            ByteWriter w;
+            w.pod(cleanup);
+            return w.take() + serialize(m);
           },
           &u, beat);
-      out = deserialize(bytes);
+      ByteReader r(bytes);
+      res.step_cleanup = r.pod<StepCleanupReport>();
+      out = deserialize(bytes.substr(sizeof(StepCleanupReport)));
     } catch (const ParameterError&) {
       throw;
     } catch (const InputError& e) {

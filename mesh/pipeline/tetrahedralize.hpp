@@ -8,6 +8,7 @@
 
 #include <icd/mesh/core/types.hpp>
 #include <icd/mesh/pipeline/bounded.hpp>
+#include <icd/mesh/pipeline/tet_cleanup.hpp>
 #include <icd/mesh/pipeline/tet_quality.hpp>
 
 namespace icd::mesh {
@@ -35,6 +36,9 @@ struct TetrahedralizeOptions {
   /// gave worse tets and more failed passes with this seeding, see
   /// experiments/studies/preprocess/README.md).
   double feature_angle_deg = 0.0;
+  /// After the optimised pass: collapse the nodes that limit the explicit
+  /// FEM stable step (tet_cleanup.hpp; target_ratio 0 turns it off).
+  StepCleanupOptions step_cleanup;
   unsigned random_seed = 0;        ///< CGAL default random generator seed (determinism)
   /// CPU-time and memory limits of the whole stage; each meshing pass runs
   /// bounded (bounded.hpp) by at most pass_share of the CPU time, so that a
@@ -55,6 +59,7 @@ struct TetrahedralizeResult {
   int passes = 0;        ///< meshing passes run (size search + the final optimised one)
   int feature_curves = 0;  ///< sharp-feature polylines protected
   int failed_passes = 0;  ///< passes that failed and were retried at another size
+  StepCleanupReport step_cleanup;  ///< of the kept (optimised) pass
   /// One line per retry or notable event ("pass 2 at cell size 0.03 failed:
   /// ...; retrying at 0.0255").
   std::vector<std::string> notes;

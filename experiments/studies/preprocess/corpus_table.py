@@ -39,6 +39,9 @@ def row(out, mesh):
         vol_rep = num(r"component\(s\), volume (\S+)", log)
         if vol_rep:
             r["volume_change"] = f"{100.0 * (float(d.group(4)) / float(vol_rep) - 1):+.1f}%"
+    ratio = num(r"near-regular tets of the same mean volume\): ratio ([\d.]+)", log)
+    if ratio:
+        r["step_ratio"] = ratio
     h = num(r"\(([\d.e+-]+)% of the bbox diagonal", log)
     if h:
         r["hausdorff_pct_diag"] = f"{float(h):.2f}"
@@ -59,6 +62,8 @@ def row(out, mesh):
     warn = []
     if d and float(d.group(1)) < 12.0:
         warn.append("min dihedral < 12")
+    if ratio and float(ratio) < 0.4:
+        warn.append("step ratio < 0.4")
     if h and float(h) > 3.0:
         warn.append("Hausdorff > 3%")
     if "volume_change" in r and abs(float(r["volume_change"].rstrip("%"))) > 5.0:
@@ -75,7 +80,7 @@ def main():
     out, meshes = sys.argv[1], sys.argv[2:]
     rows = [row(out, m) for m in meshes]
     cols = ["mesh", "triangles", "outcome", "tets", "tet_count_error", "interior_nodes",
-            "min_dihedral", "max_dihedral", "max_radius_edge", "hausdorff_pct_diag",
+            "step_ratio", "min_dihedral", "max_dihedral", "max_radius_edge", "hausdorff_pct_diag",
             "volume_change", "tet_cpu_s", "cpu_s", "wall_s", "peak_mb", "retries", "repairs",
             "target_misses", "message"]
     with open(os.path.join(out, "corpus.csv"), "w", newline="") as f:

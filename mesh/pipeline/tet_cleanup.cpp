@@ -1,0 +1,329 @@
+#include <icd/mesh/pipeline/tet_cleanup.hpp>
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <set>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/core/triangle_geometry.hpp>
+#include <icd/mesh/pipeline/fem_step.hpp>
+#include <icd/mesh/pipeline/tet_quality.hpp>
+
+namespace icd::mesh {
+namespace {
+
+using Tet = std::array<int, 4>;
+
+double tet_volume(const MatX3d& V, const Tet& t) {
+  const Eigen::Vector3d a = V.row(t[0]), b = V.row(t[1]), c = V.row(t[2]), d = V.row(t[3]);
+  return (b - a).dot((c - a).cross(d - a)) / 6.0;
+}
+
+/// Node frequencies sqrt(lambda_max(K_ii) / m_i) (linear elasticity, lumped
+/// mass), rad/s, for the scene's default density and Young's modulus; 0 for
+/// unused nodes.
+Eigen::VectorXd node_frequencies(const MatX3d& V, const std::vector<Tet>& T, double poisson) {
+  fem::Material m;
+  m.poisson = poisson;
+  const double E = m.young, nu = m.poisson;
+  const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+  const Eigen::Index n = V.rows();
+  std::vector<Eigen::Matrix3d> K(static_cast<size_t>(n), Eigen::Matrix3d::Zero());
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(n);
+  for (const Tet& t : T) {
+    Eigen::Matrix3d Dm;
+    for (int k = 0; k < 3; ++k) Dm.col(k) = (V.row(t[k + 1]) - V.row(t[0])).transpose();
+    const double vol = Dm.determinant() / 6.0;
+    const Eigen::Matrix3d G = Dm.inverse();  // rows: gradients of nodes 1..3
+    for (int a = 0; a < 4; ++a) {
+      const Eigen::Vector3d g =
+          a == 0 ? Eigen::Vector3d(-G.colwise().sum().transpose()) : Eigen::Vector3d(G.row(a - 1));
+      K[static_cast<size_t>(t[a])] +=
+          vol * ((lambda + mu) * g * g.transpose() + mu * g.squaredNorm() * Eigen::Matrix3d::Identity());
+      mass[t[a]] += m.density * vol / 4.0;
+    }
+  }
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (mass[i] > 0) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(K[static_cast<size_t>(i)],
+                                                        Eigen::EigenvaluesOnly);
+      w[i] = std::sqrt(std::max(0.0, es.eigenvalues()[2]) / mass[i]);
+    }
+  return w;
+}
+
+struct Topology {
+  bool ok = false;
+  long euler = 0;
+  int components = 0;
+};
+
+/// Whether every face is in at most two tets and the boundary is a closed
+/// edge-manifold surface; its Euler characteristic and components.
+Topology topology(const std::vector<Tet>& T, int num_nodes) {
+  Topology topo;
+  std::unordered_map<std::uint64_t, int> faces;
+  faces.reserve(T.size() * 4);
+  const auto key3 = [&](int a, int b, int c) {
+    int s[3] = {a, b, c};
+    std::sort(s, s + 3);
+    return (static_cast<std::uint64_t>(s[0]) * num_nodes + s[1]) * num_nodes + s[2];
+  };
+  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  for (const Tet& t : T)
+    for (const auto& f : kFace)
+      if (++faces[key3(t[f[0]], t[f[1]], t[f[2]])] > 2) return topo;
+  std::unordered_map<std::uint64_t, int> edges;
+  std::vector<int> parent(static_cast<size_t>(num_nodes));
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](int x) {
+    while (parent[static_cast<size_t>(x)] != x)
+      x = parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
+    return x;
+  };
+  std::set<int> verts;
+  long nf = 0;
+  for (const auto& [k, n] : faces) {
+    if (n != 1) continue;
+    ++nf;
+    const int v[3] = {static_cast<int>(k / (static_cast<std::uint64_t>(num_nodes) * num_nodes)),
+                      static_cast<int>(k / num_nodes % num_nodes), static_cast<int>(k % num_nodes)};
+    for (int e = 0; e < 3; ++e) {
+      const int a = std::min(v[e], v[(e + 1) % 3]), b = std::max(v[e], v[(e + 1) % 3]);
+      ++edges[static_cast<std::uint64_t>(a) * num_nodes + b];
+      verts.insert(v[e]);
+      parent[static_cast<size_t>(find(a))] = find(b);
+    }
+  }
+  for (const auto& [k, n] : edges)
+    if (n != 2) return topo;
+  std::set<int> roots;
+  for (int v : verts) roots.insert(find(v));
+  topo.ok = true;
+  topo.euler = static_cast<long>(verts.size()) - static_cast<long>(edges.size()) + nf;
+  topo.components = static_cast<int>(roots.size());
+  return topo;
+}
+
+double min_dihedral(const MatX3d& V, const Tet& t) {
+  const TetShape s = tet_shape(V.row(t[0]).transpose(), V.row(t[1]).transpose(),
+                               V.row(t[2]).transpose(), V.row(t[3]).transpose());
+  return *std::min_element(s.dihedral_deg, s.dihedral_deg + 6);
+}
+
+}  // namespace
+
+double ideal_omega(double mean_volume, double poisson) {
+  StableStepOptions o;
+  o.material.poisson = poisson;
+  o.material.model = fem::MaterialModel::Linear;
+  const TetMesh ideal = bcc_block(o.ideal_cells, std::cbrt(12.0 * mean_volume));
+  return stable_step_report(ideal, o).omega_max;
+}
+
+StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) {
+  if (!(o.target_ratio >= 0) || !(o.max_shift >= 0) || !(o.max_volume_change >= 0) ||
+      o.max_collapses < 0 || !(o.poisson > -1 && o.poisson < 0.5))
+    throw ParameterError("raise_stable_step: need target_ratio, max_shift, max_volume_change, "
+                         "max_collapses >= 0 and poisson in (-1, 0.5)");
+  StepCleanupReport rep;
+  const int n = static_cast<int>(mesh.V.rows());
+  if (mesh.T.rows() == 0 || o.target_ratio == 0) return rep;
+  std::vector<Tet> T(static_cast<size_t>(mesh.T.rows()));
+  for (Eigen::Index e = 0; e < mesh.T.rows(); ++e)
+    for (int k = 0; k < 4; ++k) T[static_cast<size_t>(e)][k] = mesh.T(e, k);
+  double volume0 = 0;
+  double dmin = 180;
+  for (const Tet& t : T) {
+    volume0 += tet_volume(mesh.V, t);
+    dmin = std::min(dmin, min_dihedral(mesh.V, t));
+  }
+  dmin = std::min(dmin, o.min_dihedral_deg);
+  const double ideal = ideal_omega(volume0 / static_cast<double>(T.size()), o.poisson);
+  const double threshold = ideal / o.target_ratio;
+  const double diagonal = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
+  const Topology topo0 = topology(T, n);
+  if (!topo0.ok) return rep;  // not a mesh this pass can keep valid
+  double volume = volume0;
+  Eigen::VectorXd w = node_frequencies(mesh.V, T, o.poisson);
+  rep.ratio_before = ideal / w.maxCoeff();
+  // Positions of the surface as it was, where a peel or collapse moved it:
+  // each must stay within max_shift * diagonal of the current boundary (a
+  // bound on the cumulative change, not only on each step's).
+  std::vector<Eigen::Vector3d> moved;
+  // ... and every point of the new boundary near the change (vertices, edge
+  // midpoints, centroids of its faces at `touched` nodes) within it of the
+  // original boundary: a peel may expose faces of interior nodes.
+  const double lim2 = std::pow(o.max_shift * diagonal, 2);
+  const auto near_surface = [&](const MatX3i& F, const Eigen::Vector3d& p) {
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      const Eigen::Vector3d a = mesh.V.row(F(f, 0)), b = mesh.V.row(F(f, 1)), c = mesh.V.row(F(f, 2));
+      if ((closest_point_on_triangle(p, a, b, c) - p).squaredNorm() <= lim2) return true;
+    }
+    return false;
+  };
+  const MatX3i F0 = boundary_faces(mesh.T);
+  const auto within = [&](const std::vector<Tet>& cand, const std::vector<Eigen::Vector3d>& pts,
+                          const std::set<int>& touched) {
+    MatX4i Tc(static_cast<Eigen::Index>(cand.size()), 4);
+    for (size_t e = 0; e < cand.size(); ++e)
+      for (int k = 0; k < 4; ++k) Tc(static_cast<Eigen::Index>(e), k) = cand[e][k];
+    const MatX3i Fc = boundary_faces(Tc);
+    for (const Eigen::Vector3d& p : pts)
+      if (!near_surface(Fc, p)) return false;
+    for (Eigen::Index f = 0; f < Fc.rows(); ++f) {
+      if (!touched.count(Fc(f, 0)) && !touched.count(Fc(f, 1)) && !touched.count(Fc(f, 2)))
+        continue;
+      const Eigen::Vector3d a = mesh.V.row(Fc(f, 0)), b = mesh.V.row(Fc(f, 1)), c = mesh.V.row(Fc(f, 2));
+      for (const Eigen::Vector3d& p : {a, b, c, Eigen::Vector3d((a + b) / 2), Eigen::Vector3d((b + c) / 2),
+                                       Eigen::Vector3d((c + a) / 2), Eigen::Vector3d((a + b + c) / 3)})
+        if (!near_surface(F0, p)) return false;
+    }
+    return true;
+  };
+  std::set<int> stuck;
+  long attempts = 0;  // nodes tried: bounded whatever the mesh
+  while (rep.collapses < o.max_collapses && attempts++ < 4L * n) {
+    // Surface nodes and edges, node -> tets.
+    std::vector<std::vector<int>> around(static_cast<size_t>(n));
+    for (size_t e = 0; e < T.size(); ++e)
+      for (int v : T[e]) around[static_cast<size_t>(v)].push_back(static_cast<int>(e));
+    MatX4i Tm(static_cast<Eigen::Index>(T.size()), 4);
+    for (size_t e = 0; e < T.size(); ++e)
+      for (int k = 0; k < 4; ++k) Tm(static_cast<Eigen::Index>(e), k) = T[e][k];
+    const MatX3i F = boundary_faces(Tm);
+    std::vector<char> surface(static_cast<size_t>(n), 0);
+    std::set<std::pair<int, int>> bedges;
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        surface[static_cast<size_t>(F(f, k))] = 1;
+        bedges.insert(std::minmax(F(f, k), F(f, (k + 1) % 3)));
+      }
+    // The worst node not known to be stuck.
+    int i = -1;
+    for (int v = 0; v < n; ++v)
+      if (w[v] > threshold && !stuck.count(v) && (i < 0 || w[v] > w[i])) i = v;
+    if (i < 0) break;
+    std::set<int> nbrs;
+    for (int e : around[static_cast<size_t>(i)])
+      for (int v : T[static_cast<size_t>(e)])
+        if (v != i) nbrs.insert(v);
+    double best = w[i];
+    std::vector<Tet> best_T;
+    double best_volume = 0;
+    // Candidates: collapse i into a neighbour j; for a surface node, also
+    // peel (j = -1): remove every tet of i, the surface receding to the
+    // faces opposite i (i's thin tets hold little volume).
+    std::vector<int> options(nbrs.begin(), nbrs.end());
+    if (surface[static_cast<size_t>(i)]) options.push_back(-1);
+    for (int j : options) {
+      if (j >= 0 && surface[static_cast<size_t>(i)] && !bedges.count(std::minmax(i, j))) continue;
+      if (j >= 0 && surface[static_cast<size_t>(i)] &&
+          (mesh.V.row(i) - mesh.V.row(j)).norm() > o.max_shift * diagonal)
+        continue;
+      if (j < 0) {  // the height of i over each opposite face: how far the surface moves
+        bool near = true;
+        for (int e : around[static_cast<size_t>(i)]) {
+          const Tet& t = T[static_cast<size_t>(e)];
+          int k = 0;
+          while (t[k] != i) ++k;
+          const Eigen::Vector3d a = mesh.V.row(t[(k + 1) % 4]), b = mesh.V.row(t[(k + 2) % 4]),
+                                c = mesh.V.row(t[(k + 3) % 4]), p = mesh.V.row(i);
+          const Eigen::Vector3d nrm = (b - a).cross(c - a);
+          if (std::abs(nrm.normalized().dot(p - a)) > o.max_shift * diagonal) near = false;
+        }
+        if (!near) continue;
+      }
+      std::vector<Tet> cand;
+      cand.reserve(T.size());
+      double vol = volume;
+      bool valid = true;
+      std::vector<int> changed;
+      for (size_t e = 0; e < T.size() && valid; ++e) {
+        Tet t = T[e];
+        const bool has_i = std::find(t.begin(), t.end(), i) != t.end();
+        if (!has_i) {
+          cand.push_back(t);
+          continue;
+        }
+        vol -= tet_volume(mesh.V, t);
+        if (j < 0 || std::find(t.begin(), t.end(), j) != t.end()) continue;  // removed
+        std::replace(t.begin(), t.end(), i, j);
+        const double v = tet_volume(mesh.V, t);
+        if (!(v > 0) || min_dihedral(mesh.V, t) < dmin) valid = false;
+        vol += v;
+        changed.push_back(static_cast<int>(cand.size()));
+        cand.push_back(t);
+      }
+      if (!valid || std::abs(vol / volume0 - 1) > o.max_volume_change) continue;
+      const Topology topo = topology(cand, n);
+      if (!topo.ok || topo.euler != topo0.euler || topo.components != topo0.components) continue;
+      {  // an interior collapse may expose nothing; the check is cheap
+        std::vector<Eigen::Vector3d> pts = moved;
+        if (surface[static_cast<size_t>(i)]) pts.emplace_back(mesh.V.row(i).transpose());
+        if (!within(cand, pts, nbrs)) continue;
+      }
+      const Eigen::VectorXd wc = node_frequencies(mesh.V, cand, o.poisson);
+      double worst = j >= 0 ? wc[j] : 0.0;
+      for (int e : changed)
+        for (int v : cand[static_cast<size_t>(e)]) worst = std::max(worst, wc[v]);
+      for (int v : nbrs) worst = std::max(worst, wc[v]);
+      if (j < 0)  // the nodes left without a tet
+        for (int v : nbrs)
+          if (wc[v] == 0 && std::none_of(cand.begin(), cand.end(), [&](const Tet& t) {
+                return std::find(t.begin(), t.end(), v) != t.end();
+              }))
+            worst = INFINITY;
+      if (worst < best) {
+        best = worst;
+        best_T = std::move(cand);
+        best_volume = vol;
+      }
+    }
+    if (best_T.empty()) {
+      stuck.insert(i);
+      continue;
+    }
+    if (surface[static_cast<size_t>(i)]) moved.emplace_back(mesh.V.row(i).transpose());
+    T = std::move(best_T);
+    volume = best_volume;
+    ++rep.collapses;
+    w = node_frequencies(mesh.V, T, o.poisson);
+    stuck.clear();  // a collapse changes the neighbourhoods
+  }
+  for (int v = 0; v < n; ++v)
+    if (w[v] > threshold) ++rep.stuck;
+  rep.ratio_after = ideal / w.maxCoeff();
+  rep.volume_change = volume / volume0 - 1;
+  if (rep.collapses == 0) return rep;
+  // Compact: drop unused nodes, keep the order of the others.
+  std::vector<int> id(static_cast<size_t>(n), -1);
+  for (const Tet& t : T)
+    for (int v : t) id[static_cast<size_t>(v)] = 0;
+  int next = 0;
+  for (int v = 0; v < n; ++v)
+    if (id[static_cast<size_t>(v)] == 0) id[static_cast<size_t>(v)] = next++;
+  MatX3d V(next, 3);
+  for (int v = 0; v < n; ++v)
+    if (id[static_cast<size_t>(v)] >= 0) V.row(id[static_cast<size_t>(v)]) = mesh.V.row(v);
+  MatX4i Tn(static_cast<Eigen::Index>(T.size()), 4);
+  for (size_t e = 0; e < T.size(); ++e)
+    for (int k = 0; k < 4; ++k) Tn(static_cast<Eigen::Index>(e), k) = id[static_cast<size_t>(T[e][k])];
+  mesh.V = std::move(V);
+  mesh.T = std::move(Tn);
+  mesh.F = boundary_faces(mesh.T);
+  return rep;
+}
+
+}  // namespace icd::mesh

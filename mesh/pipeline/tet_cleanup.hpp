@@ -1,0 +1,55 @@
+#pragma once
+/// A post-pass on a coarse tet mesh for explicit FEM (issue 30, item 5): the
+/// stable step of a lumped-mass mesh is set by its lightest, stiffest node,
+/// and on Mesh_3 meshes of 1,500-2,000 tets that is a surface node held by
+/// two or three tiny tets (a thin feature one tet thick: the dragon's worst
+/// node has 0.3 % of a mean node's mass and sets a step 0.07 x that of
+/// near-regular tets). The pass collapses such nodes into a neighbour, worst
+/// first, while the result stays a valid mesh with a closed manifold boundary.
+/// Plain Eigen: no CGAL.
+#include <icd/mesh/core/types.hpp>
+
+namespace icd::mesh {
+
+/// Options of raise_stable_step().
+struct StepCleanupOptions {
+  /// Collapse nodes while the largest node frequency exceeds that of
+  /// near-regular tets of the same mean volume / target_ratio (0: off). The
+  /// node frequency (the 3x3 diagonal block of M^-1 K, linear elasticity) is
+  /// a lower bound of the mesh's largest eigenfrequency and within 1 % of it
+  /// on the bunny and dragon, whose top modes sit on single nodes.
+  double target_ratio = 0.6;
+  double poisson = 0.3;  ///< Poisson ratio of the node frequencies (the ratio depends on it only)
+  /// A surface node moves at most this fraction of the bounding-box diagonal
+  /// (the length of the boundary edge it is collapsed along).
+  double max_shift = 0.02;
+  /// The enclosed volume changes by at most this fraction in all.
+  double max_volume_change = 0.01;
+  /// Every tet a collapse changes keeps its smallest dihedral angle at least
+  /// min(this, the mesh's smallest before the pass), in degrees.
+  double min_dihedral_deg = 12.0;
+  int max_collapses = 2000;
+};
+
+/// What raise_stable_step() did.
+struct StepCleanupReport {
+  int collapses = 0;       ///< nodes removed
+  int stuck = 0;           ///< nodes above the target that no valid collapse improved
+  double ratio_before = 0; ///< node-frequency estimate of the stable-step ratio before the pass
+  double ratio_after = 0;  ///< ... and after it
+  double volume_change = 0;  ///< relative change of the enclosed volume
+};
+
+/// Collapses the nodes that limit the stable step (see StepCleanupOptions),
+/// in place: `mesh` (positive tets, F its boundary, a closed manifold) keeps
+/// positive tets, a closed manifold boundary of the same Euler characteristic
+/// and components, and every node used; F is recomputed. Deterministic.
+StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& options = {});
+
+/// Largest circular eigenfrequency (rad/s) of the near-regular BCC block with
+/// mean tet volume `mean_volume`, the scene's default density and Young's
+/// modulus and `poisson` (fem_step.hpp's ideal), for the node frequencies of
+/// raise_stable_step().
+double ideal_omega(double mean_volume, double poisson);
+
+}  // namespace icd::mesh

@@ -1,0 +1,87 @@
+// The stable-step post-pass (tet_cleanup.hpp): it removes the light node of a
+// thin cap on a near-regular block and leaves the block itself alone; the
+// stable step is checked with the FEM module's estimate (fem_step.hpp), the
+// mesh with the same closed-manifold test as the mesher's.
+#include <icd/mesh/pipeline/tet_cleanup.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/pipeline/fem_step.hpp>
+
+namespace icd::mesh {
+namespace {
+
+// Each directed boundary edge once and its reverse once: a closed manifold.
+bool closed_manifold(const TetMesh& m) {
+  std::map<std::pair<int, int>, int> directed;
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ++directed[{m.F(f, k), m.F(f, (k + 1) % 3)}];
+  for (const auto& [e, n] : directed) {
+    const auto rev = directed.find({e.second, e.first});
+    if (n != 1 || rev == directed.end() || rev->second != 1) return false;
+  }
+  return true;
+}
+
+TEST(TetCleanup, NearRegularBlockIsLeftAlone) {
+  TetMesh m = bcc_block(4, 0.1);
+  const TetMesh before = m;
+  const StepCleanupReport r = raise_stable_step(m);
+  EXPECT_EQ(r.collapses, 0);
+  EXPECT_EQ(r.stuck, 0);
+  EXPECT_GT(r.ratio_before, 0.6);
+  EXPECT_EQ(m.T, before.T);
+  EXPECT_EQ(m.V, before.V);
+}
+
+TEST(TetCleanup, ThinCapIsRemovedAndTheStepRecovers) {
+  // A flat tet on a boundary face: its apex holds a 60th of a mean node's
+  // mass and sets the step of the whole block.
+  const double h = 0.1;
+  TetMesh m = bcc_block(4, h);
+  const Eigen::Vector3d a = m.V.row(m.F(0, 0)), b = m.V.row(m.F(0, 1)), c = m.V.row(m.F(0, 2));
+  const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+  const Eigen::Vector3d apex = (a + b + c) / 3 + 0.03 * h * n;
+  m.V.conservativeResize(m.V.rows() + 1, 3);
+  m.V.row(m.V.rows() - 1) = apex.transpose();
+  m.T.conservativeResize(m.T.rows() + 1, 4);
+  m.T.row(m.T.rows() - 1) << m.F(0, 0), m.F(0, 1), m.F(0, 2), static_cast<int>(m.V.rows() - 1);
+  m.F = boundary_faces(m.T);
+  ASSERT_TRUE(closed_manifold(m));
+  const StableStepReport fem_before = stable_step_report(m);
+  ASSERT_LT(fem_before.ratio, 0.4);  // the cap costs more than half the step
+  const double volume_before = signed_tet_volumes(m.V, m.T).sum();
+
+  const StepCleanupReport r = raise_stable_step(m);
+  EXPECT_GE(r.collapses, 1);
+  // The node estimate is a lower bound of the top frequency: its ratio an
+  // upper bound of the FEM ratio, and close to it here.
+  EXPECT_NEAR(r.ratio_before, fem_before.ratio, 0.05 * fem_before.ratio);
+  const StableStepReport fem_after = stable_step_report(m);
+  EXPECT_GT(fem_after.ratio, 0.9);
+  EXPECT_LE(fem_after.ratio, r.ratio_after * 1.0001);
+  EXPECT_TRUE(closed_manifold(m));
+  EXPECT_EQ(m.V.rows(), bcc_block(4, h).V.rows());  // the apex is gone, nothing else
+  EXPECT_GT(signed_tet_volumes(m.V, m.T).minCoeff(), 0.0);
+  EXPECT_NEAR(signed_tet_volumes(m.V, m.T).sum(), volume_before, 0.01 * volume_before);
+  EXPECT_NEAR(r.volume_change, signed_tet_volumes(m.V, m.T).sum() / volume_before - 1, 1e-12);
+}
+
+TEST(TetCleanup, BadOptionsAreRefused) {
+  TetMesh m = bcc_block(2, 1.0);
+  StepCleanupOptions o;
+  o.target_ratio = -1;
+  EXPECT_THROW(raise_stable_step(m, o), ParameterError);
+  o = {};
+  o.poisson = 0.5;
+  EXPECT_THROW(raise_stable_step(m, o), ParameterError);
+}
+
+}  // namespace
+}  // namespace icd::mesh
