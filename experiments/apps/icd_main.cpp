@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
   std::filesystem::path out = "results/main";
   std::filesystem::path scene_path = icd::runner::scenes_dir() / "bunny_dragon.json";
   std::filesystem::path cache_dir = icd::runner::default_cache_dir();
-  int frames = -1;
+  int frames = -1, threads = -1;
   std::vector<std::string> overrides;  // --set
   icd::experiments::Cli cli("icd-main",
                                     "  The project's main job: the paper's bunny-dragon scene.");
@@ -24,9 +24,15 @@ int main(int argc, char** argv) {
             "scene to run (default: " + scene_path.string() + ")")
       .path("--cache-dir", cache_dir, "DIR",
             "asset cache folder (default: " + cache_dir.string() + ", see README Programs)")
-      .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000);
+      .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000)
+      .integer("--threads", threads, "N",
+               "worker threads advancing the objects (0 = hardware concurrency; overrides the "
+               "scene's threads field)",
+               0, 1024);
   cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
+  // --threads is the scene field `threads`, applied after every --set.
+  if (threads >= 0) overrides.push_back("threads=" + std::to_string(threads));
   try {
     const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
     std::printf("scene \"%s\" (%s)\n", scene.name.c_str(), scene_path.c_str());

@@ -11,7 +11,7 @@
 
 int main(int argc, char** argv) {
   std::filesystem::path scene_path, out, cache_dir = icd::runner::default_cache_dir();
-  int frames = -1;
+  int frames = -1, threads = -1;
   double target_fps = -1;
   bool dry = false, quiet = false;
   std::vector<std::string> overrides;
@@ -26,6 +26,10 @@ int main(int argc, char** argv) {
       .integer("--frames", frames, "N", "override the scene's frame count", 1, 100000000)
       .real("--target-fps", target_fps, "F",
             "real-time mode at F frames per second (0 = off; overrides the scene)", 0.0, 1e5)
+      .integer("--threads", threads, "N",
+               "worker threads advancing the objects (0 = hardware concurrency; overrides the "
+               "scene's threads field)",
+               0, 1024)
       .path("--cache-dir", cache_dir, "DIR", "asset cache folder (see below)")
       .custom("--set", "KEY=VALUE",
               "override a scene field (repeatable; KEY dotted, array indices as numbers, e.g. "
@@ -34,6 +38,8 @@ int main(int argc, char** argv) {
       .flag("--dry-run", dry, "print the stages the scene needs and check its input files, run nothing")
       .flag("--quiet", quiet, "no progress bar");
   if (const auto status = cli.parse(argc, argv)) return *status;
+  // --threads is the scene field `threads`, applied after every --set.
+  if (threads >= 0) overrides.push_back("threads=" + std::to_string(threads));
   try {
     const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
     std::printf("scene \"%s\": %zu objects, %d frames at %g Hz\n", scene.name.c_str(),
