@@ -108,17 +108,17 @@ void bind_coupling(py::module_& m) {
 #ifdef ICD_PYTHON_WITH_PREPROCESS
   m.def(
       "preprocess",
-      [](const std::filesystem::path& input, const std::filesystem::path& folder, int coarse_tets,
-         bool spheres) {
+      [](const std::filesystem::path& input, const std::optional<std::filesystem::path>& folder,
+         int coarse_tets, bool spheres) {
         mesh::PreprocessOptions o;
         o.tetrahedralize.target_tets = coarse_tets;
         if (!spheres) o.sphere_builder = mesh::SphereBuilder::none;
         const SurfaceMesh dense = read_surface_mesh(input);
         mesh::PreprocessResult r = mesh::preprocess(dense, o, {}, input.string());
-        if (!folder.empty()) coupling::write_asset_bundle(folder, r.bundle);
+        if (folder) coupling::write_asset_bundle(*folder, r.bundle);
         return r.bundle;
       },
-      py::arg("input"), py::arg("folder") = std::filesystem::path(), py::arg("coarse_tets") = 1500,
+      py::arg("input"), py::arg("folder") = py::none(), py::arg("coarse_tets") = 1500,
       py::arg("spheres") = true,
       "Raw surface -> bundle (repair, simplify, tetrahedralize, rigid links, medial-axis "
       "sphere tree); written to `folder` when given.");

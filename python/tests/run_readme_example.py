@@ -14,5 +14,10 @@ end = text.find("```\n", start + 10)
 if start < 0 or end < 0:
     sys.exit("README.md: no ```python block after the Python paragraph")
 code = text[start + len("```python\n"):end]
+before = {p.name for p in root.iterdir()}
 exec(compile(code, "README.md (Python example)", "exec"), {"__name__": "__readme__"})
+# Nothing written into the repository root (a default folder once became ".").
+stray = sorted({p.name for p in root.iterdir()} - before)
+if stray:
+    sys.exit("README example wrote into the repository root: " + ", ".join(stray))
 print("README Python example ran:", len(code.splitlines()), "lines")
