@@ -148,14 +148,14 @@ TEST(ConservativeDefaults, DeformedBunnyAndDragonEveryContactPointInAReportedPai
       const double na = a[i].spheres.num_nodes(), nb = b[j].spheres.num_nodes();
       if (std::max(na, nb) > 1.5 * std::min(na, nb)) continue;
       const std::filesystem::path &pa = bunnies[i], &pb = dragons[j];
-      for (double phase : {0.0, 1.3}) {
-        const Coverage c = check(a[i], b[j], 0.006, phase);
-        std::printf("%s (%d spheres) x %s (%d spheres), phase %.1f: %d contact points, %d outside "
-                    "every reported pair (%.3f %%) over %d budgets\n",
-                    pa.filename().c_str(), c.spheres_a, pb.filename().c_str(), c.spheres_b, phase,
+      for (auto [amp, phase] : {std::pair{0.006, 0.0}, std::pair{0.006, 1.3}, std::pair{0.02, 0.7}}) {
+        const Coverage c = check(a[i], b[j], amp, phase);
+        std::printf("%s (%d spheres) x %s (%d spheres), amplitude %.0f mm, phase %.1f: %d contact "
+                    "points, %d outside every reported pair (%.3f %%) over %d budgets\n",
+                    pa.filename().c_str(), c.spheres_a, pb.filename().c_str(), c.spheres_b, 1e3 * amp, phase,
                     c.points, c.uncovered, 100.0 * c.uncovered / std::max(1, c.points), c.budgets);
         EXPECT_GT(c.points, 20);
-        EXPECT_EQ(c.uncovered, 0) << pa << " x " << pb << " phase " << phase;
+        EXPECT_EQ(c.uncovered, 0) << pa << " x " << pb << " amplitude " << amp << " phase " << phase;
       }
     }
 }
