@@ -48,8 +48,9 @@ struct FrameMetrics {
   /// Interrupted queries whose response used the pair's previous complete
   /// answer (collision.on_interrupt = "previous").
   int reused = 0;
-  /// Cycles whose penalty forces were scaled down because the stiffness on
-  /// the lightest node exceeded what the cycle length allows (see World::kContactOmegaLimit).
+  /// Cycles whose penalty forces were scaled down because a node's penalty
+  /// stiffness over its mass exceeded what the cycle length allows (see
+  /// World::kContactOmegaLimit).
   int softened = 0;
   /// Cycles whose penalty forces were scaled down to keep the contact
   /// passive (collision.passive).
@@ -149,6 +150,17 @@ struct RuntimeObject {
   double cycle_obstacle_depth = 0;
   /// Kinematic objects: the current pose (positions = pose * rest).
   RigidPose pose;
+  /// Deformable object in no close pair and not near an obstacle this frame
+  /// (World::plan_islands): it skips the frame's cycles but the last and then
+  /// advances over the whole frame at once (its FEM, sphere update and
+  /// queries), so it does not pay for the cycles others' contacts need.
+  bool deferred = false;
+  /// Simulated time this object is behind the World's cycle clock, s (> 0
+  /// only for a deferred object inside a frame).
+  double lag = 0;
+  /// Simulated time its last advance covered, s (its cycle length, or the
+  /// whole frame for a deferred object).
+  double advanced = 0;
 };
 
 /// A simulation: objects, the plan of the stages they need, and the frame loop.
@@ -185,6 +197,9 @@ class World {
 
   /// The last query of each collision pair (same order as plan().pairs).
   const std::vector<collision::CollisionResult>& results() const { return m_results; }
+  /// The test budget each pair's last query of the last cycle got (-1: no
+  /// test budget; 0: not queried), same order as plan().pairs.
+  const std::vector<int64_t>& pair_test_budgets() const { return m_pair_tests; }
 
   /// Advances one frame of 1 / frame_rate simulated seconds with the
   /// settings' query budget (in real-time mode: what is left of the frame).
@@ -215,6 +230,26 @@ class World {
   /// and re-run as shorter cycles (recursively, `depth` deep).
   void run_cycles(double t0, double length, int n, int depth, bool ends_frame,
                   const std::function<double(double)>& budget_at, FrameMetrics& m);
+  /// Decides which pairs are queried in every cycle of the coming frame of dt
+  /// (m_pair_close: in contact, swept hit, or root spheres closer than twice
+  /// the pair's motion over the frame plus one leaf) and which deformable
+  /// objects are deferred (RuntimeObject::deferred: in no close pair, not
+  /// near an obstacle). Depends on the state only: the same for any thread count.
+  void plan_islands(double dt);
+  /// collision.budget_split = Priority: each pair's priority weight
+  /// (m_pair_weight) and m_query_pairs in the order they share the pool
+  /// (lowest priority first); Even: weights 1, order unchanged.
+  void share_budget();
+  std::vector<double> m_pair_weight;   ///< priority weight of each pair this cycle
+  std::vector<size_t> m_query_pairs;   ///< pairs that need a traversal this cycle
+  std::vector<double> m_pair_budget;   ///< their time budgets this cycle, s
+  std::vector<int64_t> m_pair_tests;   ///< their test budgets this cycle (-1: none)
+  std::vector<double> m_pair_depth;    ///< deepest penetration of each pair's last response, m
+  /// Lightest lumped node mass of the deformable objects in close pairs this
+  /// frame (plan_islands; m_min_node_mass before it runs), kg.
+  double m_close_min_mass = 1;
+  /// Per pair: queried in every cycle of the frame (else only in its last).
+  std::vector<char> m_pair_close;
   /// Cycles a frame of dt needs so that no pair moves more than
   /// collision.cycle_motion leaf radii relative to each other per cycle,
   /// from each object's last measured sphere speed.
@@ -260,6 +295,7 @@ class World {
     double contact_scale = 1;
     double contact_work = 0, passive_allowance = -1;
     std::vector<std::vector<collision::Sphere>> start_spheres;
+    std::vector<double> lags;
   };
   void save(Snapshot& s) const;
   void restore(const Snapshot& s);
@@ -314,6 +350,9 @@ class World {
   std::vector<double> m_complete_depth;
   double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
   double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
+  /// Squared frequency bound of the last response's penalty springs, 1/s^2:
+  /// ContactStats::max_rate summed over the pairs (per node k share / m).
+  double m_contact_rate = 0;
   double m_penalty_energy = 0;  ///< penalty spring energy of the last response, J
   double m_contact_scale = 1;   ///< softening of the current contact episode (1: none)
   /// Work done by the contact forces on the deformable objects since the

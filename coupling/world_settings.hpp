@@ -44,6 +44,10 @@ struct ObjectSetup {
   /// false: the object takes no part in sphere-tree collisions (e.g. a static
   /// box that collides as an analytic obstacle, WorldSettings::obstacles).
   bool sphere_collisions = true;
+  /// User weight of the object's pairs when one query budget is shared by
+  /// priority (CollisionSpec::budget_split = Priority), > 0: e.g. larger for
+  /// objects near the camera. A pair's weight is the product of its objects'.
+  double collision_weight = 1;
 };
 
 /// One object ready to simulate: its setup and its geometry (dense surface,
@@ -69,6 +73,25 @@ enum class InterruptedResponse {
   Previous,
 };
 
+/// How the query budget of a cycle is shared among the pairs that need a
+/// query (their swept trees touch and their roots overlap).
+enum class BudgetSplit {
+  /// Every pair gets the request's budget (in real-time mode: an equal share
+  /// of what is left of the frame).
+  Even,
+  /// Level of detail for many pairs (the paper's closing idea): the same
+  /// total, n pairs x the even budget, shared by each pair's priority
+  /// w = w_a w_b (1 + depth / leaf + closing speed x frame / leaf): the user
+  /// weights of its objects (ObjectSetup::collision_weight), its deepest
+  /// penetration in the last response and the speed at which its objects'
+  /// centres approach, both in leaf radii of the pair's smaller tree. The
+  /// pairs are queried lowest priority first, each with its weight's
+  /// fraction of what is left of the total (tests, or seconds measured), so
+  /// what resting pairs do not use goes to deep or fast-closing ones; each
+  /// gets at least one test (min_query_budget in seconds).
+  Priority,
+};
+
 /// The collision request of every pair query of a simulation: 1 ms per
 /// query in the fast breadth-first mode.
 inline collision::CollisionRequest default_query() {
@@ -84,6 +107,8 @@ struct CollisionSpec {
   /// depth cap, list cap, parent filter. start_front and record_front are
   /// set per query by the World (temporal_coherence).
   collision::CollisionRequest query = default_query();
+  /// How one cycle's query budget is shared among its pairs.
+  BudgetSplit budget_split = BudgetSplit::Even;
   /// Seed each query with the previous query's front of the same pair.
   bool temporal_coherence = false;
   /// After each update, grow parents to enclose their children (a layered

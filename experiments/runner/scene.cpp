@@ -461,6 +461,7 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
   o.initial_compression = f.number("initial_compression", 0, 0, 0.95);
   if (o.initial_compression > 0 && o.kind != ObjectKind::Deformable)
     f.fail(f.path("initial_compression"), "only a deformable object can start compressed");
+  o.collision_weight = f.number("collision_weight", o.collision_weight, 0, 1e6, true);
   if (o.kind == ObjectKind::Static && o.velocity.norm() > 0)
     f.fail(f.path("velocity"), "a static object cannot have a velocity");
   if (const Json* mat = f.get("material")) {
@@ -578,6 +579,11 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.layered = f.boolean("layered", c.layered);
   c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", c.single_cycle_when_apart);
   c.swept = f.boolean("swept", c.swept);
+  c.budget_split =
+      f.string("budget_split", c.budget_split == BudgetSplit::Priority ? "priority" : "even",
+               {"even", "priority"}) == "priority"
+          ? BudgetSplit::Priority
+          : BudgetSplit::Even;
   c.cycle_motion = f.number("cycle_motion", c.cycle_motion, 0, 1e3, true);
   c.midpoint = f.boolean("midpoint", c.midpoint);
   c.passive = f.boolean("passive", c.passive);

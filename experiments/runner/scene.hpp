@@ -54,6 +54,7 @@ Json read_scene_json(const std::filesystem::path& path);
 void apply_overrides(Json& json, const std::vector<std::string>& overrides);
 
 using coupling::CollisionSpec;
+using coupling::BudgetSplit;
 using coupling::InterruptedResponse;
 using coupling::ObjectKind;
 using coupling::PrimitiveSpec;

@@ -1,0 +1,235 @@
+// Scheduling of the frame between objects and pairs: objects in no close
+// pair skip the cycles others' contacts need (plan_islands), and one query
+// budget shared among pairs by priority (collision.budget_split).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <icd/coupling/primitive_asset.hpp>
+#include <icd/coupling/world.hpp>
+#include <icd/mesh/core/error.hpp>
+
+namespace icd::coupling {
+namespace {
+
+WorldObject ball(const std::string& name, const Eigen::Vector3d& x, const Eigen::Vector3d& v,
+                 double radius = 0.1) {
+  PrimitiveSpec p;
+  p.radius = radius;
+  p.subdivisions = 2;
+  p.cells = 5;
+  WorldObject o;
+  o.setup.name = name;
+  o.setup.material.young = 5e5;
+  o.setup.velocity = v;
+  o.asset = make_primitive_asset(p, 3);
+  place_asset(o.asset, {0, x, {0, 0, 0}});
+  return o;
+}
+
+WorldSettings deterministic() {
+  WorldSettings s;
+  s.collision.query.budget_tests = 1000000;
+  s.collision.query.budget_seconds = std::numeric_limits<double>::infinity();
+  s.collision.contact.stiffness = 2000;
+  s.threads = 1;
+  return s;
+}
+
+const RuntimeObject& named(const World& w, const std::string& name) {
+  for (const RuntimeObject& o : w.objects())
+    if (o.setup.name == name) return o;
+  throw std::runtime_error("no object " + name);
+}
+
+// A head-on pair runs many cycles per frame while in contact; a third ball,
+// far from both, is in no close pair: it must advance exactly as it does
+// in a world where nothing is in contact (one advance over each frame),
+// bitwise, instead of being cut into the pair's cycles.
+TEST(WorldScheduling, FarObjectDoesNotPayForTheCyclesOfAContact) {
+  std::vector<WorldObject> busy;
+  busy.push_back(ball("left", {-0.12, 0, 0}, {0.6, 0, 0}));
+  busy.push_back(ball("right", {0.12, 0, 0}, {-0.6, 0, 0}));
+  busy.push_back(ball("far", {3, 0, 0}, {0, 0.2, 0}));
+  // Reference: the same far ball, with a partner that never comes near it.
+  std::vector<WorldObject> quiet;
+  quiet.push_back(ball("decoy", {-3, 0, 0}, {0, -0.2, 0}));
+  quiet.push_back(ball("far", {3, 0, 0}, {0, 0.2, 0}));
+  World world(std::move(busy), deterministic());
+  World reference(std::move(quiet), deterministic());
+  int cycled_frames = 0;
+  for (int f = 0; f < 30; ++f) {
+    const FrameMetrics m = world.step();
+    const FrameMetrics r = reference.step();
+    ASSERT_EQ(r.cycles, 1) << "frame " << f;  // nothing near anything
+    const RuntimeObject& far = named(world, "far");
+    const RuntimeObject& ref = named(reference, "far");
+    if (m.cycles > ref.substeps) ++cycled_frames;  // old path: >= 1 sub-step per cycle
+    // (a frame tried as one cycle and rolled back counts the trial's work too)
+    ASSERT_EQ(far.substeps, ref.substeps * (1 + m.rollback))
+        << "frame " << f << ", " << m.cycles << " cycles";
+    ASSERT_TRUE((far.positions.array() == ref.positions.array()).all()) << "frame " << f;
+    ASSERT_TRUE((far.sim->velocities().array() == ref.sim->velocities().array()).all())
+        << "frame " << f;
+  }
+  // The pair did go through a contact that cut its frames into more cycles
+  // than the far ball's sub-steps.
+  EXPECT_GT(cycled_frames, 0);
+}
+
+// A contact's response depends on the objects in contact only: adding a
+// resting object with much lighter coarse nodes (a finer mesh), far from the
+// pair, changes neither the pair's cycles nor its softening, so the pair
+// moves bitwise as without it. (Before: the cycle count and the softening
+// used the lightest node of all objects, and the light far object cut the
+// pair's frames into more cycles and softened its penalty.)
+TEST(WorldScheduling, ALightObjectFarAwayDoesNotChangeAContact) {
+  const auto pair = [] {
+    std::vector<WorldObject> v;
+    v.push_back(ball("left", {-0.12, 0, 0}, {0.6, 0, 0}));
+    v.push_back(ball("right", {0.12, 0, 0}, {-0.6, 0, 0}));
+    return v;
+  };
+  std::vector<WorldObject> with_light = pair();
+  PrimitiveSpec fine;
+  fine.radius = 0.05;
+  fine.subdivisions = 2;
+  fine.cells = 9;
+  WorldObject light;
+  light.setup.name = "light";
+  light.setup.material.young = 5e5;
+  light.asset = make_primitive_asset(fine, 3);
+  place_asset(light.asset, {0, {0, 3, 0}, {0, 0, 0}});
+  with_light.push_back(std::move(light));
+  World alone(pair(), deterministic());
+  World crowd(std::move(with_light), deterministic());
+  // The light object's nodes are lighter than the pair's (else this tests nothing).
+  ASSERT_LT(crowd.objects()[2].node_mass.minCoeff(), 0.5 * alone.objects()[0].node_mass.minCoeff());
+  int contact_frames = 0;
+  for (int f = 0; f < 30; ++f) {
+    const FrameMetrics a = alone.step();
+    const FrameMetrics c = crowd.step();
+    contact_frames += a.active_pairs > 0;
+    ASSERT_EQ(a.cycles, c.cycles) << "frame " << f;
+    ASSERT_EQ(a.softened, c.softened) << "frame " << f;
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_TRUE((alone.objects()[i].positions.array() == crowd.objects()[i].positions.array()).all())
+          << "frame " << f << " object " << i;
+    }
+  }
+  EXPECT_GT(contact_frames, 0);
+}
+
+// Level of detail for many pairs. Scripted (kinematic) balls hold still, so
+// every world sees the same spheres whatever its budget: three resting pairs
+// just touching and one critical pair deeply overlapping. Oracle: the same
+// scene with an unlimited budget. With a test budget too small for the
+// critical pair's traversal, the even split (every pair the same budget)
+// leaves it interrupted; the priority split gives it the share of its depth
+// and finds exactly the oracle's colliding leaf pairs.
+TEST(WorldScheduling, PrioritySplitFindsTheCriticalPairWhereTheEvenSplitDoesNot) {
+  const auto scene = [] {
+    std::vector<WorldObject> v;
+    const auto still = [&v](const std::string& name, const Eigen::Vector3d& x) {
+      WorldObject o = ball(name, x, {0, 0, 0});
+      o.setup.kind = ObjectKind::Rigid;
+      o.setup.motion = [](double) { return RigidPose{}; };  // rest = placed pose
+      v.push_back(std::move(o));
+    };
+    for (int k = 0; k < 3; ++k) {  // resting pairs: 2 mm overlap
+      still("rest" + std::to_string(k) + "a", {-0.1 + 0.001, 1.0 * k, 0});
+      still("rest" + std::to_string(k) + "b", {0.1 - 0.001, 1.0 * k, 0});
+    }
+    still("deep_a", {-0.07, 3, 0});  // critical pair: 6 cm overlap
+    still("deep_b", {0.07, 3, 0});
+    v.push_back(ball("soft", {0, -5, 0}, {0, 0, 0}));  // a deformable object: response on
+    return v;
+  };
+  WorldSettings oracle_settings = deterministic();
+  oracle_settings.collision.query.budget_tests = -1;
+  World oracle(scene(), oracle_settings);
+  oracle.step();
+  oracle.step();
+  // The pairs of the plan: find the critical and the resting ones.
+  const auto& pairs = oracle.plan().pairs;
+  const auto pair_of = [&](const World& w, const std::string& a, const std::string& b) {
+    for (size_t p = 0; p < pairs.size(); ++p) {
+      const std::string& na = w.objects()[pairs[p].first].setup.name;
+      const std::string& nb = w.objects()[pairs[p].second].setup.name;
+      if ((na == a && nb == b) || (na == b && nb == a)) return p;
+    }
+    throw std::runtime_error("no pair " + a + " - " + b);
+  };
+  const size_t critical = pair_of(oracle, "deep_a", "deep_b");
+  const collision::CollisionResult& truth = oracle.results()[critical];
+  ASSERT_FALSE(truth.interrupted);
+  ASSERT_FALSE(truth.colliding.empty());
+  for (int k = 0; k < 3; ++k) {
+    const std::string r = "rest" + std::to_string(k);
+    ASSERT_FALSE(oracle.results()[pair_of(oracle, r + "a", r + "b")].colliding.empty());
+  }
+  // A budget per query 70% of what the critical traversal needs.
+  const int64_t budget = truth.tests * 7 / 10;
+  auto sorted = [](std::vector<collision::NodePair> v) {
+    std::sort(v.begin(), v.end(), [](const collision::NodePair& x, const collision::NodePair& y) {
+      return std::pair(x.a, x.b) < std::pair(y.a, y.b);
+    });
+    return v;
+  };
+  const auto run = [&](BudgetSplit split) {
+    WorldSettings s = deterministic();
+    s.collision.query.budget_tests = budget;
+    s.collision.budget_split = split;
+    auto w = std::make_unique<World>(scene(), s);
+    w->step();
+    w->step();
+    return w;
+  };
+  const std::unique_ptr<World> even = run(BudgetSplit::Even);
+  const std::unique_ptr<World> priority = run(BudgetSplit::Priority);
+  // Even: every queried pair the same budget; the critical query is cut short.
+  EXPECT_EQ(even->pair_test_budgets()[critical], budget);
+  EXPECT_TRUE(even->results()[critical].interrupted);
+  EXPECT_NE(sorted(even->results()[critical].colliding), sorted(truth.colliding));
+  // Priority: the queries of the last cycle used no more than the same
+  // total (4 pairs x the budget), the critical pair got more than its even share.
+  int64_t used = 0, queried = 0;
+  for (size_t p = 0; p < pairs.size(); ++p)
+    if (priority->pair_test_budgets()[p] > 0) {
+      used += priority->results()[p].tests;
+      ++queried;
+    }
+  EXPECT_EQ(queried, 4);
+  EXPECT_LE(used, queried * budget);
+  EXPECT_GT(priority->pair_test_budgets()[critical], budget);
+  EXPECT_FALSE(priority->results()[critical].interrupted);
+  EXPECT_EQ(sorted(priority->results()[critical].colliding), sorted(truth.colliding));
+  // The resting pairs keep a budget of their own.
+  for (int k = 0; k < 3; ++k) {
+    const std::string r = "rest" + std::to_string(k);
+    EXPECT_GT(priority->pair_test_budgets()[pair_of(*priority, r + "a", r + "b")], 0);
+  }
+}
+
+TEST(WorldScheduling, RefusesANonPositiveCollisionWeight) {
+  std::vector<WorldObject> v;
+  v.push_back(ball("a", {-1, 0, 0}, {0, 0, 0}));
+  v.push_back(ball("b", {1, 0, 0}, {0, 0, 0}));
+  v[1].setup.collision_weight = 0;
+  try {
+    World w(std::move(v), deterministic());
+    FAIL() << "accepted collision_weight 0";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"b\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("collision_weight"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace icd::coupling
