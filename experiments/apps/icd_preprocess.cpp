@@ -146,6 +146,8 @@ std::variant<Command, int> parse(int argc, char** argv) {
   if (const auto status = cli.parse(argc, argv)) return *status;
   const auto fail = [](const std::string& what) { return Cli::fail("icd-preprocess", what); };
   o.tetrahedralize.cell_size = cell_size;
+  if (!(o.tetrahedralize.step_cleanup.target_ratio >= 0))
+    return fail("--step-target must be >= 0 (0: no post-pass)");
   if (simplify_faces && simplify_ratio)
     return fail("--simplify-faces and --simplify-ratio contradict each other: give one");
   if (simplify_ratio) {
@@ -186,8 +188,9 @@ void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, doubl
   const std::string fem_warnings =
       icd::mesh::fem_quality_warnings(r.stable_step, r.quality.min_dihedral_deg);
   if (!fem_warnings.empty())
-    std::printf("-- WARNING: tets not fit for explicit FEM: %s (raise --sliver-bound or "
-                "--coarse-tets)\n",
+    std::printf("-- WARNING: tets not fit for explicit FEM: %s (thin parts whose light surface "
+                "nodes the --step-target post-pass could not remove; see "
+                "experiments/studies/preprocess/README.md, stable step)\n",
                 fem_warnings.c_str());
   std::printf("-- rigid links: %d dense vertices on %d coarse surface nodes\n", b.links.num_links(),
               static_cast<int>(b.surface_nodes.size()));

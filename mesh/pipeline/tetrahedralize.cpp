@@ -171,11 +171,12 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       !(o.sliver_bound_deg >= 0.0 && o.sliver_bound_deg < 70.0) || o.max_size_iterations < 1 ||
       !(o.count_tolerance > 0.0) || !(o.pass_share > 0.0 && o.pass_share <= 1.0) ||
       o.max_retries < 0 || !(o.feature_angle_deg >= 0.0 && o.feature_angle_deg < 180.0) ||
-      !(o.limits.cpu_seconds > 0.0) || !(o.limits.memory_mb > 0.0))
+      !(o.limits.cpu_seconds > 0.0) || !(o.limits.memory_mb > 0.0) ||
+      !(o.step_cleanup.target_ratio >= 0.0))
     throw ParameterError(
         "tetrahedralize_surface: need target_tets >= 1 or cell_size > 0, facet_angle_deg in (0, "
         "30], radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, "
-        "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits");
+        "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits, step_cleanup.target_ratio >= 0");
   CgalMesh sm;
   if (!detail::to_cgal(surface, sm) || !CGAL::is_closed(sm))
     throw InputError("tetrahedralize_surface: the surface is not a closed manifold triangle mesh");
