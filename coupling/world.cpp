@@ -230,6 +230,20 @@ void World::plan_islands(double dt) {
     active[i] = o.plan.kinematic || o.near_obstacle || o.external_forces.size() > 0;
   }
   const double g = 0.5 * m_settings.gravity.norm() * dt * dt;  // (same on both: relative 0)
+  // An object that could reach an obstacle within the frame runs the cycles
+  // too (advanced over the whole frame at once, a fast or heavily
+  // accelerated object would pass through a thin obstacle unseen): its
+  // dense surface lies within max_link of the coarse nodes' box, which moves
+  // at most 2 * speed * dt + g * dt^2 / 2 over the frame (as for pairs).
+  for (size_t i = 0; i < m_objects.size() && !m_settings.obstacles.empty(); ++i) {
+    const RuntimeObject& o = m_objects[i];
+    if (active[i] || !o.plan.fem) continue;
+    const double pad = o.max_link + 2 * o.speed * dt + g;
+    const Eigen::Vector3d lo = o.positions.colwise().minCoeff().transpose().array() - pad;
+    const Eigen::Vector3d hi = o.positions.colwise().maxCoeff().transpose().array() + pad;
+    for (const Obstacle& ob : m_settings.obstacles)
+      if (!(ob.lower_bound(lo, hi) > 0)) active[i] = 1;  // (NaN: active)
+  }
   for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
     const auto [i, j] = m_plan.pairs[p];
     const RuntimeObject& a = m_objects[i];
