@@ -63,7 +63,7 @@ void seed(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, double s
     const Tr::Vertex_handle v = tr.insert(cwp(p));
     // A seed inside a protecting ball of a sharp feature is hidden: keep the ball.
     if (v == Tr::Vertex_handle() || tr.point(v).point() != p || tr.point(v).weight() != 0 ||
-        c3t3.in_dimension(v) >= 0 && c3t3.in_dimension(v) < 2)
+        (c3t3.in_dimension(v) >= 0 && c3t3.in_dimension(v) < 2))
       continue;
     c3t3.set_dimension(v, 2);
     c3t3.set_index(v, index);
