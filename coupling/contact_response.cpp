@@ -91,6 +91,32 @@ struct Accumulator {
   }
 };
 
+// Adds k * share_n / m_n of sphere `sphere` to rate[n] for its nodes n (the
+// rate Accumulator::add reports), PartitionOfUnity or MassWeighted.
+void add_rate(const SphereTree& t, const Eigen::VectorXd& mass, ContactDistribution mode,
+              int sphere, double k, Eigen::VectorXd& rate) {
+  const int32_t begin = t.assoc_offset[sphere], end = t.assoc_offset[sphere + 1];
+  double total_mass = 0;
+  if (mode == ContactDistribution::MassWeighted)
+    for (int32_t j = begin; j < end; ++j) total_mass += mass[t.assoc_nodes[j]];
+  for (int32_t j = begin; j < end; ++j) {
+    const int32_t node = t.assoc_nodes[j];
+    const double share =
+        mode == ContactDistribution::MassWeighted ? mass[node] / total_mass : 1.0 / (end - begin);
+    rate[node] += k * share / mass[node];
+  }
+}
+
+// min over the nodes of `sphere` of cap / rate[n].
+double weight_of(const SphereTree& t, int sphere, const Eigen::VectorXd& rate, double cap) {
+  double w = std::numeric_limits<double>::infinity();
+  for (int32_t j = t.assoc_offset[sphere]; j < t.assoc_offset[sphere + 1]; ++j) {
+    const double r = rate[t.assoc_nodes[j]];
+    if (r > 0) w = std::min(w, cap / r);
+  }
+  return w;
+}
+
 }  // namespace
 
 Eigen::SparseMatrix<double> sphere_to_node_matrix(const SphereTree& tree, int num_coarse_nodes) {
@@ -132,10 +158,42 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
   fallback = fallback.allFinite() && fallback.norm() > 0 ? fallback.normalized()
                                                          : Eigen::Vector3d::UnitZ();
 
+  const double rate_cap = options.node_rate_limit;
+  if (!(rate_cap > 0.0))
+    throw ParameterError("contact response: node_rate_limit must be positive (got " +
+                         std::to_string(rate_cap) + ")");
+  const bool capped =
+      std::isfinite(rate_cap) && options.distribution != ContactDistribution::PaperAverage;
+  if (capped && (!options.mass_a || !options.mass_b))
+    throw ParameterError("contact response: node_rate_limit needs mass_a and mass_b");
+
   Accumulator acc_a(forces_a, a, options.distribution, options.mass_a),
       acc_b(forces_b, b, options.distribution, options.mass_b);
   ContactStats stats;
   const double k = options.stiffness;
+  auto depth = [&](const NodePair& p, double cap) {
+    const collision::Sphere& sa = a.spheres[p.a];
+    const collision::Sphere& sb = b.spheres[p.b];
+    return std::min(sa.r + sb.r - (sb.center() - sa.center()).norm(), cap);
+  };
+  if (!(options.max_untested_penetration > 0.0))
+    throw ParameterError("contact response: max_untested_penetration must be positive (got " +
+                         std::to_string(options.max_untested_penetration) + ")");
+  // With a node rate cap: first every node's rate at the full k, then each
+  // pair weighted by the most loaded node of its two spheres.
+  Eigen::VectorXd rate_a, rate_b;
+  if (capped) {
+    rate_a = Eigen::VectorXd::Zero(forces_a.rows());
+    rate_b = Eigen::VectorXd::Zero(forces_b.rows());
+    auto load = [&](const NodePair& p, double cap) {
+      if (!(depth(p, cap) > 0.0)) return;
+      add_rate(a, *options.mass_a, options.distribution, p.a, k, rate_a);
+      add_rate(b, *options.mass_b, options.distribution, p.b, k, rate_b);
+    };
+    for (const NodePair& p : result.colliding) load(p, std::numeric_limits<double>::infinity());
+    if (options.use_untested)
+      for (const NodePair& p : result.untested) load(p, options.max_untested_penetration);
+  }
   auto respond = [&](const NodePair& p, double cap, bool leaf) {
     const collision::Sphere& sa = a.spheres[p.a];
     const collision::Sphere& sb = b.spheres[p.b];
@@ -144,25 +202,33 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     const double delta = std::min(sa.r + sb.r - dist, cap);
     if (!(delta > 0.0)) return;
     const Eigen::Vector3d n = dist > 1e-12 * (sa.r + sb.r) ? Eigen::Vector3d(d / dist) : fallback;
-    const Eigen::Vector3d f = k * delta * n;  // on b; -f on a (Eq. 11)
-    acc_a.add(p.a, -f, k);
-    acc_b.add(p.b, f, k);
+    double kp = k;
+    if (capped) {
+      double w = std::min(weight_of(a, p.a, rate_a, rate_cap), weight_of(b, p.b, rate_b, rate_cap));
+      if (!std::isfinite(w)) w = 1;
+      w = std::min(w, 1.0);
+      if (w < 1) {
+        ++stats.capped_pairs;
+        stats.min_weight = std::min(stats.min_weight, w);
+      }
+      kp = w * k;
+    }
+    const Eigen::Vector3d f = kp * delta * n;  // on b; -f on a (Eq. 11)
+    acc_a.add(p.a, -f, kp);
+    acc_b.add(p.b, f, kp);
     if (options.distribution != ContactDistribution::PaperAverage) {
       stats.total_force_a -= f;
       stats.total_force_b += f;
     }
     ++stats.active_pairs;
     stats.max_penetration = std::max(stats.max_penetration, delta);
-    stats.penalty_energy += 0.5 * k * delta * delta;
+    stats.penalty_energy += 0.5 * kp * delta * delta;
     if (leaf) {
       const double ratio = delta / std::max(std::min(sa.r, sb.r), 1e-300);
       stats.max_depth_ratio = std::max(stats.max_depth_ratio, ratio);
       stats.deep_pairs += ratio > 1.0;
     }
   };
-  if (!(options.max_untested_penetration > 0.0))
-    throw ParameterError("contact response: max_untested_penetration must be positive (got " +
-                         std::to_string(options.max_untested_penetration) + ")");
   for (const NodePair& p : result.colliding) respond(p, std::numeric_limits<double>::infinity(), true);
   if (options.use_untested)
     for (const NodePair& p : result.untested) respond(p, options.max_untested_penetration, false);
@@ -174,6 +240,57 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     stats.max_rate = acc_a.rate.maxCoeff() + acc_b.rate.maxCoeff();
   stats.max_node_stiffness = std::max(acc_a.stiffness.size() ? acc_a.stiffness.maxCoeff() : 0.0,
                                       acc_b.stiffness.size() ? acc_b.stiffness.maxCoeff() : 0.0);
+  return stats;
+}
+
+DeepContactStats deep_contact_velocity_step(const SphereTree& a, const SphereTree& b,
+                                            const collision::CollisionResult& result,
+                                            const Eigen::VectorXd& mass_a,
+                                            const Eigen::VectorXd& mass_b, Eigen::Ref<MatX3d> vel_a,
+                                            Eigen::Ref<MatX3d> vel_b, double depth_ratio) {
+  check_association(a, vel_a.rows(), "a");
+  check_association(b, vel_b.rows(), "b");
+  if (mass_a.size() != vel_a.rows() || mass_b.size() != vel_b.rows() ||
+      !(mass_a.minCoeff() > 0.0) || !(mass_b.minCoeff() > 0.0))
+    throw ParameterError("deep contact step: one positive mass per node and object needed");
+  DeepContactStats stats;
+  // Mass-weighted mean velocity and total mass of a sphere's nodes.
+  auto mean = [](const SphereTree& t, int s, const Eigen::VectorXd& m, const auto& v,
+                 double& total) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    total = 0;
+    for (int32_t j = t.assoc_offset[s]; j < t.assoc_offset[s + 1]; ++j) {
+      const int32_t n = t.assoc_nodes[j];
+      p += m[n] * v.row(n).transpose();
+      total += m[n];
+    }
+    return Eigen::Vector3d(p / std::max(total, 1e-300));
+  };
+  for (const NodePair& p : result.colliding) {
+    const collision::Sphere& sa = a.spheres[p.a];
+    const collision::Sphere& sb = b.spheres[p.b];
+    const Eigen::Vector3d d = sb.center() - sa.center();
+    const double dist = d.norm();
+    const double delta = sa.r + sb.r - dist;
+    if (!(delta > depth_ratio * std::min(sa.r, sb.r)) || !(dist > 1e-12 * (sa.r + sb.r))) continue;
+    if (a.assoc_offset[p.a] == a.assoc_offset[p.a + 1] ||
+        b.assoc_offset[p.b] == b.assoc_offset[p.b + 1])
+      continue;
+    ++stats.pairs;
+    const Eigen::Vector3d n = d / dist;
+    double ma = 0, mb = 0;
+    const Eigen::Vector3d va = mean(a, p.a, mass_a, vel_a, ma);
+    const Eigen::Vector3d vb = mean(b, p.b, mass_b, vel_b, mb);
+    const double vn = (vb - va).dot(n);  // < 0: approaching
+    if (!(vn < 0.0)) continue;
+    ++stats.approaching;
+    const double mu = ma * mb / (ma + mb);
+    const double j = -vn * mu;  // impulse on b along n, -j on a
+    const Eigen::RowVector3d da = (-j / ma) * n.transpose(), db = (j / mb) * n.transpose();
+    for (int32_t k = a.assoc_offset[p.a]; k < a.assoc_offset[p.a + 1]; ++k) vel_a.row(a.assoc_nodes[k]) += da;
+    for (int32_t k = b.assoc_offset[p.b]; k < b.assoc_offset[p.b + 1]; ++k) vel_b.row(b.assoc_nodes[k]) += db;
+    stats.removed_energy += 0.5 * mu * vn * vn;
+  }
   return stats;
 }
 

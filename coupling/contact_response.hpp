@@ -55,6 +55,17 @@ struct ContactOptions {
   /// to report ContactStats::max_rate. Not owned; may be null otherwise.
   const Eigen::VectorXd* mass_a = nullptr;
   const Eigen::VectorXd* mass_b = nullptr;
+  /// Largest penalty rate a coarse node may receive (1/s^2; inf = no cap,
+  /// the paper). A node's rate is the sum over its active pairs of
+  /// k * share / m_n (see ContactStats::max_rate); with hundreds of leaf
+  /// pairs on one node the summed stiffness far exceeds what an explicit
+  /// cycle of length h keeps stable ((omega h)^2 = rate h^2 < 4). With a
+  /// cap, every pair is weighted by w = min(1, cap / rate_n) over the nodes
+  /// of both its spheres, so no node's rate exceeds the cap however many
+  /// pairs it has, the forces stay equal and opposite pair by pair
+  /// (momentum conserved) and nodes with few pairs keep the full k. Needs
+  /// mass_a and mass_b. Not applied to PaperAverage.
+  double node_rate_limit = std::numeric_limits<double>::infinity();
 };
 
 /// What the response did.
@@ -83,7 +94,37 @@ struct ContactStats {
   /// and added for the two objects. A staggered response stays stable while
   /// sqrt(max_rate) h < 2. 0 unless both mass arrays were given.
   double max_rate = 0;
+  /// Pairs whose force was weighted down by ContactOptions::node_rate_limit
+  /// (w < 1), and the smallest weight (1: none).
+  int capped_pairs = 0;
+  double min_weight = 1;
 };
+
+/// What deep_contact_velocity_step did.
+struct DeepContactStats {
+  int pairs = 0;               ///< deep leaf pairs found
+  int approaching = 0;         ///< of which still approaching: their velocities changed
+  double removed_energy = 0;   ///< kinetic energy taken out (J, >= 0)
+};
+
+/// The backstop of the penalty (not in the paper): a colliding leaf pair
+/// deeper than `depth_ratio` times the smaller of its radii whose spheres
+/// still approach each other along n = (O_b - O_a) / |O_b - O_a| gets an
+/// inelastic velocity step: the mass-weighted mean velocities of the two
+/// spheres' coarse nodes (V_i) lose their relative normal approach speed,
+/// each node of a side shifted by the same vector. Pairs are treated one
+/// after the other (one Gauss-Seidel sweep). Each step conserves momentum
+/// and removes (1/2) mu v_n^2 of kinetic energy (mu the reduced mass of the
+/// two node sets): the pair stops sinking deeper, the penalty then pushes it
+/// out. mass_a / mass_b: lumped node masses; vel_a / vel_b: node velocities,
+/// changed in place. Throws ParameterError on missing associations or
+/// masses of the wrong size.
+DeepContactStats deep_contact_velocity_step(const collision::SphereTree& a,
+                                            const collision::SphereTree& b,
+                                            const collision::CollisionResult& result,
+                                            const Eigen::VectorXd& mass_a,
+                                            const Eigen::VectorXd& mass_b, Eigen::Ref<MatX3d> vel_a,
+                                            Eigen::Ref<MatX3d> vel_b, double depth_ratio = 1.0);
 
 /// The sphere -> coarse node map of one object as a sparse matrix
 /// D (#coarse nodes x #spheres): column i holds 1/|V_i| on the nodes of V_i,

@@ -721,6 +721,12 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       co.coincident_direction = cb - ca;
       co.mass_a = &a.node_mass;
       co.mass_b = &b.node_mass;
+      // Each object's nodes a little under half the stable rate (the
+      // softening below adds the two objects' largest rates; at exactly half,
+      // rounding tipped it over and, the scale only falling during an
+      // episode, softened every later cycle).
+      if (cs.node_rate_cap)
+        co.node_rate_limit = 0.45 * (kContactOmegaLimit / h) * (kContactOmegaLimit / h);
       // An interrupted query answers with coarse spheres; with on_interrupt =
       // "previous" the last complete answer (if recent) stands in, evaluated
       // at the current sphere positions; if it is older, the untested pairs
@@ -746,6 +752,22 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       m.max_penetration = std::max(m.max_penetration, st.max_penetration);
       m.deep_pairs = std::max(m.deep_pairs, st.deep_pairs);
       m.depth_ratio = std::max(m.depth_ratio, st.max_depth_ratio);
+      m.capped_pairs += st.capped_pairs;
+      // Deep pairs still approaching stop sinking: an inelastic velocity step
+      // on their coarse nodes (deformable objects on both sides only).
+      if (cs.deep_step_ratio > 0 && a.sim && b.sim &&
+          st.max_depth_ratio > cs.deep_step_ratio) {
+        MatX3d va = a.sim->velocities(), vb = b.sim->velocities();
+        const DeepContactStats ds = deep_contact_velocity_step(
+            a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : r, a.node_mass, b.node_mass, va,
+            vb, cs.deep_step_ratio);
+        if (ds.approaching > 0) {
+          a.sim->set_velocities(va);
+          b.sim->set_velocities(vb);
+          m.deep_steps += ds.approaching;
+          m.deep_step_energy += ds.removed_energy;
+        }
+      }
       const double step = cs.cycle_motion * m_pair_leaf[p];
       if (cs.swept && start_free && st.deep_pairs > 0 && a.motion + b.motion > step) {
         // First seen already deeper than a leaf after a motion longer than

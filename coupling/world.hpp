@@ -82,6 +82,14 @@ struct FrameMetrics {
   /// Largest penetration / smaller leaf radius of a colliding leaf pair in
   /// the frame (> 1 with deep_pairs).
   double depth_ratio = 0;
+  /// Pair forces weighted down by the per-node rate cap
+  /// (collision.node_rate_cap), summed over the frame's cycles.
+  int64_t capped_pairs = 0;
+  /// Deep approaching leaf pairs given an inelastic velocity step
+  /// (collision.deep_step_ratio), summed over the frame's cycles.
+  int deep_steps = 0;
+  /// Kinetic energy those steps removed in the frame, J.
+  double deep_step_energy = 0;
   /// Real-time mode (WorldSettings::target_fps > 0): the frame's deadline,
   /// 1 / target_fps of wall time, s (0: not in real-time mode).
   double deadline = 0;

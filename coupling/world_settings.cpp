@@ -27,6 +27,8 @@ void validate(const WorldSettings& s) {
   collision::validate(c.query);
   if (!(c.contact.stiffness > 0) || !std::isfinite(c.contact.stiffness))
     fail("collision.contact.stiffness", "must be > 0 and finite", c.contact.stiffness);
+  if (!(c.deep_step_ratio >= 0) || !std::isfinite(c.deep_step_ratio))
+    fail("collision.deep_step_ratio", "must be >= 0 and finite (0: off)", c.deep_step_ratio);
   if (!(c.previous_max_age >= 0))
     fail("collision.previous_max_age", "must be >= 0", c.previous_max_age);
   if (!(c.cycle_motion > 0) || !std::isfinite(c.cycle_motion))

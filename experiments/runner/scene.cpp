@@ -587,6 +587,8 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.cycle_motion = f.number("cycle_motion", c.cycle_motion, 0, 1e3, true);
   c.midpoint = f.boolean("midpoint", c.midpoint);
   c.passive = f.boolean("passive", c.passive);
+  c.node_rate_cap = f.boolean("node_rate_cap", c.node_rate_cap);
+  c.deep_step_ratio = f.number("deep_step_ratio", c.deep_step_ratio, 0, 1e3);
   const bool paper_update = c.update.mode == collision::SphereUpdateMode::PaperRatio;
   const std::string upd =
       f.string("sphere_update", paper_update ? "paper" : "conservative", {"paper", "conservative"});

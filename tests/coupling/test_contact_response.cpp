@@ -215,5 +215,125 @@ TEST(ContactResponse, MassWeightedGivesEqualAccelerations) {
   EXPECT_THROW(apply_contact_forces(a, b, r, o, fa, fb), ParameterError);
 }
 
+// The node rate cap: 40 leaf pairs all on node 0 of each object (rate
+// 40 k / m, far above the cap) and one pair on nodes 1 of both (rate k / m,
+// below it). The crowded pairs are weighted to exactly the cap on node 0
+// (reference: k delta summed by hand, times cap / rate), the lone pair keeps
+// the full k, and the forces stay equal and opposite.
+TEST(ContactResponse, NodeRateCapHoldsEachNodeAtTheCapAndSparesTheOthers) {
+  const int crowd = 40;
+  std::vector<Sphere> la, lb;
+  std::vector<std::vector<int>> aa = {{0}}, ab = {{0}};
+  for (int i = 0; i < crowd; ++i) {
+    la.push_back({0.01 * i, 0, 0, 0.5});
+    lb.push_back({0.01 * i, 0, 0.6 + 0.001 * i, 0.5});  // penetration 0.4 - 0.001 i
+    aa.push_back({0});
+    ab.push_back({0});
+  }
+  la.push_back({5, 0, 0, 0.5});
+  lb.push_back({5, 0, 0.9, 0.5});  // penetration 0.1, nodes 1
+  aa.push_back({1});
+  ab.push_back({1});
+  const SphereTree a = make_tree(la, aa), b = make_tree(lb, ab);
+  CollisionResult r;
+  for (int i = 1; i <= crowd + 1; ++i) r.colliding.push_back({i, i});
+  const Eigen::VectorXd ma = (Eigen::VectorXd(2) << 2.0, 2.0).finished();
+  const Eigen::VectorXd mb = (Eigen::VectorXd(2) << 4.0, 4.0).finished();
+  ContactOptions o;
+  o.stiffness = 100;
+  o.mass_a = &ma;
+  o.mass_b = &mb;
+  MatX3d fa0 = MatX3d::Zero(2, 3), fb0 = MatX3d::Zero(2, 3);
+  const ContactStats raw = apply_contact_forces(a, b, r, o, fa0, fb0);
+  EXPECT_EQ(raw.capped_pairs, 0);
+  const double cap = 500;  // 1/s^2: node 0 of a has 40 * 100 / 2 = 2000, of b 1000
+  o.node_rate_limit = cap;
+  MatX3d fa = MatX3d::Zero(2, 3), fb = MatX3d::Zero(2, 3);
+  const ContactStats s = apply_contact_forces(a, b, r, o, fa, fb);
+  EXPECT_EQ(s.capped_pairs, crowd);
+  EXPECT_NEAR(s.min_weight, cap / 2000.0, 1e-15);
+  double sum_delta = 0;
+  for (int i = 0; i < crowd; ++i) sum_delta += 0.4 - 0.001 * i;
+  // Weighted by the more loaded side (a: 2000 / s^2): w = 0.25.
+  EXPECT_NEAR(fb(0, 2), 0.25 * 100 * sum_delta, 1e-9);
+  EXPECT_NEAR(fa(0, 2), -0.25 * 100 * sum_delta, 1e-9);
+  EXPECT_NEAR(fb(1, 2), 100 * 0.1, 1e-12);  // the lone pair: full k
+  EXPECT_EQ(fb(1, 2), fb0(1, 2));
+  EXPECT_LT((fa.colwise().sum() + fb.colwise().sum()).norm(), 1e-12);
+  // Every node's rate at most the cap on each side; the raw response's was 4x.
+  EXPECT_LE(s.max_rate, 2 * cap * (1 + 1e-12));
+  EXPECT_NEAR(raw.max_rate, 2000 + 1000, 1e-9);
+  // Without masses a cap cannot be computed.
+  o.mass_a = nullptr;
+  EXPECT_THROW(apply_contact_forces(a, b, r, o, fa, fb), ParameterError);
+}
+
+double kinetic(const MatX3d& v, const Eigen::VectorXd& m) {
+  return 0.5 * (v.rowwise().squaredNorm().transpose() * m).value();
+}
+
+// The deep-contact velocity step: a leaf pair deeper than its radius whose
+// spheres approach loses exactly its relative normal approach velocity
+// (mass-weighted means of the nodes), keeps the tangential part and the
+// momentum, and the kinetic energy drops by (1/2) mu v_n^2. A separating
+// pair, a shallow pair and a deep pair below the threshold are untouched.
+TEST(ContactResponse, DeepContactStepStopsTheApproachAndOnlyRemovesEnergy) {
+  const Eigen::Vector3d n = Eigen::Vector3d(2, -1, 2) / 3.0;
+  const Eigen::Vector3d cb = 0.5 * n;  // radii 0.4: penetration 0.3 (0.75 r)
+  const SphereTree a = make_tree({{0, 0, 0, 0.4}}, {{0, 1}, {0, 1}});
+  const SphereTree b = make_tree({{cb.x(), cb.y(), cb.z(), 0.4}}, {{0, 1, 2}, {0, 1, 2}});
+  CollisionResult r;
+  r.colliding = {{1, 1}};
+  const Eigen::VectorXd ma = (Eigen::VectorXd(2) << 1.0, 3.0).finished();
+  const Eigen::VectorXd mb = (Eigen::VectorXd(3) << 0.5, 2.0, 1.5).finished();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g(0, 1);
+  auto draw = [&](int rows) {
+    MatX3d v(rows, 3);
+    for (int i = 0; i < rows; ++i) v.row(i) << g(rng), g(rng), g(rng);
+    return v;
+  };
+  auto mean = [](const MatX3d& v, const Eigen::VectorXd& m) {
+    return Eigen::Vector3d(v.transpose() * m / m.sum());
+  };
+  int approached = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    MatX3d va = draw(2), vb = draw(3);
+    const MatX3d va0 = va, vb0 = vb;
+    const double vn0 = (mean(vb, mb) - mean(va, ma)).dot(n);
+    const DeepContactStats s = deep_contact_velocity_step(a, b, r, ma, mb, va, vb, 0.5);
+    EXPECT_EQ(s.pairs, 1);
+    const Eigen::Vector3d p0 = va0.transpose() * ma + vb0.transpose() * mb;
+    const Eigen::Vector3d p1 = va.transpose() * ma + vb.transpose() * mb;
+    EXPECT_LT((p1 - p0).norm(), 1e-12);
+    const double e0 = kinetic(va0, ma) + kinetic(vb0, mb), e1 = kinetic(va, ma) + kinetic(vb, mb);
+    if (vn0 < 0) {
+      ++approached;
+      EXPECT_EQ(s.approaching, 1);
+      EXPECT_NEAR((mean(vb, mb) - mean(va, ma)).dot(n), 0.0, 1e-12);
+      const double mu = ma.sum() * mb.sum() / (ma.sum() + mb.sum());
+      EXPECT_NEAR(e0 - e1, 0.5 * mu * vn0 * vn0, 1e-12);
+      EXPECT_NEAR(s.removed_energy, e0 - e1, 1e-12);
+      // Relative velocities within each object are kept (a uniform shift).
+      EXPECT_LT(((va.row(1) - va.row(0)) - (va0.row(1) - va0.row(0))).norm(), 1e-12);
+    } else {
+      EXPECT_EQ(s.approaching, 0);
+      EXPECT_EQ(va, va0);
+      EXPECT_EQ(vb, vb0);
+    }
+  }
+  EXPECT_GT(approached, 3);
+  EXPECT_LT(approached, 17);
+  // Above the threshold only: at depth ratio 0.8 (> 0.75) nothing moves.
+  MatX3d va = MatX3d::Zero(2, 3), vb = MatX3d::Zero(3, 3);
+  va.col(0).setConstant(1.0);
+  vb.col(0).setConstant(-1.0);
+  const MatX3d va0 = va;
+  EXPECT_EQ(deep_contact_velocity_step(a, b, r, ma, mb, va, vb, 0.8).pairs, 0);
+  EXPECT_EQ(va, va0);
+  const Eigen::VectorXd short_mass = Eigen::VectorXd::Ones(1);
+  EXPECT_THROW(deep_contact_velocity_step(a, b, r, short_mass, mb, va, vb), ParameterError);
+}
+
 }  // namespace
 }  // namespace icd::coupling
