@@ -921,4 +921,8 @@ CollisionResult collide(const SphereTree& a, const SphereTree& b, const Collisio
   return r;
 }
 
+double finish_cost_per_pair() { return t_finish_cost; }
+
+double calibrated_finish_cost_per_pair() { return output_seconds_per_pair(); }
+
 }  // namespace icd::collision

@@ -148,4 +148,12 @@ void collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& r
 /// Convenience overload returning a fresh result.
 CollisionResult collide(const SphereTree& a, const SphereTree& b, const CollisionRequest& request);
 
+/// The cost per pending pair of finishing an interrupted timed query (copying
+/// the pairs out), s, that this thread's next timed query reserves out of its
+/// budget: learnt from this thread's interrupted queries (0 before its first
+/// timed query). For studies of the budget's accuracy.
+double finish_cost_per_pair();
+/// The calibrated copy cost per pair, s (the floor of the learnt one).
+double calibrated_finish_cost_per_pair();
+
 }  // namespace icd::collision
