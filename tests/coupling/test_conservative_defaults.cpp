@@ -3,8 +3,9 @@
 // conservative on the real meshes? Every point where the deformed dense
 // bunny and dragon truly intersect (exact triangle-triangle reference) must
 // lie in both spheres of some pair a query reports (colliding leaf pair or
-// untested pair), at every test budget. Uses the bundles of the asset cache
-// (<repo>/assets, made by the scenes' preprocessing); skipped without them.
+// untested pair), at every test budget. Uses the bundles the CTest fixture
+// real_bundles makes in <build>/test_bundles (tests/coupling/CMakeLists.txt:
+// the scenes' preprocessing at ~1,100 spheres); fails without them.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -32,7 +33,7 @@ std::vector<std::filesystem::path> bundles(const std::string& prefix) {
   std::vector<std::filesystem::path> out;
   std::error_code ec;
   for (const auto& e :
-       std::filesystem::directory_iterator(std::filesystem::path(ICD_SOURCE_DIR) / "assets", ec))
+       std::filesystem::directory_iterator(std::filesystem::path(ICD_TEST_BUNDLE_DIR), ec))
     if (e.path().filename().string().rfind(prefix, 0) == 0 &&
         std::filesystem::exists(e.path() / kBundleDataFile))
       out.push_back(e.path());
@@ -135,14 +136,16 @@ Coverage check(AssetBundle a, AssetBundle b, double amp, double phase, double sh
 
 TEST(ConservativeDefaults, DeformedBunnyAndDragonEveryContactPointInAReportedPair) {
   const auto bunnies = bundles("bunny00"), dragons = bundles("ChineseDragon");
-  if (bunnies.empty() || dragons.empty())
-    GTEST_SKIP() << "no bunny00* / ChineseDragon* bundles in " << ICD_SOURCE_DIR << "/assets";
+  ASSERT_FALSE(bunnies.empty() || dragons.empty())
+      << "no bunny00* / ChineseDragon* bundles in " << ICD_TEST_BUNDLE_DIR
+      << " (made by the CTest fixture real_bundles: ctest -R ConservativeDefaults)";
+  int checked = 0;
   std::vector<AssetBundle> a, b;
   for (const auto& p : bunnies) a.push_back(read_asset_bundle(p));
   for (const auto& p : dragons) b.push_back(read_asset_bundle(p));
-  // Each bunny with the dragons of a tree of about its size (the cache holds
-  // the scenes' ~570-sphere trees and whatever else was preprocessed, e.g.
-  // ~1,100 and ~4,650 spheres: tree_depth 3 / branching 10, depth 4 / 8).
+  // Each bunny with the dragons of a tree of about its size (~1,100 spheres:
+  // tree_depth 3 / branching 10; more shapes with ICD_TEST_BUNDLE_SIZES, e.g.
+  // ~4,650 spheres: depth 4 / branching 8).
   for (std::size_t i = 0; i < a.size(); ++i)
     for (std::size_t j = 0; j < b.size(); ++j) {
       const double na = a[i].spheres.num_nodes(), nb = b[j].spheres.num_nodes();
@@ -150,6 +153,7 @@ TEST(ConservativeDefaults, DeformedBunnyAndDragonEveryContactPointInAReportedPai
       const std::filesystem::path &pa = bunnies[i], &pb = dragons[j];
       for (auto [amp, phase] : {std::pair{0.006, 0.0}, std::pair{0.006, 1.3}, std::pair{0.02, 0.7}}) {
         const Coverage c = check(a[i], b[j], amp, phase);
+        ++checked;
         std::printf("%s (%d spheres) x %s (%d spheres), amplitude %.0f mm, phase %.1f: %d contact "
                     "points, %d outside every reported pair (%.3f %%) over %d budgets\n",
                     pa.filename().c_str(), c.spheres_a, pb.filename().c_str(), c.spheres_b, 1e3 * amp, phase,
@@ -158,14 +162,15 @@ TEST(ConservativeDefaults, DeformedBunnyAndDragonEveryContactPointInAReportedPai
         EXPECT_EQ(c.uncovered, 0) << pa << " x " << pb << " amplitude " << amp << " phase " << phase;
       }
     }
+  EXPECT_GT(checked, 0) << "no bunny and dragon bundles of similar tree sizes";
 }
 
 // The check can fail: with bunny spheres 10 % too small, contact points fall
 // outside every reported pair.
 TEST(ConservativeDefaults, OracleSeesSpheresThatStopCovering) {
   const auto bunnies = bundles("bunny00"), dragons = bundles("ChineseDragon");
-  if (bunnies.empty() || dragons.empty())
-    GTEST_SKIP() << "no bunny00* / ChineseDragon* bundles in " << ICD_SOURCE_DIR << "/assets";
+  ASSERT_FALSE(bunnies.empty() || dragons.empty())
+      << "no bunny00* / ChineseDragon* bundles in " << ICD_TEST_BUNDLE_DIR;
   const Coverage c = check(read_asset_bundle(bunnies[0]), read_asset_bundle(dragons[0]), 0.006, 0.0, 0.9);
   EXPECT_GT(c.uncovered, 0);
 }
