@@ -10,6 +10,8 @@
 #include <thread>
 #include <utility>
 
+#include <Eigen/SVD>
+
 #include <icd/collision/aabb_tree.hpp>
 #include <icd/collision/sphere_update.hpp>
 #include <icd/collision/swept_spheres.hpp>
@@ -346,6 +348,43 @@ int World::motion_cycles(double dt) const {
   return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
 }
 
+int World::fit_cycles(double dt, int n, const std::vector<CycleLoad>& loads) {
+  n = std::clamp(n, 1, kMaxMotionCycles);
+  const auto work = [&](int c) {
+    const double h = dt / c;
+    double w = 0;
+    for (const CycleLoad& l : loads) {
+      const double sub = std::ceil(h / (l.step * (1 - kStepMargin)) * (1 - 1e-12));
+      w += l.cost * c * (std::max(sub, 1.0) + kCycleOverhead);
+    }
+    return w;
+  };
+  for (const CycleLoad& l : loads)
+    if (!(l.step > 0) || !std::isfinite(l.step) || !(l.cost > 0)) return n;  // nothing to fit
+  if (loads.empty()) return n;
+  // Beyond ~1.5 n the overhead of the extra cycles exceeds what they save.
+  const int last = std::min(kMaxMotionCycles, n + n / 2 + 2);
+  int best_n = n;
+  double best = work(n);
+  for (int c = n + 1; c <= last; ++c) {
+    const double w = work(c);
+    if (w < best) {
+      best = w;
+      best_n = c;
+    }
+  }
+  return best_n;
+}
+
+int World::aligned_cycles(double dt, int n) const {
+  std::vector<CycleLoad> loads;
+  for (const RuntimeObject& o : m_objects) {
+    if (!o.sim || o.deferred) continue;  // a deferred object advances once, whatever n is
+    loads.push_back({static_cast<double>(o.asset.coarse.T.rows()), o.step_cap});
+  }
+  return fit_cycles(dt, n, loads);
+}
+
 void World::set_external_forces(int i, const MatX3d& forces) {
   if (i < 0 || i >= static_cast<int>(m_objects.size()))
     throw ParameterError("World::set_external_forces: no object " + std::to_string(i));
@@ -435,7 +474,29 @@ void World::update_spheres(RuntimeObject& o) const {
     }
     return;
   }
-  collision::update_spheres(o.asset.spheres, o.rest, o.positions, m_settings.collision.update);
+  update_deformed_spheres(o, o.positions);
+}
+
+void World::update_deformed_spheres(RuntimeObject& o, const MatX3d& x) const {
+  // Best-fit rotation R of the centred nodes (Kabsch): x - c1 ~ R (X - c0).
+  const Eigen::RowVector3d c0 = o.rest.colwise().mean();
+  const Eigen::RowVector3d c1 = x.colwise().mean();
+  const Eigen::Matrix3d h = (o.rest.rowwise() - c0).transpose() * (x.rowwise() - c1);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  Eigen::Matrix3d r = svd.matrixV() * d * svd.matrixU().transpose();
+  if (!r.allFinite()) r.setIdentity();  // (a non-finite state fails in update_spheres)
+  // Rows: R^T (x - c1) + c0 is (x - c1) R + c0.
+  o.corotated = (x.rowwise() - c1) * r;
+  o.corotated.rowwise() += c0;
+  collision::update_spheres(o.asset.spheres, o.rest, o.corotated, m_settings.collision.update);
+  for (collision::Sphere& s : o.asset.spheres.spheres) {
+    const Eigen::Vector3d c = r * (s.center() - c0.transpose()) + c1.transpose();
+    s.x = c.x();
+    s.y = c.y();
+    s.z = c.z();
+  }
 }
 
 void World::update_dense(RuntimeObject& o) {
@@ -497,6 +558,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         support_work += o.obstacle_support.cwiseProduct(o.positions).sum();
       o.cycle_substeps = rep.substeps;
       o.cycle_min_step = rep.step;
+      o.step_cap = std::min(o.sim->options().max_step, o.sim->options().safety_factor * rep.step_limit);
       if (obstacles) {
         lo = lo.cwiseMin(o.positions.colwise().minCoeff().transpose());
         hi = hi.cwiseMax(o.positions.colwise().maxCoeff().transpose());
@@ -553,7 +615,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         // Midpoint sampling: the forces of this query act during the next
         // cycle, so detect at the positions predicted for its middle.
         o.predicted = o.positions + (0.5 * h) * o.sim->velocities();
-        collision::update_spheres(o.asset.spheres, o.rest, o.predicted, m_settings.collision.update);
+        update_deformed_spheres(o, o.predicted);
         if (m_settings.collision.layered) collision::enclose_children(o.asset.spheres);
         // The sweep runs from the start to the prediction, via the end.
         if (cs.swept)
@@ -1117,7 +1179,7 @@ FrameMetrics World::advance(std::optional<double> budget) {
     plan_islands(dt);
     cycles = std::max({stiff_cycles(), motion_cycles(dt), 1});
   }
-  run_cycles(m_time, dt, cycles, 0, true, budget_at, m);
+  run_cycles(m_time, dt, aligned_cycles(dt, cycles), 0, true, budget_at, m);
   m.min_budget_queries = floored;
   return finish_frame(m, frame_start);
 }

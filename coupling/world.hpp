@@ -125,6 +125,7 @@ struct RuntimeObject {
   MatX3d dense;                         ///< current dense positions (when the plan updates them)
   LinkEvaluator links;            ///< the rigid links, grouped by node triple (when dense_update)
   MatX3d predicted;               ///< coarse positions half a cycle ahead (collision.midpoint)
+  MatX3d corotated;               ///< scratch: coarse positions in the co-rotated frame
   Eigen::VectorXd node_mass;      ///< lumped coarse node masses (kg); huge for objects without FEM
   /// collision.swept: the spheres at the start of the cycle (actual
   /// positions, not the midpoint prediction), at its end, and swept from the
@@ -148,6 +149,10 @@ struct RuntimeObject {
   double obstacle_debt = 0;
   int substeps = 0;            ///< FEM sub-steps of this object in the last frame
   double step = 0;             ///< its last FEM sub-step, s (its own stable step)
+  /// The sub-step its FEM takes over an interval longer than it, at the last
+  /// stable-step estimate: min(max_step, safety_factor x stable limit), s
+  /// (0: not advanced yet). World::aligned_cycles sizes cycles by it.
+  double step_cap = 0;
   /// Scratch of one cycle's parallel stage, reduced in object order after
   /// it: contact work terms f . x0 and f . x1 (J), sub-steps, smallest
   /// step, dense vertices found inside obstacles and the deepest.
@@ -216,6 +221,31 @@ class World {
   /// none) per query in place of the settings' (and of real-time mode's).
   FrameMetrics step(double budget_seconds);
 
+  /// One object that runs a frame's cycles: its cost of one FEM sub-step
+  /// (any unit, e.g. its tets) and its sub-step over a long interval, s.
+  struct CycleLoad {
+    double cost = 1;
+    double step = 0;
+  };
+  /// The cycle count for a frame of dt (s) that needs at least n cycles (for
+  /// a stable penalty, or for motion): the n' in [n, n + n / 2 + 2] (at most
+  /// kMaxMotionCycles) with the least work. Each cycle advances an object in
+  /// ceil(h / step) equal sub-steps (h = dt / n'), so a cycle just longer than
+  /// an object's sub-step costs it two: 64 cycles of a 16.7 ms frame cost an
+  /// object with a 0.256 ms sub-step 128 sub-steps, 68 cycles cost it 68.
+  /// Work of n' cycles: sum over loads of cost x n' x (ceil(h / (step (1 -
+  /// kStepMargin))) + kCycleOverhead). n itself when no load has a step yet.
+  static int fit_cycles(double dt, int n, const std::vector<CycleLoad>& loads);
+  /// A cycle is fitted to kStepMargin below an object's sub-step: its stable
+  /// step is re-estimated within the frame (a squeezed object stiffens).
+  static constexpr double kStepMargin = 0.03;
+  /// Fixed cost of one cycle of one object, in its sub-steps: its advance()
+  /// ends with a full health check (an element pass, ~1/4 of an RK4 step),
+  /// and it updates its spheres and is queried.
+  static constexpr double kCycleOverhead = 0.3;
+  /// Most cycles a frame is cut into for motion (fast objects).
+  static constexpr int kMaxMotionCycles = 1024;
+
   /// Net energy a contact episode may give the objects with collision.passive,
   /// as a fraction of their kinetic energy when it began (the explicit
   /// penalty's own small gain, ~0.4% per bounce, stays untouched).
@@ -228,6 +258,17 @@ class World {
   /// The sphere tree of o follows its coarse nodes (rigidly, with its pose,
   /// for a kinematic object).
   void update_spheres(RuntimeObject& o) const;
+  /// The sphere tree of deformable object o follows coarse positions x
+  /// (#V x 3) in the object's co-rotated frame: x is taken back by its
+  /// best-fit rigid motion from the rest nodes (R, t: Kabsch, unweighted),
+  /// the spheres are updated there (collision.update) and moved forward by
+  /// (R, t). Both update rules measure displacements from the rest nodes, so
+  /// without it a spinning object's spheres drift and inflate: in
+  /// many_objects a dragon tipped over by the floor turned ~10 degrees per
+  /// frame, its root sphere grew from 9.5 to 14 cm within 4 frames, and the
+  /// phantom overlaps of the inflated spheres (leaf pairs 24 leaf radii
+  /// deep) drove the penalty until the FEM failed its health check.
+  void update_deformed_spheres(RuntimeObject& o, const MatX3d& x) const;
   /// Exact reference, frame counter and wall time at the end of step().
   FrameMetrics finish_frame(FrameMetrics& m, Clock::time_point frame_start);
   /// One detection/response cycle of length h (s) inside a frame, ending at
@@ -262,6 +303,9 @@ class World {
   /// collision.cycle_motion leaf radii relative to each other per cycle,
   /// from each object's last measured sphere speed.
   int motion_cycles(double dt) const;
+  /// fit_cycles for the frame of dt: the deformable objects that run the
+  /// cycles (not deferred), each weighted by its tets, at its step_cap.
+  int aligned_cycles(double dt, int n) const;
   /// Largest node displacement of scripted object o over the next dt, m.
   double scripted_motion(const RuntimeObject& o, double dt) const;
   /// Spheres at the current (actual) positions: start of the next sweep.
@@ -309,9 +353,8 @@ class World {
   void restore(const Snapshot& s);
 
   static constexpr int kMaxContactCycles = 64;
-  /// Most cycles a frame is cut into for motion (fast objects), and deepest
-  /// recursive split of a cycle (each split at most kMaxSplit cycles).
-  static constexpr int kMaxMotionCycles = 1024;
+  /// Deepest recursive split of a cycle (each split at most kMaxSplit
+  /// cycles); the most cycles for motion is kMaxMotionCycles.
   static constexpr int kMaxSplitDepth = 4;
   static constexpr int kMaxSplit = 64;
   /// Largest motion per cycle of an object near an obstacle, m: each cycle's

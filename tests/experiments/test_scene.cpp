@@ -139,6 +139,61 @@ TEST(Scene, EachBadFieldGetsAClearError) {
   }
 }
 
+// Level of detail: collision.budget_split and each object's collision_weight
+// reach the World's settings and objects; left out, the library defaults.
+TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
+  const Scene s = parse(with_objects(
+      R"({"name": "a", "primitive": {"type": "sphere", "radius": 0.1, "cells": 3},
+          "position": [-0.3, 0, 0], "collision_weight": 2.5},
+         {"name": "b", "primitive": {"type": "sphere", "radius": 0.1, "cells": 3},
+          "position": [0.3, 0, 0]})",
+      R"("collision": {"budget_split": "priority"})"));
+  EXPECT_EQ(s.world.collision.budget_split, coupling::BudgetSplit::Priority);
+  EXPECT_EQ(s.objects[0].collision_weight, 2.5);
+  EXPECT_EQ(s.objects[1].collision_weight, coupling::ObjectSetup{}.collision_weight);
+  const World world = make_world(s, "", "");
+  EXPECT_EQ(world.settings().collision.budget_split, coupling::BudgetSplit::Priority);
+  EXPECT_EQ(world.objects()[0].setup.collision_weight, 2.5);
+  EXPECT_EQ(world.objects()[1].setup.collision_weight, 1.0);
+
+  const Scene even = parse(with_objects(kSphere, R"("collision": {"budget_split": "even"})"));
+  EXPECT_EQ(even.world.collision.budget_split, coupling::BudgetSplit::Even);
+  const Scene plain = parse(with_objects(kSphere));
+  EXPECT_EQ(plain.world.collision.budget_split, coupling::CollisionSpec{}.budget_split);
+  EXPECT_EQ(plain.objects[0].collision_weight, coupling::ObjectSetup{}.collision_weight);
+
+  // Bad values: an InputError naming the file and the field.
+  const struct {
+    std::string text;
+    const char* field;
+    const char* what;
+  } cases[] = {
+      {with_objects(kSphere, R"("collision": {"budget_split": "random"})"),
+       "collision.budget_split", "must be one of"},
+      {with_objects(kSphere, R"("collision": {"budget_split": 1})"), "collision.budget_split",
+       "string"},
+      {with_objects(R"({"primitive": {}, "collision_weight": 0})"), "objects[0].collision_weight",
+       "must be in (0"},
+      {with_objects(R"({"primitive": {}, "collision_weight": -2})"), "objects[0].collision_weight",
+       "must be in (0"},
+      {with_objects(R"({"primitive": {}, "collision_weight": "near"})"),
+       "objects[0].collision_weight", "must be a number"},
+      {with_objects(R"({"primitive": {}, "collision_weight": 1e7})"), "objects[0].collision_weight",
+       "must be in (0"},
+  };
+  for (const auto& c : cases) {
+    try {
+      parse(c.text);
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("s.json: ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(std::string(c.field) + ":"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(c.what), std::string::npos) << msg;
+    }
+  }
+}
+
 // --dry-run plans: each scene runs only the stages it needs.
 // "initial_compression" (the stability study's 70 % cases): the object's
 // coarse nodes start squeezed along x about their centroid, y and z as at
