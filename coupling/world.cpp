@@ -124,6 +124,7 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
       fem::ModelOptions mo;
       mo.damping = o.setup.damping;
       mo.gravity = m_settings.gravity;
+      mo.mass_scaling.target_ratio = o.setup.mass_scaling_target;
       fem::Model model =
           naming(o, [&] { return fem::Model(o.rest, o.asset.coarse.T, o.setup.material, mo); });
       for (int n : o.setup.fixed_nodes)

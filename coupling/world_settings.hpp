@@ -34,6 +34,11 @@ struct ObjectSetup {
   fem::Material material;
   fem::RayleighDamping damping;
   fem::Integrator integrator = fem::Integrator::RK4;
+  /// Selective mass scaling of a deformable object (fem::MassScaling::
+  /// target_ratio, 0: off; scene field "fem": {"mass_scaling_target"}): its
+  /// light nodes get just enough mass for a stable step of this fraction of
+  /// near-regular tets' (why 0.5 and what it costs in accuracy: fem/README.md).
+  double mass_scaling_target = fem::kSceneMassScalingTarget;
   std::vector<int> fixed_nodes;  ///< coarse node indices held fixed
   /// Initial velocity of a deformable object, constant velocity of a rigid one, m/s.
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();

@@ -21,6 +21,24 @@ Model::Model(const Eigen::Ref<const MatX3d>& rest_positions, const Eigen::Ref<co
   set_gravity(options.gravity);
   set_damping(options.damping);
   set_strain_rate_damping(options.strain_rate_damping);
+  validate(options.mass_scaling);
+  if (options.mass_scaling.target_ratio > 0)
+    m_mass_scaling = apply_mass_scaling(*this, rest_positions, options.mass_scaling);
+}
+
+void Model::set_masses(const Eigen::Ref<const Eigen::VectorXd>& mass) {
+  if (mass.size() != num_nodes())
+    throw ParameterError("fem::Model::set_masses: " + std::to_string(mass.size()) +
+                         " masses, expected #V = " + std::to_string(num_nodes()));
+  for (int i = 0; i < num_nodes(); ++i)
+    if (!((mass[i] > 0 || (mass[i] == 0 && m_mass[i] == 0)) && std::isfinite(mass[i])))
+      throw ParameterError("fem::Model::set_masses: mass of node " + std::to_string(i) + " = " +
+                           std::to_string(mass[i]) +
+                           " is invalid: expected finite and > 0 kg (0 only for a node in no tet)");
+  m_mass = mass;
+  m_inv_mass = m_mass.cwiseInverse();
+  update_dofs();
+  update_load();
 }
 
 void Model::set_strain_rate_damping(const StrainRateDamping& damping) {

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <icd/fem/forces.hpp>
+#include <icd/fem/mass_scaling.hpp>
 #include <icd/fem/strain_rate_damping.hpp>
 
 namespace icd::fem {
@@ -25,6 +26,10 @@ struct ModelOptions {
   StrainRateDamping strain_rate_damping;
   Eigen::Vector3d gravity{0.0, 0.0, 0.0};  ///< m/s^2
   ForceOptions forces;
+  /// Selective mass scaling at construction (off by default; the scenes turn
+  /// it on, experiments/runner/scene.hpp). The added mass is mass: it feels
+  /// gravity and Rayleigh alpha damping like the rest (fem/README.md).
+  MassScaling mass_scaling;
 };
 
 /// One object. Positions and velocities (#V x 3) are passed in; the model
@@ -40,8 +45,15 @@ class Model {
   const TetMeshData& mesh() const { return m_forces.mesh(); }
   const Material& material() const { return m_forces.material(); }
   ElasticForces& elastic() { return m_forces; }
-  /// Lumped nodal masses (#V), kg.
+  /// Lumped nodal masses (#V), kg, after any mass scaling: what the
+  /// integrators, the stable-step estimate, energies and loads use.
   const Eigen::VectorXd& mass() const { return m_mass; }
+  /// Replaces the nodal masses (#V, finite, > 0 kg, 0 only for a node in no
+  /// tet; ParameterError naming the node otherwise), e.g. by
+  /// apply_mass_scaling(); gravity loads follow.
+  void set_masses(const Eigen::Ref<const Eigen::VectorXd>& mass);
+  /// What ModelOptions::mass_scaling did (target_ratio 0: off).
+  const MassScalingReport& mass_scaling() const { return m_mass_scaling; }
 
   /// Fixes the given nodes (their velocity and acceleration stay zero).
   /// Throws ParameterError naming an out-of-range node.
@@ -120,6 +132,7 @@ class Model {
   Eigen::Vector3d m_gravity;
   RayleighDamping m_damping;
   StrainRateDamping m_strain_rate_damping;
+  MassScalingReport m_mass_scaling;
   MatX3d m_scratch;
 };
 

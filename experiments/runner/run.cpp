@@ -350,6 +350,14 @@ RealTimeSummary summarize_real_time(const std::vector<FrameMetrics>& frames) {
   return s;
 }
 
+std::vector<std::string> describe_mass_scaling(const World& world) {
+  std::vector<std::string> lines;
+  for (const coupling::RuntimeObject& o : world.objects())
+    if (o.sim && o.sim->model().mass_scaling().target_ratio > 0)
+      lines.push_back("object \"" + o.setup.name + "\": " + o.sim->model().mass_scaling().to_string());
+  return lines;
+}
+
 std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt) {
   if (opt.out_dir.empty()) throw ParameterError("run_scene: an output folder is required");
   Scene scene = scene_in;
@@ -377,6 +385,8 @@ std::vector<FrameMetrics> run_scene(const Scene& scene_in, const RunOptions& opt
   std::filesystem::remove_all(vtu_tmp);
 
   World world = make_world(scene, opt.cache_dir, opt.tool_dir, opt.preprocess_limits);
+  if (opt.log)
+    for (const std::string& line : describe_mass_scaling(world)) std::fprintf(opt.log, "%s\n", line.c_str());
   const std::vector<std::string> file_names = object_file_names(world);
   const bool tty = opt.progress && isatty(fileno(stderr));
   std::vector<FrameMetrics> frames;

@@ -43,6 +43,10 @@ void check_scene_inputs(const Scene& scene);
 World make_world(const Scene& scene, const std::filesystem::path& cache_dir,
                  const std::filesystem::path& tool_dir, const ChildLimits& limits = {});
 
+/// One line per deformable object of `world` with mass scaling on: what
+/// fem::MassScalingReport::to_string says, prefixed with the object's name.
+std::vector<std::string> describe_mass_scaling(const World& world);
+
 /// Warnings, one sentence each naming the object, when the placed objects'
 /// sizes suggest a unit mismatch (an asset left in millimetres beside objects
 /// in metres): an object more than 100 times larger or smaller than another

@@ -480,6 +480,11 @@ ObjectSpec parse_object(const Json& j, const std::string& path, const std::strin
     }
     m.finish();
   }
+  if (const Json* fem_fields = f.get("fem")) {
+    Fields m(*fem_fields, f.path("fem"), source);
+    o.mass_scaling_target = m.number("mass_scaling_target", o.mass_scaling_target, 0, 1);
+    m.finish();
+  }
   const std::string integ =
       f.string("integrator", "rk4", {"rk4", "symplectic_euler", "backward_euler"});
   o.integrator = integ == "rk4"                ? fem::Integrator::RK4

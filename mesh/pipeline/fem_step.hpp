@@ -27,6 +27,9 @@ struct StableStepOptions {
   /// ideal within 1 % of larger blocks (StableStepReport measured; the top
   /// mode of a free BCC block lies inside it, not at its boundary).
   int ideal_cells = 5;
+  /// Also report the step with selective mass scaling to this ratio
+  /// (fem::MassScaling; the scenes' default), 0: not.
+  double mass_scaling_target = fem::kSceneMassScalingTarget;
 };
 
 /// Result of stable_step_report(). Steps in seconds, the mesh's units taken
@@ -38,13 +41,18 @@ struct StableStepReport {
   double omega_max = 0, ideal_omega_max = 0;  ///< omega_bound of each estimate, rad/s
   double mean_volume = 0;                     ///< mean tet volume of the mesh
   bool converged = false;                     ///< both Lanczos estimates converged
+  /// With StableStepOptions::mass_scaling_target > 0: what the scaling adds
+  /// (fem::apply_mass_scaling) and the step and ratio of the scaled model
+  /// (the ratio against this report's ideal; 0 when not computed).
+  fem::MassScalingReport scaling;
+  double scaled_step = 0, scaled_ratio = 0;
   std::string error;  ///< non-empty when the FEM model refused the mesh (then all figures 0)
 
   /// One line for the tool's summary.
   std::string to_string(const StableStepOptions& options) const;
 };
 
-/// A cube of n x n x n cells of edge h cut into the body-centred cubic (BCC)
+/// fem::bcc_block with its boundary faces: a cube of n x n x n cells of edge h cut into the body-centred cubic (BCC)
 /// lattice's tets: for every pair of neighbouring cell centres, four tets
 /// (the two centres and an edge of the face between them); faces on the
 /// block's boundary get no tets, so the block is a solid of 12 n^3 - 12 n^2

@@ -192,124 +192,208 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     }
     return true;
   };
-  std::set<int> stuck;
-  long attempts = 0;  // nodes tried: bounded whatever the mesh
-  while (rep.collapses < o.max_collapses && attempts++ < 4L * n) {
-    // Surface nodes and edges, node -> tets.
-    std::vector<std::vector<int>> around(static_cast<size_t>(n));
+  // The mesh around the current T: node -> tets, surface nodes and edges.
+  struct Local {
+    std::vector<std::vector<int>> around;
+    std::vector<char> surface;
+    std::set<std::pair<int, int>> bedges;
+  };
+  const auto local = [&] {
+    Local L;
+    L.around.resize(static_cast<size_t>(n));
     for (size_t e = 0; e < T.size(); ++e)
-      for (int v : T[e]) around[static_cast<size_t>(v)].push_back(static_cast<int>(e));
+      for (int v : T[e]) L.around[static_cast<size_t>(v)].push_back(static_cast<int>(e));
     MatX4i Tm(static_cast<Eigen::Index>(T.size()), 4);
     for (size_t e = 0; e < T.size(); ++e)
       for (int k = 0; k < 4; ++k) Tm(static_cast<Eigen::Index>(e), k) = T[e][k];
     const MatX3i F = boundary_faces(Tm);
-    std::vector<char> surface(static_cast<size_t>(n), 0);
-    std::set<std::pair<int, int>> bedges;
+    L.surface.assign(static_cast<size_t>(n), 0);
     for (Eigen::Index f = 0; f < F.rows(); ++f)
       for (int k = 0; k < 3; ++k) {
-        surface[static_cast<size_t>(F(f, k))] = 1;
-        bedges.insert(std::minmax(F(f, k), F(f, (k + 1) % 3)));
+        L.surface[static_cast<size_t>(F(f, k))] = 1;
+        L.bedges.insert(std::minmax(F(f, k), F(f, (k + 1) % 3)));
       }
+    return L;
+  };
+  const auto neighbours = [&](const Local& L, int i) {
+    std::set<int> nbrs;
+    for (int e : L.around[static_cast<size_t>(i)])
+      for (int v : T[static_cast<size_t>(e)])
+        if (v != i) nbrs.insert(v);
+    return nbrs;
+  };
+  // A move of node i: collapse into a neighbour j, or, for a surface node,
+  // peel (j = -1): remove every tet of i, the surface receding to the faces
+  // opposite i (i's thin tets hold little volume). Valid when every tet it
+  // changes stays positive with smallest dihedral angle >= floor_deg, the
+  // volume, topology and surface bounds hold; `worst` is the largest node
+  // frequency it leaves around i, `dihedral` the smallest angle of the tets
+  // it changes (180 when it only removes tets).
+  struct Move {
+    std::vector<Tet> T;
+    double volume = 0, worst = 0, dihedral = 180;
+  };
+  const auto evaluate = [&](const Local& L, const std::set<int>& nbrs, int i, int j,
+                            double floor_deg, Move& out) {
+    const bool surf = L.surface[static_cast<size_t>(i)] != 0;
+    if (j >= 0 && surf && !L.bedges.count(std::minmax(i, j))) return false;
+    if (j >= 0 && surf && (mesh.V.row(i) - mesh.V.row(j)).norm() > o.max_shift * diagonal)
+      return false;
+    if (j < 0) {  // the height of i over each opposite face: how far the surface moves
+      for (int e : L.around[static_cast<size_t>(i)]) {
+        const Tet& t = T[static_cast<size_t>(e)];
+        int k = 0;
+        while (t[k] != i) ++k;
+        const Eigen::Vector3d a = mesh.V.row(t[(k + 1) % 4]), b = mesh.V.row(t[(k + 2) % 4]),
+                              c = mesh.V.row(t[(k + 3) % 4]), p = mesh.V.row(i);
+        const Eigen::Vector3d nrm = (b - a).cross(c - a);
+        if (std::abs(nrm.normalized().dot(p - a)) > o.max_shift * diagonal) return false;
+      }
+    }
+    Move m;
+    m.T.reserve(T.size());
+    double vol = volume;
+    std::vector<int> changed;
+    for (size_t e = 0; e < T.size(); ++e) {
+      Tet t = T[e];
+      const bool has_i = std::find(t.begin(), t.end(), i) != t.end();
+      if (!has_i) {
+        m.T.push_back(t);
+        continue;
+      }
+      vol -= tet_volume(mesh.V, t);
+      if (j < 0 || std::find(t.begin(), t.end(), j) != t.end()) continue;  // removed
+      std::replace(t.begin(), t.end(), i, j);
+      const double v = tet_volume(mesh.V, t);
+      if (!(v > 0)) return false;
+      const double d = min_dihedral(mesh.V, t);
+      if (d < floor_deg) return false;
+      m.dihedral = std::min(m.dihedral, d);
+      vol += v;
+      changed.push_back(static_cast<int>(m.T.size()));
+      m.T.push_back(t);
+    }
+    if (std::abs(vol / volume0 - 1) > o.max_volume_change) return false;
+    const Topology topo = topology(m.T, n);
+    if (!topo.ok || topo.euler != topo0.euler || topo.components != topo0.components) return false;
+    {  // an interior collapse may expose nothing; the check is cheap
+      std::vector<Eigen::Vector3d> pts = moved;
+      if (surf) pts.emplace_back(mesh.V.row(i).transpose());
+      if (!within(m.T, pts, nbrs)) return false;
+    }
+    const Eigen::VectorXd wc = node_frequencies(mesh.V, m.T, o.poisson);
+    double worst = j >= 0 ? wc[j] : 0.0;
+    for (int e : changed)
+      for (int v : m.T[static_cast<size_t>(e)]) worst = std::max(worst, wc[v]);
+    for (int v : nbrs) worst = std::max(worst, wc[v]);
+    if (j < 0)  // the nodes left without a tet
+      for (int v : nbrs)
+        if (wc[v] == 0 && std::none_of(m.T.begin(), m.T.end(), [&](const Tet& t) {
+              return std::find(t.begin(), t.end(), v) != t.end();
+            }))
+          worst = INFINITY;
+    m.volume = vol;
+    m.worst = worst;
+    out = std::move(m);
+    return true;
+  };
+  const auto apply = [&](const Local& L, int i, Move& m) {
+    if (L.surface[static_cast<size_t>(i)]) moved.emplace_back(mesh.V.row(i).transpose());
+    T = std::move(m.T);
+    volume = m.volume;
+    w = node_frequencies(mesh.V, T, o.poisson);
+  };
+  std::set<int> stuck;
+  long attempts = 0;  // nodes tried: bounded whatever the mesh
+  while (rep.collapses < o.max_collapses && attempts++ < 4L * n) {
+    const Local L = local();
     // The worst node not known to be stuck.
     int i = -1;
     for (int v = 0; v < n; ++v)
       if (w[v] > threshold && !stuck.count(v) && (i < 0 || w[v] > w[i])) i = v;
     if (i < 0) break;
-    std::set<int> nbrs;
-    for (int e : around[static_cast<size_t>(i)])
-      for (int v : T[static_cast<size_t>(e)])
-        if (v != i) nbrs.insert(v);
-    double best = w[i];
-    std::vector<Tet> best_T;
-    double best_volume = 0;
-    // Candidates: collapse i into a neighbour j; for a surface node, also
-    // peel (j = -1): remove every tet of i, the surface receding to the
-    // faces opposite i (i's thin tets hold little volume).
+    const std::set<int> nbrs = neighbours(L, i);
+    Move best;
+    best.worst = w[i];
+    bool found = false;
     std::vector<int> options(nbrs.begin(), nbrs.end());
-    if (surface[static_cast<size_t>(i)]) options.push_back(-1);
+    if (L.surface[static_cast<size_t>(i)]) options.push_back(-1);
     for (int j : options) {
-      if (j >= 0 && surface[static_cast<size_t>(i)] && !bedges.count(std::minmax(i, j))) continue;
-      if (j >= 0 && surface[static_cast<size_t>(i)] &&
-          (mesh.V.row(i) - mesh.V.row(j)).norm() > o.max_shift * diagonal)
-        continue;
-      if (j < 0) {  // the height of i over each opposite face: how far the surface moves
-        bool near = true;
-        for (int e : around[static_cast<size_t>(i)]) {
-          const Tet& t = T[static_cast<size_t>(e)];
-          int k = 0;
-          while (t[k] != i) ++k;
-          const Eigen::Vector3d a = mesh.V.row(t[(k + 1) % 4]), b = mesh.V.row(t[(k + 2) % 4]),
-                                c = mesh.V.row(t[(k + 3) % 4]), p = mesh.V.row(i);
-          const Eigen::Vector3d nrm = (b - a).cross(c - a);
-          if (std::abs(nrm.normalized().dot(p - a)) > o.max_shift * diagonal) near = false;
-        }
-        if (!near) continue;
-      }
-      std::vector<Tet> cand;
-      cand.reserve(T.size());
-      double vol = volume;
-      bool valid = true;
-      std::vector<int> changed;
-      for (size_t e = 0; e < T.size() && valid; ++e) {
-        Tet t = T[e];
-        const bool has_i = std::find(t.begin(), t.end(), i) != t.end();
-        if (!has_i) {
-          cand.push_back(t);
-          continue;
-        }
-        vol -= tet_volume(mesh.V, t);
-        if (j < 0 || std::find(t.begin(), t.end(), j) != t.end()) continue;  // removed
-        std::replace(t.begin(), t.end(), i, j);
-        const double v = tet_volume(mesh.V, t);
-        if (!(v > 0) || min_dihedral(mesh.V, t) < dmin) valid = false;
-        vol += v;
-        changed.push_back(static_cast<int>(cand.size()));
-        cand.push_back(t);
-      }
-      if (!valid || std::abs(vol / volume0 - 1) > o.max_volume_change) continue;
-      const Topology topo = topology(cand, n);
-      if (!topo.ok || topo.euler != topo0.euler || topo.components != topo0.components) continue;
-      {  // an interior collapse may expose nothing; the check is cheap
-        std::vector<Eigen::Vector3d> pts = moved;
-        if (surface[static_cast<size_t>(i)]) pts.emplace_back(mesh.V.row(i).transpose());
-        if (!within(cand, pts, nbrs)) continue;
-      }
-      const Eigen::VectorXd wc = node_frequencies(mesh.V, cand, o.poisson);
-      double worst = j >= 0 ? wc[j] : 0.0;
-      for (int e : changed)
-        for (int v : cand[static_cast<size_t>(e)]) worst = std::max(worst, wc[v]);
-      for (int v : nbrs) worst = std::max(worst, wc[v]);
-      if (j < 0)  // the nodes left without a tet
-        for (int v : nbrs)
-          if (wc[v] == 0 && std::none_of(cand.begin(), cand.end(), [&](const Tet& t) {
-                return std::find(t.begin(), t.end(), v) != t.end();
-              }))
-            worst = INFINITY;
-      if (worst < best) {
-        best = worst;
-        best_T = std::move(cand);
-        best_volume = vol;
+      Move m;
+      if (evaluate(L, nbrs, i, j, dmin, m) && m.worst < best.worst) {
+        best = std::move(m);
+        found = true;
       }
     }
-    if (best_T.empty()) {
+    if (!found) {
       stuck.insert(i);
       continue;
     }
-    if (surface[static_cast<size_t>(i)]) moved.emplace_back(mesh.V.row(i).transpose());
-    T = std::move(best_T);
-    volume = best_volume;
+    apply(L, i, best);
     ++rep.collapses;
-    w = node_frequencies(mesh.V, T, o.poisson);
     // A collapse changes the tets of i's neighbours only: they may have new
     // moves; a node stuck elsewhere stays stuck (retrying every stuck node
     // after each collapse made the pass quadratic: 35 s on a meshed cube).
     for (int v : nbrs) stuck.erase(v);
   }
+  // Second phase: the tets below the dihedral target (the smallest first),
+  // by the same moves of one of their nodes, under the same bounds, where the
+  // move leaves every tet it changes with a larger smallest angle than the
+  // tet removed and the largest node frequency no higher than the target's
+  // or today's (the step does not get worse).
+  rep.min_dihedral_before = 180;
+  for (const Tet& t : T) rep.min_dihedral_before = std::min(rep.min_dihedral_before, min_dihedral(mesh.V, t));
+  std::set<Tet> stuck_tets;
+  while (o.dihedral_target_deg > 0 && rep.collapses + rep.dihedral_collapses < o.max_collapses &&
+         attempts++ < 8L * n) {
+    int bad = -1;
+    double angle = o.dihedral_target_deg;
+    for (size_t e = 0; e < T.size(); ++e) {
+      const double d = min_dihedral(mesh.V, T[e]);
+      if (d < angle) {
+        Tet key = T[e];
+        std::sort(key.begin(), key.end());
+        if (stuck_tets.count(key)) continue;
+        angle = d;
+        bad = static_cast<int>(e);
+      }
+    }
+    if (bad < 0) break;
+    const Local L = local();
+    const double cap = std::max(threshold, w.maxCoeff());
+    Move best;
+    int best_i = -1;
+    std::set<int> best_nbrs;
+    for (int i : T[static_cast<size_t>(bad)]) {
+      const std::set<int> nbrs = neighbours(L, i);
+      std::vector<int> options(nbrs.begin(), nbrs.end());
+      if (L.surface[static_cast<size_t>(i)]) options.push_back(-1);
+      for (int j : options) {
+        Move m;
+        if (evaluate(L, nbrs, i, j, std::nextafter(angle, 180.0), m) && m.worst <= cap &&
+            (best_i < 0 || m.dihedral > best.dihedral)) {
+          best = std::move(m);
+          best_i = i;
+          best_nbrs = nbrs;
+        }
+      }
+    }
+    if (best_i < 0) {
+      Tet key = T[static_cast<size_t>(bad)];
+      std::sort(key.begin(), key.end());
+      stuck_tets.insert(key);
+      continue;
+    }
+    apply(L, best_i, best);
+    ++rep.dihedral_collapses;
+  }
+  rep.min_dihedral_after = 180;
+  for (const Tet& t : T) rep.min_dihedral_after = std::min(rep.min_dihedral_after, min_dihedral(mesh.V, t));
   for (int v = 0; v < n; ++v)
     if (w[v] > threshold) ++rep.stuck;
   rep.ratio_after = ideal / w.maxCoeff();
   rep.volume_change = volume / volume0 - 1;
-  if (rep.collapses == 0) return rep;
+  if (rep.collapses + rep.dihedral_collapses == 0) return rep;
   // Compact: drop unused nodes, keep the order of the others.
   std::vector<int> id(static_cast<size_t>(n), -1);
   for (const Tet& t : T)

@@ -33,6 +33,11 @@ TEST(Scene, ParsesDefaultsAndFields) {
   EXPECT_DOUBLE_EQ(o.material.poisson, 0.45);
   EXPECT_DOUBLE_EQ(o.damping.beta, 0.001);
   EXPECT_EQ(o.integrator, fem::Integrator::SymplecticEuler);
+  EXPECT_EQ(o.mass_scaling_target, coupling::ObjectSetup{}.mass_scaling_target);
+  EXPECT_EQ(parse(with_objects(R"({"primitive": {}, "fem": {"mass_scaling_target": 0}})"))
+                .objects[0]
+                .mass_scaling_target,
+            0.0);
   EXPECT_EQ(s.world.collision.query.budget_tests, 100);
   EXPECT_EQ(s.world.collision.query.mode, collision::TraversalMode::Priority);
   EXPECT_TRUE(std::isinf(s.world.collision.query.budget_seconds));  // a test budget alone
@@ -54,6 +59,7 @@ TEST(Scene, FieldsLeftOutKeepTheLibraryDefaults) {
   EXPECT_EQ(s.objects[0].material.young, m.young);
   EXPECT_EQ(s.objects[0].material.density, m.density);
   EXPECT_EQ(s.objects[0].material.model, m.model);
+  EXPECT_EQ(s.objects[0].mass_scaling_target, coupling::ObjectSetup{}.mass_scaling_target);
   const coupling::CollisionSpec c;
   const collision::CollisionRequest& q = s.world.collision.query;
   EXPECT_EQ(q.budget_seconds, c.query.budget_seconds);
@@ -102,6 +108,10 @@ TEST(Scene, EachBadFieldGetsAClearError) {
        "objects[0].initial_compression", "must be in [0, 0.95]"},
       {with_objects(R"({"primitive": {}, "kind": "rigid", "initial_compression": 0.5})"),
        "objects[0].initial_compression", "deformable"},
+      {with_objects(R"({"primitive": {}, "fem": {"mass_scaling_target": 1.5}})"),
+       "objects[0].fem.mass_scaling_target", "must be in [0, 1]"},
+      {with_objects(R"({"primitive": {}, "fem": {"mass_scaling": 0.5}})"),
+       "objects[0].fem.mass_scaling", "unknown field"},
       {with_objects(R"({"primitive": {}, "velocity": [1, 0]})"), "objects[0].velocity",
        "array of 3"},
       {with_objects(R"({"primitive": {}, "fixed_nodes": [1, -2]})"), "objects[0].fixed_nodes[1]",

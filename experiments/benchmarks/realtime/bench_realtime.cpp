@@ -86,6 +86,8 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
   scene.world.target_fps = 0;
   scene.world.threads = 1;
   World one = icd::runner::make_world(scene, cache, tools);
+  for (const std::string& line : icd::runner::describe_mass_scaling(one))
+    std::printf("%s\n", line.c_str());
   scene.world.threads = 2;
   World two = icd::runner::make_world(scene, cache, tools);
   Series s1, s2;

@@ -13,6 +13,7 @@
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/pipeline/fem_step.hpp>
+#include <icd/mesh/pipeline/tet_quality.hpp>
 
 namespace icd::mesh {
 namespace {
@@ -71,6 +72,65 @@ TEST(TetCleanup, ThinCapIsRemovedAndTheStepRecovers) {
   EXPECT_GT(signed_tet_volumes(m.V, m.T).minCoeff(), 0.0);
   EXPECT_NEAR(signed_tet_volumes(m.V, m.T).sum(), volume_before, 0.01 * volume_before);
   EXPECT_NEAR(r.volume_change, signed_tet_volumes(m.V, m.T).sum() / volume_before - 1, 1e-12);
+}
+
+TEST(TetCleanup, SliverBelowTheDihedralTargetIsRemoved) {
+  // An interior lattice node moved 92 % of the way to the plane of the
+  // opposite face of one of its tets: a flat sliver (below 10 deg) that does
+  // not limit the step much (ratio ~0.7, above the step target). The
+  // dihedral phase removes it, keeping the step above the step target.
+  TetMesh m = bcc_block(4, 1.0);
+  Eigen::Index c = -1;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    if ((m.V.row(i) - Eigen::RowVector3d(1.5, 1.5, 1.5)).norm() < 1e-12) c = i;
+  ASSERT_GE(c, 0);
+  const Eigen::RowVector3d rest = m.V.row(c);
+  bool made = false;
+  for (Eigen::Index t = 0; t < m.T.rows() && !made; ++t) {
+    int k = -1;
+    for (int a = 0; a < 4; ++a)
+      if (m.T(t, a) == c) k = a;
+    if (k < 0) continue;
+    const Eigen::Vector3d p0 = m.V.row(m.T(t, (k + 1) % 4)), p1 = m.V.row(m.T(t, (k + 2) % 4)),
+                          p2 = m.V.row(m.T(t, (k + 3) % 4));
+    const Eigen::Vector3d nrm = (p1 - p0).cross(p2 - p0).normalized();
+    const Eigen::Vector3d x = rest.transpose();
+    m.V.row(c) = (x - 0.92 * nrm.dot(x - p0) * nrm).transpose();
+    const TetQuality q = tet_quality(m);
+    made = q.min_volume > 0 && q.min_dihedral_deg < 10.0;
+    if (!made) m.V.row(c) = rest;
+  }
+  ASSERT_TRUE(made);
+  const TetQuality q0 = tet_quality(m);
+  const double volume0 = signed_tet_volumes(m.V, m.T).sum();
+  StableStepOptions so;
+  so.mass_scaling_target = 0;
+  const StableStepReport fem0 = stable_step_report(m, so);
+  ASSERT_GT(fem0.ratio, 0.6);  // the step phase has nothing to do
+
+  TetMesh off = m;
+  StepCleanupOptions o;
+  o.dihedral_target_deg = 0;
+  const StepCleanupReport r_off = raise_stable_step(off, o);
+  EXPECT_EQ(r_off.collapses + r_off.dihedral_collapses, 0);
+  EXPECT_EQ(off.T, m.T);
+
+  const StepCleanupReport r = raise_stable_step(m);
+  EXPECT_EQ(r.collapses, 0);
+  EXPECT_GE(r.dihedral_collapses, 1);
+  const TetQuality q1 = tet_quality(m);
+  EXPECT_NEAR(r.min_dihedral_before, q0.min_dihedral_deg, 1e-9);
+  EXPECT_NEAR(r.min_dihedral_after, q1.min_dihedral_deg, 1e-9);
+  EXPECT_GE(q1.min_dihedral_deg, 12.0);
+  EXPECT_TRUE(closed_manifold(m));
+  EXPECT_GT(signed_tet_volumes(m.V, m.T).minCoeff(), 0.0);
+  EXPECT_NEAR(signed_tet_volumes(m.V, m.T).sum(), volume0, 1e-9 * volume0);  // interior only
+  // The node estimate of the ratio stays at or above the target (0.6); the
+  // FEM ratio is below the node estimate (a lower bound of omega_max) but close.
+  EXPECT_GE(r.ratio_after, 0.6);
+  const StableStepReport fem1 = stable_step_report(m, so);
+  EXPECT_GT(fem1.ratio, 0.9 * 0.6);
+  EXPECT_LE(fem1.ratio, r.ratio_after * 1.0001);
 }
 
 TEST(TetCleanup, BadOptionsAreRefused) {
