@@ -4,6 +4,7 @@
 // (the message says what and where), 2 on bad command-line options.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -92,8 +93,22 @@ std::variant<Command, int> parse(int argc, char** argv) {
             "... and diameter at most F * bbox diagonal")
       .real("--max-surface-change", o.repair.max_surface_change, "F",
             "largest area/volume change of a local self-intersection repair, relative")
+      .custom("--wrap", "WHEN",
+              "rebuild the surface by alpha wrapping: fallback (when repair would refuse it: "
+              "a non-manifold edge, unresolved self-intersections), always, never",
+              [&](const std::string& v) {
+                try {
+                  o.repair.wrap = icd::mesh::parse_wrap(v, "--wrap");
+                } catch (const icd::ParameterError& e) {
+                  throw std::invalid_argument(e.what());
+                }
+              })
+      .real("--wrap-alpha", o.repair.wrap_alpha, "F",
+            "alpha of the wrap, F * bbox diagonal (smaller: closer to the input, more faces)")
       .real("--radius-edge", o.tetrahedralize.radius_edge_bound, "B",
             "tet radius-edge ratio bound, >= 2")
+      .real("--interior-size", o.tetrahedralize.interior_size_factor, "F",
+            "cell size inside = F x the surface's, in (0, 1] (smaller: more interior nodes)")
       .real("--facet-distance", o.tetrahedralize.facet_distance_factor, "F",
             "surface approximation bound, F * cell size")
       .real("--feature-angle", o.tetrahedralize.feature_angle_deg, "DEG",
@@ -192,6 +207,29 @@ void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, doubl
                 "nodes the --step-target post-pass could not remove; see "
                 "experiments/studies/preprocess/README.md, stable step)\n",
                 fem_warnings.c_str());
+  {
+    // Fidelity of the coarse mesh (issue 30 item 6; targets as in
+    // experiments/studies/preprocess/README.md).
+    const auto& q = r.quality;
+    const double dv = r.repair.volume > 0 ? q.total_volume / r.repair.volume - 1.0 : 0.0;
+    const int interior = q.num_vertices - q.num_surface_nodes;
+    const double share = q.num_vertices > 0 ? static_cast<double>(interior) / q.num_vertices : 0;
+    const int target = c.options.tetrahedralize.cell_size > 0 ? 0 : c.options.tetrahedralize.target_tets;
+    const double dt = target > 0 ? static_cast<double>(q.num_tets) / target - 1.0 : 0.0;
+    const double h = r.hausdorff_dense_coarse >= 0 ? r.hausdorff_dense_coarse / r.bbox_diagonal : -1;
+    std::printf("-- fidelity: volume %+.2f %% of the repaired surface's, ", 100.0 * dv);
+    if (h >= 0) std::printf("Hausdorff %.2f %% of the diagonal, ", 100.0 * h);
+    if (target > 0) std::printf("%d tets for %d requested (%+.0f %%), ", q.num_tets, target, 100.0 * dt);
+    std::printf("%d interior nodes (%.1f %% of %d)\n", interior, 100.0 * share, q.num_vertices);
+    std::string miss;
+    const auto add = [&miss](const std::string& m) { miss += (miss.empty() ? "" : "; ") + m; };
+    if (std::abs(dv) > 0.05) add("volume changed by more than 5 %");
+    if (h > 0.03) add("Hausdorff distance above 3 % of the diagonal (--coarse-tets more)");
+    if (target > 0 && std::abs(dt) > 0.25) add("tet count more than 25 % off the request");
+    if (share < 0.10)
+      add("under 10 % of the nodes inside: thick parts have few nodes to deform (--interior-size 0.7)");
+    if (!miss.empty()) std::printf("-- WARNING: fidelity target missed: %s\n", miss.c_str());
+  }
   std::printf("-- rigid links: %d dense vertices on %d coarse surface nodes\n", b.links.num_links(),
               static_cast<int>(b.surface_nodes.size()));
   if (c.options.sphere_builder != icd::mesh::SphereBuilder::none) {

@@ -57,4 +57,10 @@ double approximate_hausdorff_distance(const SurfaceMesh& a, const SurfaceMesh& b
   return std::max(one_sided(a, b), one_sided(b, a));
 }
 
+double approximate_one_sided_distance(const SurfaceMesh& from, const SurfaceMesh& to) {
+  if (from.F.rows() == 0 || to.F.rows() == 0)
+    throw InputError("approximate_one_sided_distance: empty surface");
+  return one_sided(from, to);
+}
+
 }  // namespace icd::mesh

@@ -13,4 +13,8 @@ namespace icd::mesh {
 /// Throws InputError for an empty mesh.
 double approximate_hausdorff_distance(const SurfaceMesh& a, const SurfaceMesh& b);
 
+/// The one-sided part: the largest distance from the samples of `from` (as
+/// above) to the surface `to`. Throws InputError for an empty mesh.
+double approximate_one_sided_distance(const SurfaceMesh& from, const SurfaceMesh& to);
+
 }  // namespace icd::mesh

@@ -7,6 +7,7 @@
 
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/pipeline/canonical.hpp>
 #include <icd/mesh/pipeline/hausdorff.hpp>
 
 namespace icd::mesh {
@@ -186,11 +187,15 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
            " faces, " + std::to_string(r.repair.holes_filled) + " hole(s) filled");
   }
   r.bbox_diagonal = (b.dense.V.colwise().maxCoeff() - b.dense.V.colwise().minCoeff()).norm();
+  // The stages below see the repaired surface in an order fixed by its
+  // geometry (canonical.hpp): permuted input gives the same coarse mesh and
+  // sphere tree. The bundle keeps the repaired surface in the input's order.
+  const SurfaceMesh canonical = canonical_order(b.dense);
   SurfaceMesh simplified;
   {
     Stage t(r, progress, "simplify");
     ByteReader in(t.run(limits, [&] {
-      SimplifyResult sr = simplify_surface(b.dense, o.simplify);
+      SimplifyResult sr = simplify_surface(canonical, o.simplify);
       ByteWriter w;
       write_surface(w, sr.mesh);
       w.pod(sr.report);
@@ -256,11 +261,11 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
           collision::SphereTree tree;
           bool hit = false;
           if (o.sphere_builder == SphereBuilder::medial_axis) {
-            SphereTreeBuild st = build_sphere_tree(b.dense, o.spheres);
+            SphereTreeBuild st = build_sphere_tree(canonical, o.spheres);
             tree = std::move(st.tree);
             hit = st.hit_time_limit;
           } else {
-            tree = collision::build_octree_tree(b.dense.V, b.dense.F, o.octree);
+            tree = collision::build_octree_tree(canonical.V, canonical.F, o.octree);
           }
           const std::vector<int> cand(b.surface_nodes.data(),
                                       b.surface_nodes.data() + b.surface_nodes.size());

@@ -34,7 +34,29 @@ struct RepairOptions {
   /// Largest relative change of area or volume the local repair may make
   /// (changes above 0.5 % are reported).
   double max_surface_change = 0.05;
+  /// What to do when the surface cannot be made clean by the steps above (a
+  /// non-manifold edge, self-intersections that neither autorefinement nor
+  /// the local repair resolve): rebuild it by CGAL's 3D alpha wrapping (a
+  /// closed, manifold, intersection-free surface enclosing the input at
+  /// distance `wrap_offset`, bridging gaps narrower than `wrap_alpha`).
+  enum class Wrap {
+    never,     ///< refuse, naming the cause and the option --wrap
+    fallback,  ///< wrap only what would otherwise be refused (the default)
+    always,    ///< wrap every input (after welding), skipping steps 5-9
+  };
+  Wrap wrap = Wrap::fallback;
+  double wrap_alpha = 0.01;   ///< alpha, a fraction of the bounding-box diagonal (> 0)
+  double wrap_offset = 0.0;   ///< offset, fraction of the diagonal; 0: wrap_alpha / 30
+  /// A wrap with a point farther than this fraction of the diagonal from the
+  /// input (approximate one-sided distance, wrap to input: surfaces of the
+  /// input inside the wrap, e.g. overlapping parts, do not count) is refused, naming
+  /// --wrap-alpha (a smaller alpha follows the input more closely).
+  double max_wrap_distance = 0.03;
 };
+
+/// "never", "fallback" or "always"; anything else throws ParameterError naming `field`.
+RepairOptions::Wrap parse_wrap(const std::string& name, const std::string& field = "wrap");
+const char* to_string(RepairOptions::Wrap wrap);
 
 /// What repair_surface() did, in counts.
 struct RepairReport {
@@ -54,6 +76,11 @@ struct RepairReport {
   int self_intersections_repaired = 0;  ///< intersecting face pairs removed by local repair
   double area_change = 0.0;             ///< relative area change of the local repair
   double volume_change = 0.0;           ///< relative volume change of the local repair
+  /// Why the surface was rebuilt by alpha wrapping: 0 not wrapped, 1 a
+  /// non-manifold edge, 2 unresolved self-intersections, 3 asked (--wrap always).
+  int wrap_cause = 0;
+  double wrap_alpha = 0.0;     ///< alpha used, fraction of the diagonal
+  double wrap_distance = 0.0;  ///< largest distance wrap -> input / diagonal (approximate)
   int components = 0;                   ///< connected components of the output
   int output_vertices = 0, output_faces = 0;
   double volume = 0.0;  ///< enclosed volume of the output (model units^3)

@@ -79,7 +79,8 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
   const Criteria criteria(p::facet_angle = o.facet_angle_deg,
                           p::facet_size = o.facet_size_factor * size,
                           p::facet_distance = o.facet_distance_factor * size,
-                          p::cell_radius_edge_ratio = o.radius_edge_bound, p::cell_size = size,
+                          p::cell_radius_edge_ratio = o.radius_edge_bound,
+                          p::cell_size = o.interior_size_factor * size,
                           p::edge_size = o.facet_size_factor * size);
   C3t3 c3t3;
   // Sharp features (detected on the domain) are protected by balls first, as
@@ -172,11 +173,12 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       !(o.count_tolerance > 0.0) || !(o.pass_share > 0.0 && o.pass_share <= 1.0) ||
       o.max_retries < 0 || !(o.feature_angle_deg >= 0.0 && o.feature_angle_deg < 180.0) ||
       !(o.limits.cpu_seconds > 0.0) || !(o.limits.memory_mb > 0.0) ||
-      !(o.step_cleanup.target_ratio >= 0.0))
+      !(o.step_cleanup.target_ratio >= 0.0) ||
+      !(o.interior_size_factor > 0.0 && o.interior_size_factor <= 1.0))
     throw ParameterError(
         "tetrahedralize_surface: need target_tets >= 1 or cell_size > 0, facet_angle_deg in (0, "
         "30], radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, "
-        "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits, step_cleanup.target_ratio >= 0");
+        "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits, step_cleanup.target_ratio >= 0, interior_size_factor in (0, 1]");
   CgalMesh sm;
   if (!detail::to_cgal(surface, sm) || !CGAL::is_closed(sm))
     throw InputError("tetrahedralize_surface: the surface is not a closed manifold triangle mesh");

@@ -10,6 +10,10 @@ import re
 import sys
 
 TARGET_TETS = 2000
+# "Enough interior nodes for the object to deform": at least this share of the
+# coarse mesh's nodes lies inside (a mesh whose nodes are nearly all on the
+# surface has no node to carry bending or compression through thick parts).
+MIN_INTERIOR_SHARE = 0.10
 
 
 def num(pattern, text, group=1, default=""):
@@ -29,7 +33,7 @@ def row(out, mesh):
     q = re.search(r"(\d+) vertices \((\d+) on the surface\), (\d+) tets", log)
     if q:
         nv, ns, nt = map(int, q.groups())
-        r.update(tets=nt, interior_nodes=nv - ns,
+        r.update(tets=nt, interior_nodes=nv - ns, interior_share=f"{100.0 * (nv - ns) / nv:.1f}%",
                  tet_count_error=f"{100.0 * (nt / TARGET_TETS - 1):+.0f}%")
     d = re.search(r"dihedral angles \[([^,]+), ([^\]]+)\] deg, max radius-edge ratio ([^,]+), "
                   r"min volume [^,]+, total volume (\S+)", log)
@@ -48,9 +52,13 @@ def row(out, mesh):
     t = re.search(r"; total ([\d.]+) \(([\d.]+)\), peak (\d+) MB", log)
     if t:
         r.update(wall_s=t.group(1), cpu_s=t.group(2), peak_mb=t.group(3))
-    tet_cpu = num(r"tetrahedralize [\d.]+ \(([\d.]+)\)", log)
-    if tet_cpu:
-        r["tet_cpu_s"] = tet_cpu
+    for stage, col in (("repair", "repair_cpu_s"), ("simplify", "simplify_cpu_s"),
+                       ("tetrahedralize", "tet_cpu_s"), ("sphere tree", "sphere_cpu_s"),
+                       ("hausdorff", "hausdorff_cpu_s")):
+        m = re.search(r"[ :]" + stage + r" ([\d.]+) \(([\d.]+)\) \[", log)
+        if m:
+            r[col] = m.group(2)
+            r[col.replace("cpu", "wall")] = m.group(1)
     r["retries"] = len(re.findall(r"-- note: tetrahedralize: pass at", log))
     r["repairs"] = "; ".join(
         s for s in [
@@ -58,7 +66,9 @@ def row(out, mesh):
             "local SI repair" if "repaired self-intersections locally" in log else "",
             "split vertices" if "split non-manifold vertices" in log else "",
             "holes %s" % num(r"filled holes: (\d+)", log) if "filled holes" in log else "",
-            "WIDE HOLE" if "WARNING: filled a hole" in log else ""] if s)
+            "WIDE HOLE" if "WARNING: filled a hole" in log else "",
+            "alpha-wrapped (%s%% diag)" % num(r"lies within ([\d.e+-]+) % of the diagonal of the input", log)
+            if "rebuilt the surface by alpha wrapping" in log else ""] if s)
     warn = []
     if d and float(d.group(1)) < 12.0:
         warn.append("min dihedral < 12")
@@ -70,8 +80,8 @@ def row(out, mesh):
         warn.append("volume > 5%")
     if q and abs(nt / TARGET_TETS - 1) > 0.25:
         warn.append("tets off by > 25%")
-    if q and nv - ns < 10:
-        warn.append("< 10 interior nodes")
+    if q and (nv - ns) < MIN_INTERIOR_SHARE * nv:
+        warn.append(f"interior nodes < {100 * MIN_INTERIOR_SHARE:.0f}%")
     r["target_misses"] = ", ".join(warn)
     return r
 
@@ -80,16 +90,23 @@ def main():
     out, meshes = sys.argv[1], sys.argv[2:]
     rows = [row(out, m) for m in meshes]
     cols = ["mesh", "triangles", "outcome", "tets", "tet_count_error", "interior_nodes",
-            "step_ratio", "min_dihedral", "max_dihedral", "max_radius_edge", "hausdorff_pct_diag",
-            "volume_change", "tet_cpu_s", "cpu_s", "wall_s", "peak_mb", "retries", "repairs",
+            "interior_share", "step_ratio", "min_dihedral", "max_dihedral", "max_radius_edge",
+            "hausdorff_pct_diag", "volume_change", "repair_cpu_s", "simplify_cpu_s", "tet_cpu_s",
+            "sphere_cpu_s", "hausdorff_cpu_s", "cpu_s", "wall_s", "peak_mb", "retries", "repairs",
             "target_misses", "message"]
+    csv_cols = cols + ["repair_wall_s", "simplify_wall_s", "tet_wall_s", "sphere_wall_s",
+                       "hausdorff_wall_s"]
     with open(os.path.join(out, "corpus.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore")
+        w = csv.DictWriter(f, fieldnames=csv_cols, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
     ok = sum(r["outcome"] == "ok" for r in rows)
     with open(os.path.join(out, "corpus_table.md"), "w") as f:
-        f.write(f"{ok} of {len(rows)} meshes succeeded ({100.0 * ok / max(1, len(rows)):.0f} %).\n\n")
+        retried = sum(r["outcome"] == "ok" and r["retries"] > 0 for r in rows)
+        wrapped = sum(r["outcome"] == "ok" and "alpha-wrapped" in r["repairs"] for r in rows)
+        f.write(f"{ok} of {len(rows)} meshes succeeded ({100.0 * ok / max(1, len(rows)):.0f} %) "
+                f"with defaults; {retried} of them after mesher retries at nearby cell sizes, "
+                f"{wrapped} rebuilt by alpha wrapping.\n\n")
         f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
         for r in rows:
             f.write("| " + " | ".join(str(r.get(c, "")).replace("|", "/") for c in cols) + " |\n")

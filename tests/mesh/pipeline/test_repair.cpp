@@ -143,7 +143,50 @@ TEST(Repair, RefusesNonManifoldEdge) {
   m.V << b.V, Eigen::RowVector3d(-1, -1, 3);
   m.F.resize(13, 3);
   m.F << b.F, b.F(0, 0), b.F(0, 1), 8;
-  expect_refused(m, {"non-manifold edge", "shared by 3 faces"});
+  RepairOptions o;
+  o.wrap = RepairOptions::Wrap::never;
+  expect_refused(m, {"non-manifold edge", "shared by 3 faces", "--wrap fallback"}, o);
+}
+
+SurfaceMesh box_with_fin() {
+  SurfaceMesh b = make_box_surface({0, 0, 0}, {1, 1, 1});
+  SurfaceMesh m;
+  m.V.resize(9, 3);
+  m.V << b.V, Eigen::RowVector3d(-0.2, -0.2, 1.2);
+  m.F.resize(13, 3);
+  m.F << b.F, b.F(0, 0), b.F(0, 1), 8;
+  return m;
+}
+
+TEST(Repair, NonManifoldEdgeIsWrappedByDefault) {
+  // The option the refusal above names fixes it (and is the default): the
+  // alpha wrap is a closed, oriented surface enclosing the box and its fin.
+  const SurfaceMesh m = box_with_fin();
+  RepairOptions o;  // the default --wrap fallback, at a coarser alpha (fewer faces: faster)
+  o.wrap_alpha = 0.02;
+  const RepairResult r = repair_surface(m, o, "in.off");
+  EXPECT_EQ(r.report.wrap_cause, 1);
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  EXPECT_EQ(r.report.components, 1);
+  // Oracle: the unit box grown by the offset (alpha / 30 of the diagonal)
+  // plus a thin shell around the fin; within 3 %.
+  EXPECT_NEAR(enclosed_volume(r.mesh.V, r.mesh.F), 1.0, 0.03);
+  EXPECT_NEAR(r.report.volume, enclosed_volume(r.mesh.V, r.mesh.F), 1e-9);
+  // Every wrap vertex lies near the input: within the bounding box of the
+  // box and fin grown by 2 % of the diagonal.
+  const double diag = std::sqrt(3.0);
+  for (int i = 0; i < r.mesh.V.rows(); ++i) {
+    const Eigen::RowVector3d p = r.mesh.V.row(i);
+    EXPECT_TRUE((p.array() >= -0.2 - 0.02 * diag).all() && (p.array() <= 1.2 + 0.02 * diag).all())
+        << p;
+  }
+  EXPECT_LE(r.report.wrap_distance, o.max_wrap_distance);
+  EXPECT_GT(r.report.wrap_distance, 0.0);  // the offset at least
+  EXPECT_NE(r.report.to_string().find("rebuilt the surface by alpha wrapping"), std::string::npos);
+  // A wrap limit below what the wrap achieves refuses it, naming --wrap-alpha.
+  RepairOptions strict = o;
+  strict.max_wrap_distance = 1e-6;
+  expect_refused(m, {"non-manifold edge", "alpha wrapping", "--wrap-alpha"}, strict);
 }
 
 TEST(Repair, SplitsNonManifoldVertex) {
@@ -237,10 +280,44 @@ TEST(Repair, RefusesSelfIntersectionWithCountLocationAndOption) {
   RepairOptions o;
   o.autorefine = false;          // only the local repair, which changes the shape a lot here
   o.max_surface_change = 0.001;  // refused above 0.1 %
+  o.wrap = RepairOptions::Wrap::never;
   expect_refused(two_overlapping_spheres(),
                  {"intersects itself", "intersecting face pair", "e.g. faces near",
-                  "the local repair"},
+                  "the local repair", "--wrap fallback"},
                  o);
+}
+
+TEST(Repair, UnresolvedSelfIntersectionIsWrapped) {
+  // The same case with the option the refusal names: the wrap encloses the
+  // union of the two spheres (oracle as in OverlappingSpheresBecomeTheirUnion,
+  // plus the offset shell: 3 %).
+  RepairOptions o;
+  o.autorefine = false;
+  o.max_surface_change = 0.001;
+  o.wrap = RepairOptions::Wrap::fallback;
+  o.wrap_alpha = 0.03;  // coarser than the default: faster
+  const RepairResult r = repair_surface(two_overlapping_spheres(), o, "in.off");
+  EXPECT_EQ(r.report.wrap_cause, 2);
+  EXPECT_EQ(r.report.self_intersections_repaired, 0);
+  EXPECT_EQ(r.report.components, 1);
+  EXPECT_TRUE(closed_and_oriented(r.mesh.F));
+  const double d = Eigen::Vector3d(1.0, 0.2, 0.1).norm(), R = 1.0;
+  const double lens = std::numbers::pi * (4 * R + d) * (2 * R - d) * (2 * R - d) / 12.0;
+  const double vball = enclosed_volume(make_icosphere(3).V, make_icosphere(3).F);
+  const double expected = 2 * vball - lens * vball / (4.0 / 3.0 * std::numbers::pi);
+  EXPECT_NEAR(r.report.volume, expected, 0.03 * expected);
+}
+
+TEST(Repair, WrapNamesRoundTripAndABadNameNamesTheField) {
+  for (auto w : {RepairOptions::Wrap::never, RepairOptions::Wrap::fallback,
+                 RepairOptions::Wrap::always})
+    EXPECT_EQ(parse_wrap(to_string(w)), w);
+  try {
+    parse_wrap("sometimes", "--wrap");
+    ADD_FAILURE() << "no exception";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("--wrap"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Repair, RefusesZeroVolume) {

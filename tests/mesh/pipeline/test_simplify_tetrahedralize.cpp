@@ -103,6 +103,26 @@ TEST(Tetrahedralize, DeterministicForSameInput) {
   EXPECT_TRUE(a.mesh.T == b.mesh.T);
 }
 
+TEST(Tetrahedralize, SmallerInteriorSizeAddsInteriorNodes) {
+  // The same surface sizing with the cells inside bounded at half the size:
+  // more nodes inside (counted from the tets' boundary), still a valid mesh.
+  const SurfaceMesh s = make_icosphere(3);
+  TetrahedralizeOptions o;
+  o.cell_size = 0.5;
+  const TetrahedralizeResult a = tetrahedralize_surface(s, o);
+  o.interior_size_factor = 0.5;
+  const TetrahedralizeResult b = tetrahedralize_surface(s, o);
+  check_tet_mesh(b, 4.0 / 3.0 * std::numbers::pi, 0.08);
+  const auto interior = [](const TetMesh& m) {
+    return m.V.rows() - static_cast<Eigen::Index>(boundary_nodes(m.F).size());
+  };
+  std::cout << "  interior nodes " << interior(a.mesh) << " -> " << interior(b.mesh) << " of "
+            << a.mesh.V.rows() << " -> " << b.mesh.V.rows() << "\n";
+  EXPECT_GT(interior(b.mesh), interior(a.mesh) + 5);
+  o.interior_size_factor = 1.5;
+  EXPECT_THROW(tetrahedralize_surface(s, o), ParameterError);
+}
+
 TEST(Tetrahedralize, RefusesOpenOrInvertedSurface) {
   SurfaceMesh s = make_icosphere(1);
   SurfaceMesh open = s;
