@@ -99,8 +99,9 @@ std::variant<Command, int> parse(int argc, char** argv) {
               [&](const std::string& v) {
                 try {
                   o.repair.wrap = icd::mesh::parse_wrap(v, "--wrap");
-                } catch (const icd::ParameterError& e) {
-                  throw std::invalid_argument(e.what());
+                } catch (const icd::ParameterError&) {
+                  throw std::invalid_argument("must be never, fallback or always, got '" + v +
+                                              "'");
                 }
               })
       .real("--wrap-alpha", o.repair.wrap_alpha, "F",
@@ -227,7 +228,7 @@ void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, doubl
     if (h > 0.03) add("Hausdorff distance above 3 % of the diagonal (--coarse-tets more)");
     if (target > 0 && std::abs(dt) > 0.25) add("tet count more than 25 % off the request");
     if (share < 0.10)
-      add("under 10 % of the nodes inside: thick parts have few nodes to deform (--interior-size 0.7)");
+      add("under 10 % of the nodes inside: thick parts have few nodes to deform (--interior-size 0.6)");
     if (!miss.empty()) std::printf("-- WARNING: fidelity target missed: %s\n", miss.c_str());
   }
   std::printf("-- rigid links: %d dense vertices on %d coarse surface nodes\n", b.links.num_links(),

@@ -317,7 +317,9 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     for (const std::string& f : failures) s << "; " << f;
     if (failures.empty() && !last_cause.empty()) s << ": " << last_cause;
     s << ". Options that change this: --coarse-tets N or --cell-size H (other sizes), "
-         "--time-limit S and --memory-limit MB (the stage's limits)";
+         "--time-limit S and --memory-limit MB (the stage's limits), --wrap always (mesh an "
+         "alpha-wrapped surface instead: near-contact gaps narrower than --wrap-alpha, which "
+         "can stall the mesher, are closed)";
     throw InputError(s.str());
   }
   if (res.failed_passes > 0 && heartbeat)

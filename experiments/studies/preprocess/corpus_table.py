@@ -2,7 +2,9 @@
 """Reads the logs of run_corpus.sh (OUT/logs/MESH.log, .rc) and writes
 OUT/corpus.csv and OUT/corpus_table.md: one row per mesh.
 
-usage: corpus_table.py OUT MESH...
+usage: corpus_table.py [--check] OUT MESH...
+--check: exit 1 when a mesh that succeeded lacks a figure of the table (the
+CTest PreprocessCorpus.Subset: the log format and this parser cannot drift apart).
 """
 import csv
 import os
@@ -86,8 +88,17 @@ def row(out, mesh):
     return r
 
 
+REQUIRED = ["tets", "tet_count_error", "interior_nodes", "interior_share", "step_ratio",
+            "min_dihedral", "max_radius_edge", "hausdorff_pct_diag", "volume_change",
+            "repair_cpu_s", "tet_cpu_s", "cpu_s", "wall_s", "peak_mb"]
+
+
 def main():
-    out, meshes = sys.argv[1], sys.argv[2:]
+    args = sys.argv[1:]
+    check = bool(args) and args[0] == "--check"
+    if check:
+        args = args[1:]
+    out, meshes = args[0], args[1:]
     rows = [row(out, m) for m in meshes]
     cols = ["mesh", "triangles", "outcome", "tets", "tet_count_error", "interior_nodes",
             "interior_share", "step_ratio", "min_dihedral", "max_dihedral", "max_radius_edge",
@@ -111,6 +122,13 @@ def main():
         for r in rows:
             f.write("| " + " | ".join(str(r.get(c, "")).replace("|", "/") for c in cols) + " |\n")
     print(f"[corpus] {ok}/{len(rows)} ok; table in {out}/corpus_table.md")
+    if check:
+        missing = [(r["mesh"], c) for r in rows if r["outcome"] == "ok" for c in REQUIRED
+                   if str(r.get(c, "")) == ""]
+        for m, c in missing:
+            print(f"[corpus] {m}: no {c} found in its log", file=sys.stderr)
+        if missing:
+            sys.exit(1)
 
 
 main()

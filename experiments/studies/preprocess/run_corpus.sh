@@ -55,6 +55,8 @@ for m in "${meshes[@]}"; do
   if [ $rc -ne 0 ] && [ $rc -ne 1 ]; then status=1; fi
   if [ $rc -eq 1 ] && ! grep -q "^icd-preprocess: " "$log"; then status=1; fi
 done
-python3 "$root/experiments/studies/preprocess/corpus_table.py" "$out" "${meshes[@]}" || status=1
+check=()
+if [ $subset = 1 ]; then check=(--check); fi
+python3 "$root/experiments/studies/preprocess/corpus_table.py" "${check[@]}" "$out" "${meshes[@]}" || status=1
 rm -rf "$out/bundles"
 exit $status
