@@ -165,14 +165,24 @@ TEST(ConservativeDefaults, DeformedBunnyAndDragonEveryContactPointInAReportedPai
   EXPECT_GT(checked, 0) << "no bunny and dragon bundles of similar tree sizes";
 }
 
-// The check can fail: with bunny spheres 10 % too small, contact points fall
-// outside every reported pair.
+// The check can fail: with bunny spheres shrunk, contact points fall outside
+// every reported pair, and the more so the more they shrink. (How much shrink
+// the trees tolerate depends on their padding: the canonical-order bundles
+// lose no point at 10 % and do at 20 %.)
 TEST(ConservativeDefaults, OracleSeesSpheresThatStopCovering) {
   const auto bunnies = bundles("bunny00"), dragons = bundles("ChineseDragon");
   ASSERT_FALSE(bunnies.empty() || dragons.empty())
       << "no bunny00* / ChineseDragon* bundles in " << ICD_TEST_BUNDLE_DIR;
-  const Coverage c = check(read_asset_bundle(bunnies[0]), read_asset_bundle(dragons[0]), 0.006, 0.0, 0.9);
-  EXPECT_GT(c.uncovered, 0);
+  const AssetBundle a = read_asset_bundle(bunnies[0]), b = read_asset_bundle(dragons[0]);
+  int previous = 0;
+  for (const double shrink : {0.9, 0.8, 0.6}) {
+    const Coverage c = check(a, b, 0.006, 0.0, shrink);
+    std::printf("bunny spheres x %.1f: %d of %d contact points outside every reported pair\n", shrink,
+                c.uncovered, c.points);
+    EXPECT_GE(c.uncovered, previous) << shrink;
+    previous = c.uncovered;
+  }
+  EXPECT_GT(previous, 0);
 }
 
 }  // namespace
