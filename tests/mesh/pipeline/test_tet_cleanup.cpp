@@ -15,6 +15,8 @@
 #include <icd/mesh/pipeline/fem_step.hpp>
 #include <icd/mesh/pipeline/tet_quality.hpp>
 
+#include "sliver_block.hpp"
+
 namespace icd::mesh {
 namespace {
 
@@ -79,28 +81,8 @@ TEST(TetCleanup, SliverBelowTheDihedralTargetIsRemoved) {
   // opposite face of one of its tets: a flat sliver (below 10 deg) that does
   // not limit the step much (ratio ~0.7, above the step target). The
   // dihedral phase removes it, keeping the step above the step target.
-  TetMesh m = bcc_block(4, 1.0);
-  Eigen::Index c = -1;
-  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
-    if ((m.V.row(i) - Eigen::RowVector3d(1.5, 1.5, 1.5)).norm() < 1e-12) c = i;
-  ASSERT_GE(c, 0);
-  const Eigen::RowVector3d rest = m.V.row(c);
-  bool made = false;
-  for (Eigen::Index t = 0; t < m.T.rows() && !made; ++t) {
-    int k = -1;
-    for (int a = 0; a < 4; ++a)
-      if (m.T(t, a) == c) k = a;
-    if (k < 0) continue;
-    const Eigen::Vector3d p0 = m.V.row(m.T(t, (k + 1) % 4)), p1 = m.V.row(m.T(t, (k + 2) % 4)),
-                          p2 = m.V.row(m.T(t, (k + 3) % 4));
-    const Eigen::Vector3d nrm = (p1 - p0).cross(p2 - p0).normalized();
-    const Eigen::Vector3d x = rest.transpose();
-    m.V.row(c) = (x - 0.92 * nrm.dot(x - p0) * nrm).transpose();
-    const TetQuality q = tet_quality(m);
-    made = q.min_volume > 0 && q.min_dihedral_deg < 10.0;
-    if (!made) m.V.row(c) = rest;
-  }
-  ASSERT_TRUE(made);
+  TetMesh m;
+  ASSERT_TRUE(test::bcc_block_with_centre_sliver(m));
   const TetQuality q0 = tet_quality(m);
   const double volume0 = signed_tet_volumes(m.V, m.T).sum();
   StableStepOptions so;
