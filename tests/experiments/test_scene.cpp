@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <span>
 #include <string>
 
 #include "experiments/runner/run.hpp"
@@ -78,13 +79,32 @@ TEST(Scene, FieldsLeftOutKeepTheLibraryDefaults) {
   EXPECT_EQ(lit.world.collision.query.clock_check_interval, 1);
 }
 
+// A scene text that must be refused, the field the message must name and what
+// it must say.
+struct BadField {
+  std::string text;
+  const char* field;
+  const char* what;
+};
+
+// Each case gets an InputError naming the file ("s.json: "), the field and what is wrong.
+void expect_each_rejected(std::span<const BadField> cases) {
+  for (const auto& c : cases) {
+    try {
+      parse(c.text);
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("s.json: ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(std::string(c.field) + ":"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(c.what), std::string::npos) << msg;
+    }
+  }
+}
+
 // Every bad field gets an InputError naming the file and the field.
 TEST(Scene, EachBadFieldGetsAClearError) {
-  const struct {
-    std::string text;
-    const char* field;
-    const char* what;
-  } cases[] = {
+  const BadField cases[] = {
       {"{}", "objects", "non-empty array"},
       {with_objects(""), "objects", "non-empty array"},
       {with_objects(R"({"name": "a"})"), "objects[0]", "exactly one of"},
@@ -136,17 +156,7 @@ TEST(Scene, EachBadFieldGetsAClearError) {
       {with_objects(kSphere, R"("output": {"vtu_every": -1})"), "output.vtu_every", "must be in"},
       {with_objects(kSphere, R"("output": {"csv": "yes"})"), "output.csv", "true or false"},
   };
-  for (const auto& c : cases) {
-    try {
-      parse(c.text);
-      ADD_FAILURE() << "accepted: " << c.text;
-    } catch (const InputError& e) {
-      const std::string msg = e.what();
-      EXPECT_EQ(msg.rfind("s.json: ", 0), 0u) << msg;
-      EXPECT_NE(msg.find(std::string(c.field) + ":"), std::string::npos) << msg;
-      EXPECT_NE(msg.find(c.what), std::string::npos) << msg;
-    }
-  }
+  expect_each_rejected(cases);
 }
 
 // Level of detail: collision.budget_split and each object's collision_weight
@@ -173,11 +183,7 @@ TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
   EXPECT_EQ(plain.objects[0].collision_weight, coupling::ObjectSetup{}.collision_weight);
 
   // Bad values: an InputError naming the file and the field.
-  const struct {
-    std::string text;
-    const char* field;
-    const char* what;
-  } cases[] = {
+  const BadField cases[] = {
       {with_objects(kSphere, R"("collision": {"budget_split": "random"})"),
        "collision.budget_split", "must be one of"},
       {with_objects(kSphere, R"("collision": {"budget_split": 1})"), "collision.budget_split",
@@ -191,17 +197,7 @@ TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
       {with_objects(R"({"primitive": {}, "collision_weight": 1e7})"), "objects[0].collision_weight",
        "must be in (0"},
   };
-  for (const auto& c : cases) {
-    try {
-      parse(c.text);
-      ADD_FAILURE() << "accepted: " << c.text;
-    } catch (const InputError& e) {
-      const std::string msg = e.what();
-      EXPECT_EQ(msg.rfind("s.json: ", 0), 0u) << msg;
-      EXPECT_NE(msg.find(std::string(c.field) + ":"), std::string::npos) << msg;
-      EXPECT_NE(msg.find(c.what), std::string::npos) << msg;
-    }
-  }
+  expect_each_rejected(cases);
 }
 
 // --dry-run plans: each scene runs only the stages it needs.
