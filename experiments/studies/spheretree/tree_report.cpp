@@ -44,22 +44,33 @@ void print_level_table(const std::string& model, const std::string& method, doub
   }
 }
 
-void print_dense_errors(const std::string& label, const SurfaceMesh& mesh,
-                        const collision::SphereTree& tree, double to_2000) {
+std::vector<LevelError> dense_errors(const SurfaceMesh& mesh, const collision::SphereTree& tree,
+                                     double to_2000) {
   const mesh::MeshOracle oracle(mesh::close_holes(mesh));
   const MatX3d dirs = mesh::probe_directions(4);
+  std::vector<LevelError> out;
   for (int l = 0; l < tree.num_levels(); ++l) {
-    double worst = 0, sum = 0;
+    LevelError e;
+    double sum = 0;
     const int begin = tree.level_offset[static_cast<size_t>(l)],
               end = tree.level_offset[static_cast<size_t>(l) + 1];
     for (int i = begin; i < end; ++i) {
       const auto& s = tree.spheres[static_cast<size_t>(i)];
-      const double e = to_2000 * mesh::sphere_protrusion(oracle, s.center(), s.r, dirs);
-      worst = std::max(worst, e), sum += e;
+      const double err = to_2000 * mesh::sphere_protrusion(oracle, s.center(), s.r, dirs);
+      e.worst = std::max(e.worst, err), sum += err;
     }
-    std::printf("# %s level %d: error on 2562 directions: worst %.1f mean %.2f\n", label.c_str(), l,
-                worst, sum / (end - begin));
+    e.mean = end > begin ? sum / (end - begin) : 0.0;
+    out.push_back(e);
   }
+  return out;
+}
+
+void print_dense_errors(const std::string& label, const SurfaceMesh& mesh,
+                        const collision::SphereTree& tree, double to_2000) {
+  const std::vector<LevelError> errors = dense_errors(mesh, tree, to_2000);
+  for (size_t l = 0; l < errors.size(); ++l)
+    std::printf("# %s level %zu: error on 2562 directions: worst %.1f mean %.2f\n", label.c_str(),
+                l, errors[l].worst, errors[l].mean);
 }
 
 double to_normalized_units(const SurfaceMesh& mesh) {

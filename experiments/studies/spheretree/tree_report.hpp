@@ -19,6 +19,17 @@ void print_level_table_header();
 void print_level_table(const std::string& model, const std::string& method, double seconds,
                        const std::vector<mesh::LevelMetrics>& levels);
 
+/// Worst and mean error of the spheres of one level.
+struct LevelError {
+  double worst = 0, mean = 0;
+};
+
+/// The worst and mean error of each level on 2562 directions (a 4 times
+/// subdivided icosahedron; close to the continuous protrusion), in the units
+/// `to_2000` turns model units into.
+std::vector<LevelError> dense_errors(const SurfaceMesh& mesh, const collision::SphereTree& tree,
+                                     double to_2000);
+
 /// Prints, as comment lines, the worst and mean error of each level on 2562
 /// directions (a 4 times subdivided icosahedron): close to the continuous
 /// protrusion. `to_2000` turns model units into the table's.
