@@ -1,4 +1,5 @@
-// sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--time-limit S] [--medial-spacing REL]
+// sphere_tree_table RESULTS_DIR [--models bunny,dragon] [--mesh PATH]... [--time-limit S]
+//                   [--medial-spacing REL]
 //                   [--cover-spacing REL] [--joint 0|1] [--regroup 0|1] [--lloyd N] [--octree 0|1]
 //                   [--worst-share F] [--leaf-worst-target REL] [--leaf-worst-factor F]
 //                   [--coverage-spacing UNITS] [--shell-samples N]  (evaluation)
@@ -170,7 +171,11 @@ int run(int argc, char** argv) {
   icd::mesh::SphereTreeOptions::Exchange& exchange = options.exchange;
   icd::mesh::WorstSplitOptions& split = options.worst_split.options;
   icd::mesh::ProtrusionPolishOptions& polish = options.polish.protrusion;
-  cli.text("--models", models_arg, "bunny,dragon", "models to build")
+  std::vector<std::string> extra_meshes;
+  cli.text("--models", models_arg, "bunny,dragon", "models to build ('' for none)")
+      .custom("--mesh", "PATH",
+              "also build this surface mesh (repeatable; named by its file stem)",
+              [&extra_meshes](const std::string& v) { extra_meshes.push_back(v); })
       .real("--time-limit", options.time_limit, "S", "CPU budget of a build (s)")
       .real("--medial-spacing", sampling.medial_spacing, "REL", "medial sample spacing")
       .real("--cover-spacing", sampling.cover_spacing, "REL", "coverage sample spacing")
@@ -237,6 +242,9 @@ int run(int argc, char** argv) {
     if (name == "bunny") models.push_back({"bunny", "bunny00.off"});
     if (name == "dragon") models.push_back({"dragon", "ChineseDragon-10kv.off"});
   }
+  // An absolute path replaces the data folder in `data / file` below.
+  for (const std::string& m : extra_meshes)
+    models.push_back({fs::path(m).stem().string(), fs::absolute(m).string()});
 
   icd::experiments::print_level_table_header();
   for (const auto& model : models) {
