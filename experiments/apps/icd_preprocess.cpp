@@ -236,8 +236,10 @@ void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, doubl
   if (c.options.sphere_builder != icd::mesh::SphereBuilder::none) {
     std::printf(
         "-- sphere tree (%s%s): %d spheres, %d levels, %zu node associations%s\n",
-        c.options.sphere_builder == icd::mesh::SphereBuilder::octree ? "octree" : "medial axis",
-        c.options.sphere_builder == icd::mesh::SphereBuilder::octree
+        c.options.sphere_builder == icd::mesh::SphereBuilder::octree ? "octree"
+        : r.sphere_fallback.empty() ? "medial axis"
+                                    : "octree, the medial-axis builder's fallback",
+        c.options.sphere_builder == icd::mesh::SphereBuilder::octree || !r.sphere_fallback.empty()
             ? ""
             : (std::string(", fit ") + icd::mesh::to_string(c.fit)).c_str(),
         b.spheres.num_nodes(), r.sphere_levels, b.spheres.assoc_nodes.size(),

@@ -1,5 +1,9 @@
 #include <icd/mesh/pipeline/preprocess.hpp>
 
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -36,6 +40,7 @@ class Stage {
     return run_bounded(m_name, limits, work, &m_usage, heartbeat(), hint);
   }
   void set_usage(const StageUsage& u) { m_usage = u; }
+  const StageUsage& usage() const { return m_usage; }
   void done(const std::string& message) {
     m_result.times.push_back({m_name, m_usage.wall_seconds, m_usage.cpu_seconds, m_usage.peak_mb});
     if (m_progress) {
@@ -172,37 +177,57 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   SurfaceMesh input = dense;
   if (!norm.centre.isZero()) input.V.rowwise() -= norm.centre;
   input.V *= s;
-  {
-    Stage t(r, progress, "repair");
-    ByteReader in(t.run(limits, [&] {
-      RepairResult rep = repair_surface(input, o.repair, name);
-      ByteWriter w;
-      write_surface(w, rep.mesh);
-      w.pod(rep.report);
-      return w.take();
-    }));
+  // Stages 1 and 2, repeated by the wrap retry below: the repaired surface
+  // (b.dense, r.repair, in the input's order) and its canonical order and
+  // simplification.
+  const auto repair_once = [&](const RepairOptions& ro, StageUsage* usage,
+                               const HeartbeatFn& beat) {
+    ByteReader in(run_bounded(
+        "repair", limits,
+        [&] {
+          RepairResult rep = repair_surface(input, ro, name);
+          ByteWriter w;
+          write_surface(w, rep.mesh);
+          w.pod(rep.report);
+          return w.take();
+        },
+        usage, beat));
     b.dense = read_surface(in);
     r.repair = in.pod<RepairReport>();
+    r.bbox_diagonal = (b.dense.V.colwise().maxCoeff() - b.dense.V.colwise().minCoeff()).norm();
+  };
+  SurfaceMesh canonical, simplified;
+  const auto simplify_once = [&](StageUsage* usage, const HeartbeatFn& beat) {
+    // The stages below see the repaired surface in an order fixed by its
+    // geometry (canonical.hpp): permuted input gives the same coarse mesh and
+    // sphere tree. The bundle keeps the repaired surface in the input's order.
+    canonical = canonical_order(b.dense);
+    ByteReader in(run_bounded(
+        "simplify", limits,
+        [&] {
+          SimplifyResult sr = simplify_surface(canonical, o.simplify);
+          ByteWriter w;
+          write_surface(w, sr.mesh);
+          w.pod(sr.report);
+          return w.take();
+        },
+        usage, beat));
+    simplified = read_surface(in);
+    r.simplify = in.pod<SimplifyReport>();
+  };
+  {
+    Stage t(r, progress, "repair");
+    StageUsage u;
+    repair_once(o.repair, &u, t.heartbeat());
+    t.set_usage(u);
     t.done(std::to_string(b.dense.V.rows()) + " vertices, " + std::to_string(b.dense.F.rows()) +
            " faces, " + std::to_string(r.repair.holes_filled) + " hole(s) filled");
   }
-  r.bbox_diagonal = (b.dense.V.colwise().maxCoeff() - b.dense.V.colwise().minCoeff()).norm();
-  // The stages below see the repaired surface in an order fixed by its
-  // geometry (canonical.hpp): permuted input gives the same coarse mesh and
-  // sphere tree. The bundle keeps the repaired surface in the input's order.
-  const SurfaceMesh canonical = canonical_order(b.dense);
-  SurfaceMesh simplified;
   {
     Stage t(r, progress, "simplify");
-    ByteReader in(t.run(limits, [&] {
-      SimplifyResult sr = simplify_surface(canonical, o.simplify);
-      ByteWriter w;
-      write_surface(w, sr.mesh);
-      w.pod(sr.report);
-      return w.take();
-    }));
-    simplified = read_surface(in);
-    r.simplify = in.pod<SimplifyReport>();
+    StageUsage u;
+    simplify_once(&u, t.heartbeat());
+    t.set_usage(u);
     t.done(std::to_string(r.simplify.input_faces) + " -> " +
            std::to_string(r.simplify.output_faces) + " faces");
   }
@@ -211,7 +236,63 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     TetrahedralizeOptions to = o.tetrahedralize;
     to.limits = limits;
     to.cell_size *= s;
-    TetrahedralizeResult tet = tetrahedralize_surface(simplified, to, t.heartbeat());
+    TetrahedralizeResult tet;
+    // The passes run in child processes: a failed attempt's CPU time is the
+    // children's, which the retry adds to this stage's.
+    const auto children_cpu = [] {
+      rusage ru{};
+      getrusage(RUSAGE_CHILDREN, &ru);
+      return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+             1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+    };
+    const double cpu0 = children_cpu();
+    const auto wall0 = std::chrono::steady_clock::now();
+    try {
+      tet = tetrahedralize_surface(simplified, to, t.heartbeat());
+    } catch (const ParameterError&) {
+      throw;
+    } catch (const InputError& e) {
+      // Automatic wrap retry: the mesher failed at every size on a repaired
+      // (not wrapped) surface, typically surfaces closer to each other than
+      // the cell size (near-contact gaps between parts: bones, camel). Mesh
+      // the alpha wrap of the input once instead (it closes gaps narrower
+      // than alpha), repeating repair and simplification, all counted in this
+      // stage; the summary's repair section and notes say so.
+      if (o.repair.wrap != RepairOptions::Wrap::fallback || r.repair.wrap_cause != 0) throw;
+      std::string first = e.what();
+      first = first.substr(0, first.find(". Options that change this"));  // the retry is the option
+      const double first_cpu = children_cpu() - cpu0;
+      const double first_wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+      const HeartbeatFn beat = t.heartbeat();
+      if (beat)
+        beat("the mesher failed on the repaired surface at every size; retrying once on its "
+             "alpha wrap (--wrap never refuses instead)");
+      RepairOptions ro = o.repair;
+      ro.wrap = RepairOptions::Wrap::always;
+      StageUsage ru, su;
+      try {
+        repair_once(ro, &ru, beat);
+        simplify_once(&su, beat);
+        tet = tetrahedralize_surface(simplified, to, beat);
+      } catch (const ParameterError&) {
+        throw;
+      } catch (const InputError& e2) {
+        throw InputError(std::string(e2.what()) +
+                         " [after the automatic retry on the alpha-wrapped surface; on the "
+                         "repaired surface first: " + first + "]");
+      }
+      r.repair.wrap_cause = 4;
+      tet.usage.cpu_seconds += first_cpu + ru.cpu_seconds + su.cpu_seconds;
+      tet.usage.wall_seconds += first_wall + ru.wall_seconds + su.wall_seconds;
+      tet.usage.peak_mb = std::max({tet.usage.peak_mb, ru.peak_mb, su.peak_mb});
+      r.wrap_retry_cause = first;
+      r.notes.push_back("tetrahedralize: the mesher failed on the repaired surface at every "
+                        "size (" + first + "; " + fmt(first_cpu) + " s CPU); the surface was "
+                        "rebuilt by alpha wrapping and meshed once more (both attempts, with "
+                        "the second repair and simplification, in this stage's time; --wrap "
+                        "never refuses instead)");
+    }
     t.set_usage(tet.usage);
     b.coarse = std::move(tet.mesh);
     r.quality = tet.quality;
@@ -219,14 +300,16 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     r.mesher_passes = tet.passes;
     for (const std::string& n : tet.notes) r.notes.push_back("tetrahedralize: " + n);
     if (tet.step_cleanup.ratio_before > 0) {
-      char buf[320];
+      char buf[480];
+      const StepCleanupReport& c = tet.step_cleanup;
       std::snprintf(buf, sizeof buf,
                     "tetrahedralize: stable-step post-pass collapsed %d node(s) (node estimate of "
                     "the step ratio %.3f -> %.3f, volume %+.2f %%, %d node(s) left above the "
-                    "target; --step-target)",
-                    tet.step_cleanup.collapses, tet.step_cleanup.ratio_before,
-                    tet.step_cleanup.ratio_after, 100.0 * tet.step_cleanup.volume_change,
-                    tet.step_cleanup.stuck);
+                    "target; --step-target); dihedral phase: %d collapse(s), %d relocation(s), "
+                    "smallest angle %.2f -> %.2f deg",
+                    c.collapses, c.ratio_before, c.ratio_after, 100.0 * c.volume_change, c.stuck,
+                    c.dihedral_collapses, c.relocations, c.min_dihedral_before,
+                    c.min_dihedral_after);
       r.notes.push_back(buf);
     }
     b.surface_nodes = boundary_nodes(b.coarse.F);
@@ -255,27 +338,55 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   }
   if (o.sphere_builder != SphereBuilder::none) {
     Stage t(r, progress, "sphere tree");
-    ByteReader in(t.run(
-        limits,
-        [&] {
-          collision::SphereTree tree;
-          bool hit = false;
-          if (o.sphere_builder == SphereBuilder::medial_axis) {
-            SphereTreeBuild st = build_sphere_tree(canonical, o.spheres);
-            tree = std::move(st.tree);
-            hit = st.hit_time_limit;
-          } else {
-            tree = collision::build_octree_tree(canonical.V, canonical.F, o.octree);
-          }
-          const std::vector<int> cand(b.surface_nodes.data(),
-                                      b.surface_nodes.data() + b.surface_nodes.size());
-          collision::associate_nearest_nodes(tree, b.coarse.V, o.association, cand);
-          ByteWriter w;
-          write_tree(w, tree);
-          w.pod(hit);
-          return w.take();
-        },
-        "--spheres octree builds a coarser tree much faster"));
+    const auto build = [&](SphereBuilder builder) {
+      return [&, builder] {
+        collision::SphereTree tree;
+        bool hit = false;
+        if (builder == SphereBuilder::medial_axis) {
+          SphereTreeBuild st = build_sphere_tree(canonical, o.spheres);
+          tree = std::move(st.tree);
+          hit = st.hit_time_limit;
+        } else {
+          tree = collision::build_octree_tree(canonical.V, canonical.F, o.octree);
+        }
+        const std::vector<int> cand(b.surface_nodes.data(),
+                                    b.surface_nodes.data() + b.surface_nodes.size());
+        collision::associate_nearest_nodes(tree, b.coarse.V, o.association, cand);
+        ByteWriter w;
+        write_tree(w, tree);
+        w.pod(hit);
+        return w.take();
+      };
+    };
+    std::string bytes;
+    try {
+      bytes = t.run(limits, build(o.sphere_builder),
+                    "--spheres octree builds a coarser tree much faster");
+    } catch (const StageError& e) {
+      // The medial-axis builder beyond its limits: the octree builder
+      // instead (seconds, deterministic), with a WARNING in the summary.
+      if (o.sphere_builder != SphereBuilder::medial_axis ||
+          (e.kind() != StageError::Kind::cpu_limit && e.kind() != StageError::Kind::memory_limit))
+        throw;
+      StageUsage first;
+      first.cpu_seconds = t.usage().cpu_seconds;
+      first.wall_seconds = t.usage().wall_seconds;
+      first.peak_mb = t.usage().peak_mb;
+      if (const HeartbeatFn beat = t.heartbeat())
+        beat("the medial-axis builder went beyond the stage's limits; building the octree tree "
+             "instead");
+      bytes = t.run(limits, build(SphereBuilder::octree));
+      StageUsage sum = t.usage();
+      sum.cpu_seconds += first.cpu_seconds;
+      sum.wall_seconds += first.wall_seconds;
+      sum.peak_mb = std::max(sum.peak_mb, first.peak_mb);
+      t.set_usage(sum);
+      r.sphere_fallback = std::string(e.what()) + " (" + fmt(first.cpu_seconds) + " s CPU)";
+      r.notes.push_back("WARNING: sphere tree: " + r.sphere_fallback +
+                        "; the bundle holds the octree builder's tree instead (coarser: more "
+                        "sphere tests near contact; a larger --time-limit builds the medial tree)");
+    }
+    ByteReader in(std::move(bytes));
     b.spheres = read_tree(in);
     r.sphere_time_limit_hit = in.pod<bool>();
     r.sphere_levels = b.spheres.num_levels();

@@ -115,12 +115,19 @@ struct PreprocessResult {
   int mesher_passes = 0;
   int sphere_levels = 0;
   bool sphere_time_limit_hit = false;  ///< the builder stopped early: output may vary between runs
+  /// Non-empty when the medial-axis builder exceeded the stage's CPU or
+  /// memory limit and the bundle holds the octree builder's tree instead:
+  /// the limit's message.
+  std::string sphere_fallback;
   /// Approximate symmetric Hausdorff distances (model units; -1 when not computed):
   double hausdorff_dense_simplified = -1.0;  ///< repaired dense vs simplified surface
   double hausdorff_dense_coarse = -1.0;      ///< repaired dense vs coarse tet boundary
   double bbox_diagonal = 0.0;                ///< of the repaired dense surface
   std::vector<StageTime> times;              ///< in stage order
   Normalisation normalisation;               ///< the stages' coordinates
+  /// Why the mesher failed on the repaired surface when the automatic wrap
+  /// retry meshed its alpha wrap instead (repair.wrap_cause 4); else empty.
+  std::string wrap_retry_cause;
   /// Retries and warnings of every stage, for the summary (one line each).
   std::vector<std::string> notes;
 };
@@ -130,7 +137,11 @@ using ProgressFn = std::function<void(const std::string& stage, const std::strin
 
 /// Runs all stages on `dense` (a raw surface as read from file; `name` prefixes
 /// error messages), in normalised coordinates (Normalisation; the bundle and
-/// every figure of the result are in model units). Every stage runs bounded by
+/// every figure of the result are in model units). With the default
+/// RepairOptions::Wrap::fallback, a repaired (not wrapped) surface on which
+/// the mesher fails at every size is rebuilt by alpha wrapping and meshed
+/// once more (the automatic wrap retry; repair.wrap_cause 4, a note, its CPU
+/// in the tetrahedralize stage). Every stage runs bounded by
 /// options.limits. Deterministic for identical input and options unless the
 /// sphere builder hits its time limit (reported). Throws what the stages
 /// throw: InputError for unusable input (StageError for a stage beyond its

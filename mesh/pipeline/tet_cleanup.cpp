@@ -134,9 +134,9 @@ double ideal_omega(double mean_volume, double poisson) {
 
 StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) {
   if (!(o.target_ratio >= 0) || !(o.max_shift >= 0) || !(o.max_volume_change >= 0) ||
-      o.max_collapses < 0 || !(o.poisson > -1 && o.poisson < 0.5))
+      o.max_collapses < 0 || o.max_relocation_sweeps < 0 || !(o.poisson > -1 && o.poisson < 0.5))
     throw ParameterError("raise_stable_step: need target_ratio, max_shift, max_volume_change, "
-                         "max_collapses >= 0 and poisson in (-1, 0.5)");
+                         "max_collapses, max_relocation_sweeps >= 0 and poisson in (-1, 0.5)");
   StepCleanupReport rep;
   const int n = static_cast<int>(mesh.V.rows());
   if (mesh.T.rows() == 0 || o.target_ratio == 0) return rep;
@@ -387,13 +387,173 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     apply(L, best_i, best);
     ++rep.dihedral_collapses;
   }
+  // Third phase: the tets still below the dihedral target (collapses found
+  // no valid move) get one of their nodes relocated, the connectivity kept:
+  // an interior node anywhere, a surface node along the boundary as it was
+  // before this phase (projected onto it, at most max_shift of the diagonal
+  // from where it was); accepted when the smallest angle of the node's tets
+  // rises, every tet stays positive, no node frequency rises above
+  // max(the target's, the mesh's largest) and the volume bound holds.
+  if (o.dihedral_target_deg > 0 && o.max_relocation_sweeps > 0) {
+    const Local L = local();
+    const MatX3d V0 = mesh.V;  // the boundary as it was: surface nodes stay on it
+    MatX4i Tm(static_cast<Eigen::Index>(T.size()), 4);
+    for (size_t e = 0; e < T.size(); ++e)
+      for (int k = 0; k < 4; ++k) Tm(static_cast<Eigen::Index>(e), k) = T[e][k];
+    const MatX3i Fb = boundary_faces(Tm);
+    std::vector<std::vector<int>> bfaces(static_cast<size_t>(n));
+    for (Eigen::Index f = 0; f < Fb.rows(); ++f)
+      for (int k = 0; k < 3; ++k) bfaces[static_cast<size_t>(Fb(f, k))].push_back(static_cast<int>(f));
+    const auto project = [&](const Eigen::Vector3d& p) {
+      Eigen::Vector3d best = p;
+      double d2 = INFINITY;
+      for (Eigen::Index f = 0; f < Fb.rows(); ++f) {
+        const Eigen::Vector3d q = closest_point_on_triangle(
+            p, V0.row(Fb(f, 0)).transpose(), V0.row(Fb(f, 1)).transpose(), V0.row(Fb(f, 2)).transpose());
+        if ((q - p).squaredNorm() < d2) {
+          d2 = (q - p).squaredNorm();
+          best = q;
+        }
+      }
+      return best;
+    };
+    const double cap = std::max(threshold, w.maxCoeff());
+    // Smallest angle of i's tets with i at x (-1 when one is not positive).
+    const auto star_min = [&](int i, const Eigen::Vector3d& x) {
+      const Eigen::RowVector3d keep = mesh.V.row(i);
+      mesh.V.row(i) = x.transpose();
+      double d = 180;
+      for (int e : L.around[static_cast<size_t>(i)]) {
+        if (!(tet_volume(mesh.V, T[static_cast<size_t>(e)]) > 0)) {
+          d = -1;
+          break;
+        }
+        d = std::min(d, min_dihedral(mesh.V, T[static_cast<size_t>(e)]));
+      }
+      mesh.V.row(i) = keep;
+      return d;
+    };
+    // The best of a few candidate positions of node i, or false.
+    const auto relocate = [&](int i, Eigen::Vector3d& to, double& gain) {
+      const bool surf = L.surface[static_cast<size_t>(i)] != 0;
+      const Eigen::Vector3d x = mesh.V.row(i).transpose();
+      const double now = star_min(i, x);
+      const std::set<int> nbrs = neighbours(L, i);
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      double mean_edge = 0;
+      int nc = 0;
+      for (int v : nbrs) {
+        mean_edge += (mesh.V.row(v) - mesh.V.row(i)).norm();
+        if (surf && !L.bedges.count(std::minmax(i, v))) continue;
+        c += mesh.V.row(v).transpose();
+        ++nc;
+      }
+      if (nbrs.empty() || nc == 0) return false;
+      mean_edge /= static_cast<double>(nbrs.size());
+      c /= nc;
+      std::vector<Eigen::Vector3d> cand;
+      for (double s : {1.0, 0.6, 0.3}) cand.push_back(x + s * (c - x));
+      // Along the gradient of the worst tet's smallest angle (finite differences).
+      int worst = -1;
+      double dw = 181;
+      for (int e : L.around[static_cast<size_t>(i)]) {
+        const double d = min_dihedral(mesh.V, T[static_cast<size_t>(e)]);
+        if (d < dw) {
+          dw = d;
+          worst = e;
+        }
+      }
+      Eigen::Vector3d g = Eigen::Vector3d::Zero();
+      const double h = 1e-4 * mean_edge;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::RowVector3d keep = mesh.V.row(i);
+        mesh.V(i, k) += h;
+        const double up = min_dihedral(mesh.V, T[static_cast<size_t>(worst)]);
+        mesh.V(i, k) -= 2 * h;
+        const double down = min_dihedral(mesh.V, T[static_cast<size_t>(worst)]);
+        mesh.V.row(i) = keep;
+        g[k] = (up - down) / (2 * h);
+      }
+      if (surf) {  // in the tangent plane of the boundary around i
+        Eigen::Vector3d nrm = Eigen::Vector3d::Zero();
+        for (int f : bfaces[static_cast<size_t>(i)]) {
+          const Eigen::Vector3d a = V0.row(Fb(f, 0)), b = V0.row(Fb(f, 1)), cc = V0.row(Fb(f, 2));
+          nrm += (b - a).cross(cc - a);
+        }
+        if (nrm.norm() > 0) g -= g.dot(nrm.normalized()) * nrm.normalized();
+      }
+      if (g.norm() > 0)
+        for (double s : {0.03, 0.06, 0.12, 0.25})
+          cand.push_back(x + s * mean_edge * g.normalized());
+      bool found = false;
+      double best = now;
+      for (Eigen::Vector3d p : cand) {
+        if (surf) {
+          p = project(p);
+          if ((p - V0.row(i).transpose()).norm() > o.max_shift * diagonal) continue;
+        }
+        const double d = star_min(i, p);
+        if (d > best + 1e-9) {
+          best = d;
+          to = p;
+          found = true;
+        }
+      }
+      gain = best - now;
+      return found;
+    };
+    for (int sweep = 0; sweep < o.max_relocation_sweeps; ++sweep) {
+      std::vector<std::pair<double, int>> bad;
+      for (size_t e = 0; e < T.size(); ++e) {
+        const double d = min_dihedral(mesh.V, T[e]);
+        if (d < o.dihedral_target_deg) bad.emplace_back(d, static_cast<int>(e));
+      }
+      std::sort(bad.begin(), bad.end());
+      int moved_now = 0;
+      for (const auto& [d0, e] : bad) {
+        if (min_dihedral(mesh.V, T[static_cast<size_t>(e)]) >= o.dihedral_target_deg) continue;
+        int best_i = -1;
+        double best_gain = 0;
+        Eigen::Vector3d best_to = Eigen::Vector3d::Zero();
+        for (int i : T[static_cast<size_t>(e)]) {
+          Eigen::Vector3d to;
+          double gain = 0;
+          if (relocate(i, to, gain) && gain > best_gain) {
+            // The step and volume bounds at the new position.
+            const Eigen::RowVector3d keep = mesh.V.row(i);
+            double dv = 0;
+            for (int t : L.around[static_cast<size_t>(i)]) dv -= tet_volume(mesh.V, T[static_cast<size_t>(t)]);
+            mesh.V.row(i) = to.transpose();
+            for (int t : L.around[static_cast<size_t>(i)]) dv += tet_volume(mesh.V, T[static_cast<size_t>(t)]);
+            const Eigen::VectorXd wc = node_frequencies(mesh.V, T, o.poisson);
+            mesh.V.row(i) = keep;
+            if (wc.maxCoeff() > cap || std::abs((volume + dv) / volume0 - 1) > o.max_volume_change)
+              continue;
+            best_i = i;
+            best_gain = gain;
+            best_to = to;
+          }
+        }
+        if (best_i < 0) continue;
+        double dv = 0;
+        for (int t : L.around[static_cast<size_t>(best_i)]) dv -= tet_volume(mesh.V, T[static_cast<size_t>(t)]);
+        mesh.V.row(best_i) = best_to.transpose();
+        for (int t : L.around[static_cast<size_t>(best_i)]) dv += tet_volume(mesh.V, T[static_cast<size_t>(t)]);
+        volume += dv;
+        ++rep.relocations;
+        ++moved_now;
+      }
+      if (moved_now == 0) break;
+    }
+    if (rep.relocations > 0) w = node_frequencies(mesh.V, T, o.poisson);
+  }
   rep.min_dihedral_after = 180;
   for (const Tet& t : T) rep.min_dihedral_after = std::min(rep.min_dihedral_after, min_dihedral(mesh.V, t));
   for (int v = 0; v < n; ++v)
     if (w[v] > threshold) ++rep.stuck;
   rep.ratio_after = ideal / w.maxCoeff();
   rep.volume_change = volume / volume0 - 1;
-  if (rep.collapses + rep.dihedral_collapses == 0) return rep;
+  if (rep.collapses + rep.dihedral_collapses == 0) return rep;  // mesh.V holds the relocations
   // Compact: drop unused nodes, keep the order of the others.
   std::vector<int> id(static_cast<size_t>(n), -1);
   for (const Tet& t : T)

@@ -36,6 +36,12 @@ struct StepCleanupOptions {
   /// traded for the angle. The issue's target (issue 30, item 5).
   double dihedral_target_deg = 12.0;
   int max_collapses = 2000;
+  /// Then the tets still below dihedral_target_deg get one of their nodes
+  /// relocated (connectivity kept: an interior node freely, a surface node
+  /// along the boundary, within max_shift), where the smallest angle of the
+  /// node's tets rises and no node frequency rises above max(the target's,
+  /// the mesh's largest): at most this many sweeps over them (0: off).
+  int max_relocation_sweeps = 4;
 };
 
 /// What raise_stable_step() did.
@@ -48,10 +54,12 @@ struct StepCleanupReport {
   int dihedral_collapses = 0;      ///< nodes removed by the dihedral phase
   double min_dihedral_before = 0;  ///< smallest dihedral angle (deg) before the dihedral phase
   double min_dihedral_after = 0;   ///< ... and after it (0 when the pass did not run)
+  int relocations = 0;             ///< node moves of the relocation phase
 };
 
 /// Collapses the nodes that limit the stable step, then those of the tets
-/// below the dihedral target (see StepCleanupOptions), in place: `mesh` (positive tets, F its boundary, a closed manifold) keeps
+/// below the dihedral target, then relocates nodes of the tets still below it
+/// (see StepCleanupOptions), in place: `mesh` (positive tets, F its boundary, a closed manifold) keeps
 /// positive tets, a closed manifold boundary of the same Euler characteristic
 /// and components, and every node used; F is recomputed. Deterministic.
 StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& options = {});

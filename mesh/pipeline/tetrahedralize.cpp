@@ -2,6 +2,7 @@
 
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_error_code.h>
 #include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polyhedral_mesh_domain_with_features_3.h>
@@ -70,10 +71,16 @@ void seed(C3t3& c3t3, const Domain& domain, const SurfaceMesh& surface, double s
   }
 }
 
+/// How mesh_once()'s refusal at the vertex cap begins (it crosses the
+/// process boundary as an InputError message).
+constexpr const char* kOverRefined = "the mesher over-refined";
+
 /// One Delaunay refinement at `size`; sliver optimisation only when `optimise`
-/// (it dominates the cost, so the size search runs without it).
+/// (it dominates the cost, so the size search runs without it). The
+/// refinement stops at `max_vertices` (0: no cap) and throws an InputError
+/// whose message begins with kOverRefined.
 TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const TetrahedralizeOptions& o,
-                  double size, bool optimise) {
+                  double size, bool optimise, std::size_t max_vertices) {
   namespace p = CGAL::parameters;
   CGAL::get_default_random() = CGAL::Random(o.random_seed);
   const Criteria criteria(p::facet_angle = o.facet_angle_deg,
@@ -91,7 +98,17 @@ TetMesh mesh_once(const Domain& domain, const SurfaceMesh& surface, const Tetrah
   seed(c3t3, domain, surface, o.facet_size_factor * size);
   // manifold(): the boundary of the complex must be a manifold surface (thin
   // parts otherwise yield boundary edges shared by four faces).
-  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::manifold());
+  CGAL::Mesh_error_code code = CGAL::CGAL_MESH_3_NO_ERROR;
+  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::manifold(),
+                      p::mesh_3_options(p::maximal_number_of_vertices = max_vertices,
+                                        p::pointer_to_error_code = &code));
+  if (code == CGAL::CGAL_MESH_3_MAXIMAL_NUMBER_OF_VERTICES_REACHED)
+    throw InputError(std::string(kOverRefined) + ": it reached " +
+                      std::to_string(c3t3.triangulation().number_of_vertices()) +
+                      " vertices, its cap (" + std::to_string(std::lround(o.over_refinement_factor)) +
+                      " x what this size should give, at least " + std::to_string(o.min_vertex_cap) +
+                      "): parts of the surface lie closer to each other than the cell size "
+                      "(near-contact gaps, thin sheets)");
   if (optimise && o.perturb)
     CGAL::perturb_mesh_3(c3t3, domain, p::sliver_bound = o.sliver_bound_deg);
   if (optimise && o.exude) CGAL::exude_mesh_3(c3t3, p::sliver_bound = o.sliver_bound_deg);
@@ -174,11 +191,13 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       o.max_retries < 0 || !(o.feature_angle_deg >= 0.0 && o.feature_angle_deg < 180.0) ||
       !(o.limits.cpu_seconds > 0.0) || !(o.limits.memory_mb > 0.0) ||
       !(o.step_cleanup.target_ratio >= 0.0) ||
-      !(o.interior_size_factor > 0.0 && o.interior_size_factor <= 1.0))
+      !(o.interior_size_factor > 0.0 && o.interior_size_factor <= 1.0) ||
+      !(o.over_refinement_factor >= 0.0) || o.min_vertex_cap < 0)
     throw ParameterError(
         "tetrahedralize_surface: need target_tets >= 1 or cell_size > 0, facet_angle_deg in (0, "
         "30], radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, "
-        "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits, step_cleanup.target_ratio >= 0, interior_size_factor in (0, 1]");
+        "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits, step_cleanup.target_ratio >= 0, interior_size_factor in (0, 1], "
+        "over_refinement_factor and min_vertex_cap >= 0");
   CgalMesh sm;
   if (!detail::to_cgal(surface, sm) || !CGAL::is_closed(sm))
     throw InputError("tetrahedralize_surface: the surface is not a closed manifold triangle mesh");
@@ -188,6 +207,19 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
                      std::to_string(volume) + "); is it oriented outward?");
   const double diagonal = (surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff()).norm();
   const double max_size = 0.5 * diagonal;  // a larger circumradius bound changes nothing
+  const double area = CGAL::Polygon_mesh_processing::area(sm);
+  // The vertex cap of a pass at `size`: over_refinement_factor x the vertices
+  // of regular tets whose circumradius is half the bound (as the initial guess
+  // below) filling the volume, plus half the surface triangles of that edge.
+  const auto vertex_cap = [&](double size) -> std::size_t {
+    if (o.over_refinement_factor <= 0.0) return 0;
+    const double a = size * 2.0 / std::sqrt(6.0);
+    const double f = o.interior_size_factor;
+    const double tets = volume / (a * a * a * f * f * f / (6.0 * std::sqrt(2.0)));
+    const double faces = area / (a * a * std::sqrt(3.0) / 4.0);
+    const double cap = o.over_refinement_factor * (tets / 5.0 + faces / 2.0);
+    return static_cast<std::size_t>(std::min(1e9, std::max<double>(o.min_vertex_cap, cap)));
+  };
   Domain domain(sm);
   TetrahedralizeResult res;
   if (o.feature_angle_deg > 0.0) {
@@ -201,10 +233,12 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
   double spent = 0.0;  // CPU seconds of all passes
   int retries_left = o.max_retries;
   std::string last_cause;
+  bool last_over_refined = false;
   std::vector<std::string> failures;
   // One bounded pass; false (and a note) when it failed.
   const auto attempt = [&](double size, bool optimise, TetMesh& out) {
     res.step_cleanup = {};
+    last_over_refined = false;
     StageLimits pl = o.limits;
     pl.cpu_seconds = std::min(o.limits.cpu_seconds - spent, o.pass_share * o.limits.cpu_seconds);
     if (pl.cpu_seconds < 0.5) {
@@ -223,7 +257,7 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       const std::string bytes = run_bounded(
           "tetrahedralize", pl,
           [&] {
-            TetMesh m = mesh_once(domain, surface, o, size, optimise);
+            TetMesh m = mesh_once(domain, surface, o, size, optimise, vertex_cap(size));
             if (m.T.rows() == 0) throw InputError("the mesher produced no tetrahedron");
             const std::string problem = boundary_problem(m);
             if (!problem.empty()) throw InputError(problem);
@@ -246,6 +280,7 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       throw;
     } catch (const InputError& e) {
       last_cause = e.what();
+      last_over_refined = last_cause.rfind(kOverRefined, 0) == 0;
     } catch (const CGAL::Failure_exception&) {  // only without isolation
       last_cause = "stage 'tetrahedralize' failed inside CGAL (an internal check did not hold)";
     }
@@ -255,15 +290,23 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     res.usage.peak_mb = std::max(res.usage.peak_mb, u.peak_mb);
     if (out.T.rows() > 0) return true;
     ++res.failed_passes;
+    if (last_over_refined) ++res.over_refined_passes;
     failures.push_back("cell size " + fmt(size) + ": " + last_cause);
     return false;
   };
   static constexpr double kNearby[] = {0.85, 1.15, 0.7, 1.3, 0.6, 1.5, 0.5, 1.7};
-  // Tries `size`, then nearby sizes while retries are left.
+  // Tries `size`, then nearby sizes while retries are left. A pass stopped
+  // by the vertex cap is retried once in all, at 1.5 x its size: runaway
+  // refinement comes from the surface's shape (gaps, sheets thinner than
+  // any size tried), not from the size, and a finer size only refines more.
   const auto attempt_near = [&](double size, bool optimise, TetMesh& out, double& used) {
     double prev = size;
     for (int k = -1; k < static_cast<int>(std::size(kNearby)); ++k) {
       used = k < 0 ? size : std::min(max_size, size * kNearby[k]);
+      if (k >= 0 && last_over_refined) {
+        if (res.over_refined_passes > 1) return false;
+        used = std::min(max_size, prev * 1.5);
+      }
       if (k >= 0) {
         if (retries_left-- <= 0) return false;
         res.notes.push_back("pass at cell size " + fmt(prev) + " failed (" +

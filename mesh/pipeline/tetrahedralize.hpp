@@ -56,6 +56,15 @@ struct TetrahedralizeOptions {
   /// limit) are retried at nearby cell sizes (x 0.85, 1.15, 0.7, 1.3, ...) up
   /// to this many times in all; each retry is reported in the result's notes.
   int max_retries = 6;
+  /// Deterministic stall guard: a refinement pass stops (and fails) at this
+  /// many times the vertices its size should give (regular tets of that size
+  /// filling the volume plus the surface's triangles; at least
+  /// min_vertex_cap). Runaway refinement (surfaces closer to each other than
+  /// the cell size: near-contact gaps, thin sheets) ran passes for minutes
+  /// into their CPU limit; with the cap it fails in seconds, and such a pass
+  /// is retried at most once, at a coarser size. 0: no cap.
+  double over_refinement_factor = 20.0;
+  int min_vertex_cap = 20000;
 };
 
 /// Result of tetrahedralize_surface().
@@ -66,6 +75,7 @@ struct TetrahedralizeResult {
   int passes = 0;        ///< meshing passes run (size search + the final optimised one)
   int feature_curves = 0;  ///< sharp-feature polylines protected
   int failed_passes = 0;  ///< passes that failed and were retried at another size
+  int over_refined_passes = 0;  ///< of them, passes stopped by the vertex cap
   StepCleanupReport step_cleanup;  ///< of the kept (optimised) pass
   /// One line per retry or notable event ("pass 2 at cell size 0.03 failed:
   /// ...; retrying at 0.0255").

@@ -115,6 +115,37 @@ TEST(TetCleanup, SliverBelowTheDihedralTargetIsRemoved) {
   EXPECT_LE(fem1.ratio, r.ratio_after * 1.0001);
 }
 
+TEST(TetCleanup, SliverIsRelocatedAwayWhenNoCollapseIsAllowed) {
+  // The same centre sliver with collapses off (max_collapses 0): the
+  // relocation phase moves a node of the sliver instead; the connectivity,
+  // every other node and the volume (the moved node is interior) stay.
+  TetMesh m;
+  ASSERT_TRUE(test::bcc_block_with_centre_sliver(m));
+  const TetMesh before = m;
+  const double volume0 = signed_tet_volumes(m.V, m.T).sum();
+  StepCleanupOptions o;
+  o.max_collapses = 0;
+  const StepCleanupReport r = raise_stable_step(m, o);
+  EXPECT_EQ(r.collapses + r.dihedral_collapses, 0);
+  EXPECT_GE(r.relocations, 1);
+  EXPECT_EQ(m.T, before.T);
+  EXPECT_EQ(m.F, before.F);
+  int moved = 0;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) moved += m.V.row(i) != before.V.row(i);
+  EXPECT_EQ(moved, 1);  // one node of the sliver, once
+  const TetQuality q = tet_quality(m);
+  EXPECT_LT(tet_quality(before).min_dihedral_deg, 10.0);
+  EXPECT_GE(q.min_dihedral_deg, 12.0);
+  EXPECT_NEAR(r.min_dihedral_after, q.min_dihedral_deg, 1e-9);
+  EXPECT_GT(q.min_volume, 0.0);
+  EXPECT_NEAR(signed_tet_volumes(m.V, m.T).sum(), volume0, 1e-9 * volume0);
+  // Off: nothing moves.
+  TetMesh off = before;
+  o.max_relocation_sweeps = 0;
+  EXPECT_EQ(raise_stable_step(off, o).relocations, 0);
+  EXPECT_EQ(off.V, before.V);
+}
+
 TEST(TetCleanup, BadOptionsAreRefused) {
   TetMesh m = bcc_block(2, 1.0);
   StepCleanupOptions o;
@@ -122,6 +153,9 @@ TEST(TetCleanup, BadOptionsAreRefused) {
   EXPECT_THROW(raise_stable_step(m, o), ParameterError);
   o = {};
   o.poisson = 0.5;
+  EXPECT_THROW(raise_stable_step(m, o), ParameterError);
+  o = {};
+  o.max_relocation_sweeps = -1;
   EXPECT_THROW(raise_stable_step(m, o), ParameterError);
 }
 
