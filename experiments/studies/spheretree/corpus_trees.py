@@ -19,6 +19,11 @@ OUT   output folder: corpus_trees.md, corpus_trees.csv, trees/<mesh>.sph, and,
       shuffled (fixed seed, each face rotated, orientation kept) and report
       whether the tree is the same file (.sph bytes) and, if not, how its
       leaves and mean162 differ (target: within 2 % and 5 %).
+--cached-only  do not preprocess or evaluate: rows come from OUT/rows/ only
+      (meshes without one are listed as not evaluated). Every evaluated mesh
+      leaves its row in OUT/rows/<mesh>.json, and a later run with the same OUT
+      reuses it, so runs over parts of the corpus (--meshes) can share OUT and
+      a last run writes the whole table.
 --subset  the CTest SphereTreeCorpus.Subset (a few seconds): mesh cross and
       its permuted copy, EXTRA = --coarse-tets 150 --no-hausdorff
       --sphere-depth 2 (the tree depends on the repaired surface, not on the
@@ -29,6 +34,7 @@ Exit status: 0 when the table was written (and, with --subset, every check
 passed), 1 otherwise; 2 for bad arguments.
 """
 import csv
+import json
 import os
 import random
 import re
@@ -205,7 +211,7 @@ def main(argv):
         print(__doc__, file=sys.stderr)
         return 2
     bin_dir, out = args[0], args[1]
-    runs, meshes, permuted, subset = [], None, [], False
+    runs, meshes, permuted, subset, cached_only = [], None, [], False, False
     i = 2
     while i < len(args):
         a = args[i]
@@ -220,6 +226,8 @@ def main(argv):
             permuted = [m for m in args[i + 1].split(",") if m]; i += 2
         elif a == "--subset":
             subset = True; i += 1
+        elif a == "--cached-only":
+            cached_only = True; i += 1
         else:
             print(f"corpus_trees.py: unknown argument {a}", file=sys.stderr)
             return 2
@@ -236,8 +244,21 @@ def main(argv):
     os.makedirs(out, exist_ok=True)
     sph_dir = os.path.join(out, "trees")
     rows, problems = [], []
+    rows_dir = os.path.join(out, "rows")
+    os.makedirs(rows_dir, exist_ok=True)
     for m in meshes:
         r = {"mesh": m}
+        cached = os.path.join(rows_dir, m + ".json")
+        if os.path.isfile(cached) and not subset:
+            r = json.load(open(cached))
+            rows.append(r)
+            if r["outcome"] != "ok":
+                problems.append(f"{m}: {r['outcome']}")
+            continue
+        if cached_only:
+            r["outcome"] = "not evaluated"
+            rows.append(r)
+            continue
         src = os.path.join(CORPUS, m + ".off")
         found = next((run for run in runs if run_holds(run, m)), None)
         if found:
@@ -254,6 +275,7 @@ def main(argv):
             t = re.search(r"\[read\][^\n]*?(\d+) triangles", log)
             r["triangles"] = t.group(1) if t else ""
             rows.append(r)
+            json.dump(r, open(cached, "w"))
             problems.append(f"{m}: {r['outcome']}")
             print(f"[trees] {m}: {r['outcome']}", flush=True)
             continue
@@ -262,6 +284,7 @@ def main(argv):
         r["outcome"] = "ok"
         r["build_wall_s"], r["build_cpu_s"] = stage_times(log)
         rows.append(r)
+        json.dump(r, open(cached, "w"))
         print(f"[trees] {m}: {r['leaves']} leaves, mean162 {r['mean162']}, mean2562 "
               f"{r['mean2562']}, uncovered {r['uncovered_pct']} %, build {r['build_cpu_s']} s CPU",
               flush=True)
@@ -291,6 +314,7 @@ def main(argv):
             dm = 100.0 * (float(e["mean162"]) / float(r["mean162"]) - 1)
             r["permuted"] = f"differs: leaves {dl:+.1f} %, mean162 {dm:+.1f} %"
             problems.append(f"{m}: permuted input gives another tree ({r['permuted']})")
+        json.dump(r, open(os.path.join(rows_dir, m + ".json"), "w"))
         print(f"[trees] {m} permuted: {r['permuted']}", flush=True)
     if subset:
         for r in rows:
