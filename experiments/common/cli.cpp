@@ -57,7 +57,9 @@ Cli& Cli::argument(const std::string& name, const std::string& help, bool requir
 Cli& Cli::arguments(const std::string& name, std::vector<std::filesystem::path>& target,
                     const std::string& help, bool required) {
   CLI::Option* o = m_impl->app.add_option(name, CLI::callback_t{}, help, false);
-  o->expected(-1)->type_name("");
+  // Every word goes to this one option: without TakeAll, CLI11 2.1 refuses a
+  // second word ("At Most 1 required but received 2").
+  o->expected(-1)->type_name("")->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   if (required) o->required();
   m_impl->entries.push_back(
       {o, name, [&target](const std::string& v) { target.emplace_back(v); }, false});

@@ -170,6 +170,28 @@ TEST(Cli, PositionalArgumentsBindInOrderAnywhereAmongTheOptions) {
   EXPECT_NE(usage.find("  THREADS"), std::string::npos) << usage;
 }
 
+TEST(Cli, ListArgumentTakesEveryRemainingWordInOrder) {
+  std::vector<std::filesystem::path> files;
+  bool quick = false;
+  auto apply_list = [&](const std::vector<std::string>& args) {
+    files.clear();
+    Cli cli("prog");
+    cli.arguments("FILE", files, "input files", true).flag("--quick", quick, "quick");
+    return cli.apply(args);
+  };
+  EXPECT_EQ(apply_list({"a.off"}), Outcome::Run);
+  EXPECT_EQ(files, (std::vector<std::filesystem::path>{"a.off"}));
+  EXPECT_EQ(apply_list({"a.off", "--quick", "b.obj", "c.ply"}), Outcome::Run);
+  EXPECT_EQ(files, (std::vector<std::filesystem::path>{"a.off", "b.obj", "c.ply"}));
+  EXPECT_TRUE(quick);
+  try {
+    apply_list({"--quick"});
+    ADD_FAILURE() << "a required list with no word must be refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "missing FILE");
+  }
+}
+
 TEST(Cli, UsageListsEveryOptionAndTheSummary) {
   Values v;
   Cli cli("prog", "Defaults: reps 5.");
