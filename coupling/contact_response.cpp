@@ -133,6 +133,28 @@ Eigen::SparseMatrix<double> sphere_to_node_matrix(const SphereTree& tree, int nu
   return D;
 }
 
+void add_contact_rates(const SphereTree& a, const SphereTree& b,
+                       const collision::CollisionResult& result, const ContactOptions& options,
+                       Eigen::VectorXd& rate_a, Eigen::VectorXd& rate_b) {
+  if (!options.mass_a || !options.mass_b)
+    throw ParameterError("contact response: node rates need mass_a and mass_b");
+  check_association(a, options.mass_a->size(), "a");
+  check_association(b, options.mass_b->size(), "b");
+  if (rate_a.size() != options.mass_a->size() || rate_b.size() != options.mass_b->size())
+    throw ParameterError("contact response: one rate per coarse node needed");
+  const double k = options.stiffness;
+  auto load = [&](const NodePair& p, double cap) {
+    const collision::Sphere& sa = a.spheres[p.a];
+    const collision::Sphere& sb = b.spheres[p.b];
+    if (!(std::min(sa.r + sb.r - (sb.center() - sa.center()).norm(), cap) > 0.0)) return;
+    add_rate(a, *options.mass_a, options.distribution, p.a, k, rate_a);
+    add_rate(b, *options.mass_b, options.distribution, p.b, k, rate_b);
+  };
+  for (const NodePair& p : result.colliding) load(p, std::numeric_limits<double>::infinity());
+  if (options.use_untested)
+    for (const NodePair& p : result.untested) load(p, options.max_untested_penetration);
+}
+
 ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
                                   const collision::CollisionResult& result,
                                   const ContactOptions& options, Eigen::Ref<MatX3d> forces_a,
@@ -171,28 +193,25 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
       acc_b(forces_b, b, options.distribution, options.mass_b);
   ContactStats stats;
   const double k = options.stiffness;
-  auto depth = [&](const NodePair& p, double cap) {
-    const collision::Sphere& sa = a.spheres[p.a];
-    const collision::Sphere& sb = b.spheres[p.b];
-    return std::min(sa.r + sb.r - (sb.center() - sa.center()).norm(), cap);
-  };
   if (!(options.max_untested_penetration > 0.0))
     throw ParameterError("contact response: max_untested_penetration must be positive (got " +
                          std::to_string(options.max_untested_penetration) + ")");
-  // With a node rate cap: first every node's rate at the full k, then each
-  // pair weighted by the most loaded node of its two spheres.
-  Eigen::VectorXd rate_a, rate_b;
+  // With a node rate cap: first every node's rate at the full k (given, over
+  // all object pairs, or of this call's pairs), then each pair weighted by
+  // the most loaded node of its two spheres.
+  Eigen::VectorXd own_a, own_b;
+  const Eigen::VectorXd* rate_a = options.total_rate_a;
+  const Eigen::VectorXd* rate_b = options.total_rate_b;
   if (capped) {
-    rate_a = Eigen::VectorXd::Zero(forces_a.rows());
-    rate_b = Eigen::VectorXd::Zero(forces_b.rows());
-    auto load = [&](const NodePair& p, double cap) {
-      if (!(depth(p, cap) > 0.0)) return;
-      add_rate(a, *options.mass_a, options.distribution, p.a, k, rate_a);
-      add_rate(b, *options.mass_b, options.distribution, p.b, k, rate_b);
-    };
-    for (const NodePair& p : result.colliding) load(p, std::numeric_limits<double>::infinity());
-    if (options.use_untested)
-      for (const NodePair& p : result.untested) load(p, options.max_untested_penetration);
+    if ((rate_a && rate_a->size() != forces_a.rows()) || (rate_b && rate_b->size() != forces_b.rows()))
+      throw ParameterError("contact response: total_rate_a / total_rate_b must hold one rate per coarse node");
+    if (!rate_a || !rate_b) {
+      own_a = Eigen::VectorXd::Zero(forces_a.rows());
+      own_b = Eigen::VectorXd::Zero(forces_b.rows());
+      add_contact_rates(a, b, result, options, own_a, own_b);
+      rate_a = &own_a;
+      rate_b = &own_b;
+    }
   }
   auto respond = [&](const NodePair& p, double cap, bool leaf) {
     const collision::Sphere& sa = a.spheres[p.a];
@@ -204,7 +223,7 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     const Eigen::Vector3d n = dist > 1e-12 * (sa.r + sb.r) ? Eigen::Vector3d(d / dist) : fallback;
     double kp = k;
     if (capped) {
-      double w = std::min(weight_of(a, p.a, rate_a, rate_cap), weight_of(b, p.b, rate_b, rate_cap));
+      double w = std::min(weight_of(a, p.a, *rate_a, rate_cap), weight_of(b, p.b, *rate_b, rate_cap));
       if (!std::isfinite(w)) w = 1;
       w = std::min(w, 1.0);
       if (w < 1) {
@@ -236,8 +255,13 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
     stats.total_force_a = acc_a.finish();
     stats.total_force_b = acc_b.finish();
   }
-  if (options.mass_a && options.mass_b && stats.active_pairs > 0)
+  if (options.mass_a && options.mass_b && stats.active_pairs > 0) {
     stats.max_rate = acc_a.rate.maxCoeff() + acc_b.rate.maxCoeff();
+    if (options.applied_rate_a && options.applied_rate_a->size() == acc_a.rate.size())
+      *options.applied_rate_a += acc_a.rate;
+    if (options.applied_rate_b && options.applied_rate_b->size() == acc_b.rate.size())
+      *options.applied_rate_b += acc_b.rate;
+  }
   stats.max_node_stiffness = std::max(acc_a.stiffness.size() ? acc_a.stiffness.maxCoeff() : 0.0,
                                       acc_b.stiffness.size() ? acc_b.stiffness.maxCoeff() : 0.0);
   return stats;

@@ -66,6 +66,19 @@ struct ContactOptions {
   /// (momentum conserved) and nodes with few pairs keep the full k. Needs
   /// mass_a and mass_b. Not applied to PaperAverage.
   double node_rate_limit = std::numeric_limits<double>::infinity();
+  /// With node_rate_limit: each node's rate over every pair it takes part
+  /// in this cycle, of all object pairs (add_contact_rates() summed over
+  /// them; #coarse nodes of a / b). The weights then hold a node touched by
+  /// several objects at the cap in all (not at the cap per object pair).
+  /// Null: this call's pairs only.
+  const Eigen::VectorXd* total_rate_a = nullptr;
+  const Eigen::VectorXd* total_rate_b = nullptr;
+  /// When set (and both masses given): the node rates of the forces applied
+  /// (weighted by the cap) are added to them (#coarse nodes of a / b), so a
+  /// caller can sum them over object pairs (the stability bound of several
+  /// pairs: World's softening).
+  Eigen::VectorXd* applied_rate_a = nullptr;
+  Eigen::VectorXd* applied_rate_b = nullptr;
 };
 
 /// What the response did.
@@ -131,6 +144,17 @@ DeepContactStats deep_contact_velocity_step(const collision::SphereTree& a,
 /// so node_forces = D * sphere_forces (PartitionOfUnity).
 Eigen::SparseMatrix<double> sphere_to_node_matrix(const collision::SphereTree& tree,
                                                   int num_coarse_nodes);
+
+/// Adds to rate_a / rate_b (#coarse nodes of a / b) each node's penalty
+/// rate k share / m_n, at the full stiffness, of the pairs of `result` that
+/// respond (as apply_contact_forces(): colliding pairs, and untested ones
+/// with use_untested, at most max_untested_penetration deep): summed over
+/// the object pairs of a cycle, the totals ContactOptions::total_rate_a/b
+/// weigh against. Needs mass_a and mass_b; throws ParameterError as
+/// apply_contact_forces() for missing associations or masses.
+void add_contact_rates(const collision::SphereTree& a, const collision::SphereTree& b,
+                       const collision::CollisionResult& result, const ContactOptions& options,
+                       Eigen::VectorXd& rate_a, Eigen::VectorXd& rate_b);
 
 /// Computes penalty forces for the pairs of `result` between trees a and b
 /// (current spheres) and adds them to forces_a (#coarse nodes of a x 3) and

@@ -66,6 +66,14 @@ LinkEvaluator::LinkEvaluator(const RigidLinks& links, const LinkEvaluatorOptions
     m_link_triple[k] = slot[at];
     ++m_links_per_triple[slot[at]];
   }
+  const int T0 = num_triples();
+  m_triple_offset.assign(static_cast<size_t>(T0) + 1, 0);
+  for (int t = 0; t < T0; ++t) m_triple_offset[t + 1] = m_triple_offset[t] + m_links_per_triple[t];
+  m_triple_links.resize(N);
+  {
+    std::vector<int32_t> next(m_triple_offset.begin(), m_triple_offset.end() - 1);
+    for (int k = 0; k < N; ++k) m_triple_links[next[m_link_triple[k]]++] = k;
+  }
   m_weights.resize(6, N);
   m_weights.topRows(3) = links.alpha.transpose();
   m_weights.bottomRows(3) = links.coeffs.transpose();
@@ -85,8 +93,48 @@ LinkApplyResult LinkEvaluator::apply(const Eigen::Ref<const MatX3d>& coarse_posi
   if (dense_out.rows() != num_links())
     throw ParameterError("LinkEvaluator::apply: dense_out has " + std::to_string(dense_out.rows()) +
                          " rows, expected " + std::to_string(num_links()));
-  const LinkApplyResult result = update_triples(coarse_positions);
+  const LinkApplyResult result =
+      update_triples(coarse_positions, num_triples(), [](int i) { return i; });
   evaluate_links(dense_out);
+  return result;
+}
+
+LinkApplyResult LinkEvaluator::apply_triples(const Eigen::Ref<const MatX3d>& coarse_positions,
+                                             const std::vector<int32_t>& triples,
+                                             Eigen::Ref<MatX3d> dense_out) {
+  if (coarse_positions.rows() != m_num_coarse_nodes)
+    throw ParameterError("LinkEvaluator::apply_triples: coarse_positions has " +
+                         std::to_string(coarse_positions.rows()) + " rows, the links expect " +
+                         std::to_string(m_num_coarse_nodes));
+  if (dense_out.rows() != num_links())
+    throw ParameterError("LinkEvaluator::apply_triples: dense_out has " +
+                         std::to_string(dense_out.rows()) + " rows, expected " +
+                         std::to_string(num_links()));
+  for (int32_t t : triples)
+    if (t < 0 || t >= num_triples())
+      throw ParameterError("LinkEvaluator::apply_triples: no triple " + std::to_string(t));
+  const int count = static_cast<int>(triples.size());
+  const LinkApplyResult result =
+      update_triples(coarse_positions, count, [&](int i) { return triples[static_cast<size_t>(i)]; });
+  using Packet = Eigen::Map<const Eigen::Vector4d, Eigen::Aligned16>;
+  const double* table = m_table.data();
+  const double* weights = m_weights.data();
+  double* out = dense_out.data();
+  const Eigen::Index stride = dense_out.outerStride();
+  for (int32_t t : triples) {
+    const double* m = table + 24 * static_cast<Eigen::Index>(t);
+    for (int32_t j = m_triple_offset[t]; j < m_triple_offset[t + 1]; ++j) {
+      const int32_t k = m_triple_links[j];
+      const double* w = weights + 6 * static_cast<Eigen::Index>(k);
+      // (the expression of evaluate_links(): the same rounding)
+      const Eigen::Vector4d p = w[0] * Packet(m) + w[1] * Packet(m + 4) + w[2] * Packet(m + 8) +
+                                w[3] * Packet(m + 12) + w[4] * Packet(m + 16) + w[5] * Packet(m + 20);
+      double* row = out + k * stride;
+      row[0] = p[0];
+      row[1] = p[1];
+      row[2] = p[2];
+    }
+  }
   return result;
 }
 
@@ -104,20 +152,22 @@ void LinkEvaluator::check_finite(const Eigen::Ref<const MatX3d>& coarse_position
 // are also copied into the table for the link loop; the frames go into the
 // table, except for degenerate triples, which get fallback_frame(). Throws
 // when a node is not finite (before any fallback frame of its chunk).
-LinkApplyResult LinkEvaluator::update_triples(const Eigen::Ref<const MatX3d>& coarse_positions) {
+template <class Index>
+LinkApplyResult LinkEvaluator::update_triples(const Eigen::Ref<const MatX3d>& coarse_positions,
+                                              int count, Index index) {
   constexpr int kLanes = 2;  // one SSE2 packet: wider lanes spill more than they gain
   static_assert(kLanes == 2, "the gather below fills two lanes");
   using Lane = Eigen::Array<double, kLanes, 1>;
-  const int T = num_triples();
   const double* X = coarse_positions.data();
   const Eigen::Index stride = coarse_positions.outerStride();
   double* table = m_table.data();
   const double tol2 = m_options.degenerate_tolerance * m_options.degenerate_tolerance;
   LinkApplyResult result;
-  for (int t0 = 0; t0 < T; t0 += kLanes) {
-    // Lane l holds triple t0 + l (the last one repeated past the end); the
-    // nodes also go into the table for the link loop.
-    const int t1 = std::min(t0 + 1, T - 1);
+  for (int i0 = 0; i0 < count; i0 += kLanes) {
+    // Lane l holds triple index(i0 + l) (the last one repeated past the
+    // end); the nodes also go into the table for the link loop.
+    const int t0 = index(i0);
+    const int t1 = index(std::min(i0 + 1, count - 1));
     const double* rows[2][3];
     for (int i = 0; i < 3; ++i) {
       rows[0][i] = X + m_triple_nodes[3 * t0 + i] * stride;
@@ -148,14 +198,14 @@ LinkApplyResult LinkEvaluator::update_triples(const Eigen::Ref<const MatX3d>& co
                        uz * minus_inv_u, ax * inv_a, ay * inv_a, az * inv_a};
     const Eigen::Array<bool, kLanes, 1> ok =
         (nn > 0.0) && (nn > tol2 * uu * vv) && (nn < std::numeric_limits<double>::infinity());
-    const int lanes = std::min(kLanes, T - t0);
+    const int lanes = std::min(kLanes, count - i0);
     const bool all_ok = ok.head(lanes).all();
     // A non-finite node makes |u|^2 or |v|^2 non-finite (so does overflow,
     // which check_finite() lets through as a degenerate frame).
     if (!all_ok && !((uu + vv).head(lanes) < std::numeric_limits<double>::infinity()).all())
       check_finite(coarse_positions);
     for (int l = 0; l < lanes; ++l) {
-      const int t = t0 + l;
+      const int t = l == 0 ? t0 : t1;
       if (!all_ok && !ok[l]) {  // keeps the previous frame for the fallback
         fallback_frame(t);
         ++result.degenerate_triples;

@@ -82,6 +82,15 @@ class LinkEvaluator {
   LinkApplyResult apply(const Eigen::Ref<const MatX3d>& coarse_positions,
                         Eigen::Ref<MatX3d> dense_out);
 
+  /// As apply(), for the links of the listed triples only (indices in
+  /// [0, num_triples()), no repeats, any order): their rows of dense_out are
+  /// written, bitwise equal to what apply() writes there (the same
+  /// arithmetic, lane by lane); the other rows are left as they are. Only
+  /// the listed triples' frame state is updated. For callers that need a
+  /// few links, e.g. the dense vertices near a static obstacle.
+  LinkApplyResult apply_triples(const Eigen::Ref<const MatX3d>& coarse_positions,
+                                const std::vector<int32_t>& triples, Eigen::Ref<MatX3d> dense_out);
+
   /// Forgets the frame state: the next apply() behaves as on a new evaluator.
   void reset_frames();
 
@@ -89,10 +98,19 @@ class LinkEvaluator {
   int num_coarse_nodes() const { return m_num_coarse_nodes; }
   /// Number of distinct ordered node triples (q0, q1, q2) among the links.
   int num_triples() const { return static_cast<int>(m_links_per_triple.size()); }
+  /// The three coarse node indices (q0, q1, q2) of triple t.
+  const int32_t* triple_nodes(int t) const { return &m_triple_nodes[3 * static_cast<size_t>(t)]; }
+  /// The links of triple t, ascending: [links_of_triple(t), links_of_triple(t + 1)) of
+  /// triple_links().
+  int32_t links_of_triple(int t) const { return m_triple_offset[static_cast<size_t>(t)]; }
+  const std::vector<int32_t>& triple_links() const { return m_triple_links; }
 
  private:
   void check_finite(const Eigen::Ref<const MatX3d>& coarse_positions) const;
-  LinkApplyResult update_triples(const Eigen::Ref<const MatX3d>& coarse_positions);
+  /// Frames of the triples index(0), ..., index(count - 1).
+  template <class Index>
+  LinkApplyResult update_triples(const Eigen::Ref<const MatX3d>& coarse_positions, int count,
+                                 Index index);
   void fallback_frame(int t);
   void evaluate_links(Eigen::Ref<MatX3d> dense_out) const;
 
@@ -103,6 +121,9 @@ class LinkEvaluator {
   std::vector<int32_t> m_triple_nodes;
   std::vector<int32_t> m_links_per_triple;  ///< #T
   std::vector<int32_t> m_link_triple;       ///< #N: triple of each link
+  /// The links of each triple, ascending (#N), and where each triple's start
+  /// (#T + 1).
+  std::vector<int32_t> m_triple_links, m_triple_offset;
   /// 6 x #N (column k: alpha_k0..2, c_k0..2 of link k).
   Eigen::Matrix<double, 6, Eigen::Dynamic> m_weights;
   /// 24 x #T, column t: q0, q1, q2, e0, e1, e2 of triple t, each padded to 4

@@ -188,6 +188,16 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
       if (!o.sim) continue;  // static and kinematic objects move as they are told
       if (o.links.num_links() == 0) o.links = LinkEvaluator(o.asset.links);
       o.max_link = o.asset.links.coeffs.rows() ? o.asset.links.coeffs.rowwise().norm().maxCoeff() : 0;
+      o.triple_reach.assign(static_cast<size_t>(o.links.num_triples()), 0.0);
+      for (int t = 0; t < o.links.num_triples(); ++t)
+        for (int32_t j = o.links.links_of_triple(t); j < o.links.links_of_triple(t + 1); ++j) {
+          const int32_t k = o.links.triple_links()[static_cast<size_t>(j)];
+          double& reach = o.triple_reach[static_cast<size_t>(t)];
+          if (reach < 0) break;
+          reach = o.asset.links.alpha.row(k).minCoeff() < 0
+                      ? -1.0
+                      : std::max(reach, o.asset.links.coeffs.row(k).norm());
+        }
       std::vector<double> leaves;
       const collision::SphereTree& t = o.asset.spheres;
       for (int i = 0; i < t.num_nodes(); ++i)
@@ -774,20 +784,21 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
     m_node_stiffness = 0;
     m_contact_rate = 0;
     m_penalty_energy = 0;
-    for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+    // Each pair's options and the answer it responds to.
+    const auto pair_options = [&](size_t p, ContactOptions& co, bool& reuse) {
       const auto [i, j] = m_plan.pairs[p];
       RuntimeObject& a = m_objects[i];
       RuntimeObject& b = m_objects[j];
-      ContactOptions co = cs.contact;
+      co = cs.contact;
       const Eigen::Vector3d ca = a.positions.colwise().mean().transpose();
       const Eigen::Vector3d cb = b.positions.colwise().mean().transpose();
       co.coincident_direction = cb - ca;
       co.mass_a = &a.node_mass;
       co.mass_b = &b.node_mass;
-      // Each object's nodes a little under half the stable rate (the
-      // softening below adds the two objects' largest rates; at exactly half,
-      // rounding tipped it over and, the scale only falling during an
-      // episode, softened every later cycle).
+      // Each node a little under half the stable rate, over all the pairs
+      // it takes part in (the softening below adds the largest rates of the
+      // two sides of a pair; at exactly half, rounding tipped it over and,
+      // the scale only falling during an episode, softened every later cycle).
       if (cs.node_rate_cap)
         co.node_rate_limit = 0.45 * (kContactOmegaLimit / h) * (kContactOmegaLimit / h);
       // An interrupted query answers with coarse spheres; with on_interrupt =
@@ -799,16 +810,50 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
                             std::isfinite(m_complete_time[p]);
       // (relative slack: cycle end times are sums of h, the age of a
       // one-frame-old answer can exceed 1 / frame_rate by rounding)
-      const bool reuse = previous && t_end - m_complete_time[p] <= cs.previous_max_age * (1 + 1e-9);
+      reuse = previous && t_end - m_complete_time[p] <= cs.previous_max_age * (1 + 1e-9);
       if (previous && !reuse && m_complete_depth[p] > 0)
         co.max_untested_penetration = m_complete_depth[p];
+    };
+    // Node rates over all pairs: the total each node's cap weighs against
+    // (a node touched by two objects must not get the cap from each), and
+    // the rates applied, whose sums bound the frequency of all the springs.
+    m_total_rate.resize(m_objects.size());
+    m_applied_rate.resize(m_objects.size());
+    for (size_t k = 0; k < m_objects.size(); ++k) {
+      m_total_rate[k].setZero(m_objects[k].rest.rows());
+      m_applied_rate[k].setZero(m_objects[k].rest.rows());
+    }
+    if (cs.node_rate_cap)
+      for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+        const auto [i, j] = m_plan.pairs[p];
+        ContactOptions co;
+        bool reuse = false;
+        pair_options(p, co, reuse);
+        naming(m_objects[i], m_objects[j], [&] {
+          add_contact_rates(m_objects[i].asset.spheres, m_objects[j].asset.spheres,
+                            reuse ? m_complete[p] : m_results[p], co, m_total_rate[i], m_total_rate[j]);
+        });
+      }
+    for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
+      const auto [i, j] = m_plan.pairs[p];
+      RuntimeObject& a = m_objects[i];
+      RuntimeObject& b = m_objects[j];
+      ContactOptions co;
+      bool reuse = false;
+      pair_options(p, co, reuse);
+      if (cs.node_rate_cap) {
+        co.total_rate_a = &m_total_rate[i];
+        co.total_rate_b = &m_total_rate[j];
+      }
+      co.applied_rate_a = &m_applied_rate[i];
+      co.applied_rate_b = &m_applied_rate[j];
+      const collision::CollisionResult& r = m_results[p];
       if (reuse) ++m.reused;
       const ContactStats st = naming(a, b, [&] {
         return apply_contact_forces(a.asset.spheres, b.asset.spheres, reuse ? m_complete[p] : r, co,
                                     a.contact_forces, b.contact_forces);
       });
       if (!r.interrupted) m_complete_depth[p] = st.max_penetration;
-      m_contact_rate += st.max_rate;
       m_pair_depth[p] = st.max_penetration;
       m_node_stiffness = std::max(m_node_stiffness, st.max_node_stiffness);
       m_penalty_energy += st.penalty_energy;
@@ -845,6 +890,17 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         m.contact_force += st.total_force_a.norm();
       }
     }
+    // The largest frequency of all the springs together: at most the largest
+    // over responding pairs of the two sides' largest node rates, each summed
+    // over every pair the node takes part in (Gershgorin on B^T M^-1 B W,
+    // B the pairs' node share vectors: row p sums to at most the rates of
+    // p's nodes weighted by shares that add up to 1 per side). For one
+    // object pair: ContactStats::max_rate.
+    for (size_t p = 0; p < m_plan.pairs.size(); ++p)
+      if (m_pair_depth[p] > 0) {
+        const auto [i, j] = m_plan.pairs[p];
+        m_contact_rate = std::max(m_contact_rate, m_applied_rate[i].maxCoeff() + m_applied_rate[j].maxCoeff());
+      }
   }
   // Past the staggered scheme's stability margin (explicit limit: omega h = 2)
   // soften the response rather than let it pump energy. The scale only
@@ -853,8 +909,8 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
   if (m_plan.response) {
     if (m_node_stiffness == 0 && contact_free()) m_contact_scale = 1;
     if (m_node_stiffness > 0) {
-      // Per node: its own stiffness over its own mass (ContactStats::
-      // max_rate, summed over the pairs: a bound for a node in several).
+      // Per node: its own stiffness over its own mass (the rates summed
+      // over the pairs, see above).
       // Not the largest stiffness over the lightest mass of all objects:
       // those are on different nodes, and on the 600-tet meshes of
       // many_objects (lightest node 7.4e-6 kg) that bound was 4x the
@@ -907,21 +963,96 @@ void World::limit_contact_work(double h, FrameMetrics& m) {
   ++m.limited;
 }
 
+void World::obstacle_layer(RuntimeObject& o, double threshold, bool same_triples) const {
+  const int num_links = o.asset.links.num_links();
+  if (o.obstacle_dense.rows() != num_links) o.obstacle_dense.resize(num_links, 3);
+  if (same_triples && m_settings.obstacle_cull) {  // the same layer at the current positions
+    o.links.apply_triples(o.positions, o.obstacle_triples, o.obstacle_dense);
+    return;
+  }
+  o.obstacle_layer.clear();
+  if (!m_settings.obstacle_cull) {  // the reference: every vertex
+    o.links.apply(o.positions, o.obstacle_dense);
+    for (int v = 0; v < num_links; ++v) o.obstacle_layer.push_back(v);
+    return;
+  }
+  // Each near obstacle's linear coordinates of the nodes: a box's local
+  // coordinates (its signed distance is at least max_k |q_k| - h_k), a
+  // plane's signed distance. Linear, so a vertex's value lies within its
+  // link's |c| of the range of its triple's nodes' values (its origin is a
+  // convex combination of them, the frame orthonormal).
+  const int n = static_cast<int>(o.positions.rows());
+  o.obstacle_local.resize(m_settings.obstacles.size());
+  const double scale = o.positions.cwiseAbs().maxCoeff() + o.max_link;
+  std::vector<double> slack(m_settings.obstacles.size(), 0.0);
+  for (int b : o.obstacle_near) {
+    const Obstacle& ob = m_settings.obstacles[static_cast<size_t>(b)];
+    MatX3d& q = o.obstacle_local[static_cast<size_t>(b)];
+    if (ob.type == Obstacle::Type::Plane) {
+      q.resize(n, 3);
+      q.col(0) = (o.positions.rowwise() - ob.point.transpose()) * ob.normal;
+    } else {
+      q = (o.positions.rowwise() - ob.point.transpose()) * ob.axes;
+    }
+    // Rounding of the links, of the signed distance and of origin weights
+    // that sum to 1 within 1e-9 (validate(RigidLinks)): far below it.
+    slack[static_cast<size_t>(b)] =
+        1e-8 * (1 + scale + ob.point.cwiseAbs().maxCoeff() +
+                (ob.type == Obstacle::Type::Box ? ob.half_extents.maxCoeff() : 0.0));
+  }
+  o.obstacle_triples.clear();
+  const int num_triples = o.links.num_triples();
+  for (int t = 0; t < num_triples; ++t) {
+    const double reach = o.triple_reach[static_cast<size_t>(t)];
+    bool take = reach < 0;
+    const int32_t* nodes = o.links.triple_nodes(t);
+    for (size_t i = 0; i < o.obstacle_near.size() && !take; ++i) {
+      const int b = o.obstacle_near[i];
+      const Obstacle& ob = m_settings.obstacles[static_cast<size_t>(b)];
+      const MatX3d& q = o.obstacle_local[static_cast<size_t>(b)];
+      double bound;
+      if (ob.type == Obstacle::Type::Plane) {
+        bound = std::min({q(nodes[0], 0), q(nodes[1], 0), q(nodes[2], 0)});
+      } else {
+        bound = -std::numeric_limits<double>::infinity();
+        for (int k = 0; k < 3; ++k) {
+          const double lo = std::min({q(nodes[0], k), q(nodes[1], k), q(nodes[2], k)});
+          const double hi = std::max({q(nodes[0], k), q(nodes[1], k), q(nodes[2], k)});
+          bound = std::max(bound, std::max(lo, -hi) - ob.half_extents[k]);
+        }
+      }
+      // (NaN: taken)
+      take = !(bound - reach - slack[static_cast<size_t>(b)] >= threshold);
+    }
+    if (take) o.obstacle_triples.push_back(t);
+  }
+  o.links.apply_triples(o.positions, o.obstacle_triples, o.obstacle_dense);
+  const std::vector<int32_t>& links = o.links.triple_links();
+  for (int32_t t : o.obstacle_triples)
+    o.obstacle_layer.insert(o.obstacle_layer.end(), links.begin() + o.links.links_of_triple(t),
+                            links.begin() + o.links.links_of_triple(t + 1));
+  // (in triple order: the callers break ties by vertex index, as a pass over
+  // every vertex in order would)
+}
+
 void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
                               const Eigen::Vector3d& hi_in, double support_work) const {
   // Within reach? The dense surface lies within max_link of the coarse
   // nodes' convex hull (a link origin is a convex combination of three
-  // nodes; the link keeps its length), which lies in [lo, hi].
+  // nodes; the link keeps its length), which lies in [lo, hi]. Only the
+  // obstacles within reach are tested.
   const Eigen::Vector3d pad = Eigen::Vector3d::Constant(o.max_link);
   const Eigen::Vector3d lo = lo_in - pad, hi = hi_in + pad;
-  bool near = false;
-  for (const Obstacle& ob : m_settings.obstacles) near = near || ob.lower_bound(lo, hi) <= 0;
-  if (!near) return;
+  o.obstacle_near.clear();
+  for (size_t b = 0; b < m_settings.obstacles.size(); ++b)
+    if (m_settings.obstacles[b].lower_bound(lo, hi) <= 0) o.obstacle_near.push_back(static_cast<int>(b));
+  if (o.obstacle_near.empty()) return;
   o.near_obstacle = true;
-  const double e_before = mechanical_energy(*o.sim, m_settings.gravity);
+  // The energy before the projection: the state as it is until the first
+  // move (only needed when something moves).
+  double e_before = 0;
   const int n = static_cast<int>(o.positions.rows());
   MatX3d corr(n, 3), dir = MatX3d::Zero(n, 3);
-  o.obstacle_dense.resize(o.asset.links.num_links(), 3);
   const auto& nodes = o.asset.links.nodes;
   // Fixed nodes stay where they are (a vertex held only by fixed nodes stays
   // inside; obstacle_depth reports it).
@@ -931,14 +1062,23 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
   // moves by their weighted mean plus a small rotation of its link.
   constexpr int kPasses = 6;
   constexpr double kTolerance = 1e-6;  // m
+  // The layer is found once, kObstacleStep wider than needed, and kept while
+  // the passes have moved no node farther than that (a node moving by D
+  // changes the layer's bound by at most D).
+  constexpr double kMargin = kObstacleStep;
+  double shifted = 0;  // largest total correction of a node since the layer was found, bound
+  std::vector<int32_t> setter(static_cast<size_t>(n));  // the vertex that set corr.row(j)
   bool moved = false;
   for (int pass = 0; pass < kPasses; ++pass) {
-    o.links.apply(o.positions, o.obstacle_dense);
+    const bool keep = pass > 0 && shifted <= kMargin;
+    obstacle_layer(o, -kTolerance + kMargin, keep);
+    if (!keep) shifted = 0;
     corr.setZero();
     bool inside = false;
-    for (int v = 0; v < o.obstacle_dense.rows(); ++v) {
+    for (int32_t v : o.obstacle_layer) {
       const Eigen::Vector3d p = o.obstacle_dense.row(v).transpose();
-      for (const Obstacle& ob : m_settings.obstacles) {
+      for (int b : o.obstacle_near) {
+        const Obstacle& ob = m_settings.obstacles[static_cast<size_t>(b)];
         Eigen::Vector3d nrm;
         const double d = ob.signed_distance(p, &nrm);
         if (!(d < -kTolerance)) continue;
@@ -947,20 +1087,31 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
           o.cycle_obstacle_depth = std::max(o.cycle_obstacle_depth, -d);
           ++o.cycle_obstacle_vertices;
         }
+        // Per node the largest correction; between equal ones, that of the
+        // lowest vertex (the layer comes in triple order).
         const Eigen::Vector3d need = -d * nrm;
+        const double need2 = need.squaredNorm();
         for (int k = 0; k < 3; ++k) {
           const int j = nodes(v, k);
-          if (!fixed[static_cast<size_t>(j)] && need.squaredNorm() > corr.row(j).squaredNorm())
+          if (fixed[static_cast<size_t>(j)]) continue;
+          const double have2 = corr.row(j).squaredNorm();
+          if (need2 > have2 || (need2 == have2 && have2 > 0 && v < setter[static_cast<size_t>(j)])) {
             corr.row(j) = need.transpose();
+            setter[static_cast<size_t>(j)] = v;
+          }
         }
       }
     }
     if (!inside) break;
+    if (!moved) e_before = mechanical_energy(*o.sim, m_settings.gravity);
+    double largest = 0;
     for (int j = 0; j < n; ++j)
       if (corr.row(j).squaredNorm() > 0) {
         o.positions.row(j) += corr.row(j);
         dir.row(j) = corr.row(j).normalized();
+        largest = std::max(largest, corr.row(j).norm());
       }
+    shifted += largest * (1 + 1e-12);
     moved = true;
   }
   MatX3d vel = o.sim->velocities();
@@ -979,8 +1130,8 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
   // they added beyond what the removed velocity took away is taken from the
   // kinetic energy (every velocity scaled alike); what it cannot pay now is
   // paid by the next cycles.
-  const double e_after = moved ? mechanical_energy(*o.sim, m_settings.gravity) : e_before;
-  const double excess = e_after - e_before + support_work + o.obstacle_debt;
+  const double change = moved ? mechanical_energy(*o.sim, m_settings.gravity) - e_before : 0.0;
+  const double excess = change + support_work + o.obstacle_debt;
   if (!(excess > 0)) {
     o.obstacle_debt = 0;
     return;
@@ -992,19 +1143,36 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
 }
 
 bool World::obstacle_support(RuntimeObject& o) const {
-  o.obstacle_dense.resize(o.asset.links.num_links(), 3);
-  o.links.apply(o.positions, o.obstacle_dense);
+  // Only the obstacles a vertex may be within kObstacleContact of (see
+  // resolve_obstacles; 1 um more against rounding).
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(o.max_link + kObstacleContact + 1e-6);
+  const Eigen::Vector3d lo = o.positions.colwise().minCoeff().transpose() - pad;
+  const Eigen::Vector3d hi = o.positions.colwise().maxCoeff().transpose() + pad;
+  o.obstacle_near.clear();
+  for (size_t b = 0; b < m_settings.obstacles.size(); ++b)
+    if (!(m_settings.obstacles[b].lower_bound(lo, hi) > 0)) o.obstacle_near.push_back(static_cast<int>(b));
+  if (o.obstacle_near.empty()) return false;
+  obstacle_layer(o, kObstacleContact);
   const int n = static_cast<int>(o.positions.rows());
   MatX3d normal = MatX3d::Zero(n, 3);
+  // Per node the normal of its highest vertex touching (the layer comes in
+  // triple order; a pass over every vertex in order keeps the last).
+  std::vector<int32_t> writer(static_cast<size_t>(n), -1);
   const auto& nodes = o.asset.links.nodes;
   bool any = false;
-  for (int v = 0; v < o.obstacle_dense.rows(); ++v) {
+  for (int32_t v : o.obstacle_layer) {
     const Eigen::Vector3d p = o.obstacle_dense.row(v).transpose();
-    for (const Obstacle& ob : m_settings.obstacles) {
+    for (int b : o.obstacle_near) {
+      const Obstacle& ob = m_settings.obstacles[static_cast<size_t>(b)];
       Eigen::Vector3d nrm;
       if (!(ob.signed_distance(p, &nrm) < kObstacleContact)) continue;
       any = true;
-      for (int k = 0; k < 3; ++k) normal.row(nodes(v, k)) = nrm.transpose();
+      for (int k = 0; k < 3; ++k) {
+        const int j = nodes(v, k);
+        if (v < writer[static_cast<size_t>(j)]) continue;
+        normal.row(j) = nrm.transpose();
+        writer[static_cast<size_t>(j)] = v;
+      }
     }
   }
   if (!any) return false;

@@ -140,6 +140,17 @@ struct RuntimeObject {
   double max_link = 0;
   double obstacle_scale = 0;
   MatX3d obstacle_dense;
+  /// Per link triple (LinkEvaluator): the longest link vector |c| of its
+  /// links, m (-1: some link has a negative origin weight, no bound: always
+  /// evaluated). A link's vertex lies within it of its origin, a convex
+  /// combination of the triple's nodes (World::obstacle_layer).
+  std::vector<double> triple_reach;
+  /// Scratch of the obstacle handling: the obstacles within reach, the node
+  /// coordinates in each one's frame, the triples and the dense vertices
+  /// (in triple order) that may be near one.
+  std::vector<int> obstacle_near;
+  std::vector<MatX3d> obstacle_local;
+  std::vector<int32_t> obstacle_triples, obstacle_layer;
   bool near_obstacle = false;  ///< came within reach of an obstacle in the last cycle
   /// Support of the obstacles for the coming cycle (#coarse nodes x 3, N;
   /// empty when none): see World::obstacle_support.
@@ -327,6 +338,21 @@ class World {
   /// the cycle has (almost) nothing to do. Frictionless and unilateral.
   /// Returns whether any node is supported. Touches object o only.
   bool obstacle_support(RuntimeObject& o) const;
+  /// The dense vertices of o that may lie closer than `threshold` (m) to one
+  /// of the obstacles o.obstacle_near at o.positions: their indices in
+  /// o.obstacle_layer, their positions (the links of their
+  /// triples evaluated, LinkEvaluator::apply_triples) in o.obstacle_dense.
+  /// The vertices come in triple order, not ascending.
+  /// A triple is skipped when a lower bound of the signed distance of its
+  /// vertices (from its nodes' coordinates in the obstacle's frame, each
+  /// vertex being within triple_reach of a convex combination of them) is
+  /// at least the threshold, so the skipped vertices are exactly ones the
+  /// callers would have found too far: the same results, bitwise, as testing
+  /// every vertex (WorldSettings::obstacle_cull = false).
+  /// With same_triples: the last call's layer, evaluated at the current
+  /// positions (for a caller that knows the nodes have not moved enough to
+  /// change it).
+  void obstacle_layer(RuntimeObject& o, double threshold, bool same_triples = false) const;
   /// Some object came within reach of an obstacle in the last cycle.
   bool m_obstacle_near = false;
   /// Detection/response cycles a frame of dt needs for a stable penalty.
@@ -402,8 +428,13 @@ class World {
   double m_min_node_mass = 1;   ///< lightest lumped node mass of the deformable objects, kg
   double m_node_stiffness = 0;  ///< largest per-node penalty stiffness of the last response, N/m
   /// Squared frequency bound of the last response's penalty springs, 1/s^2:
-  /// ContactStats::max_rate summed over the pairs (per node k share / m).
+  /// the largest over responding pairs of the two sides' largest node rates
+  /// (k share / m, summed over all pairs).
   double m_contact_rate = 0;
+  /// Per object, per coarse node: the penalty rate over all pairs of this
+  /// cycle at the full stiffness (what the node rate cap weighs against) and
+  /// as applied, 1/s^2.
+  std::vector<Eigen::VectorXd> m_total_rate, m_applied_rate;
   double m_penalty_energy = 0;  ///< penalty spring energy of the last response, J
   double m_contact_scale = 1;   ///< softening of the current contact episode (1: none)
   /// Work done by the contact forces on the deformable objects since the

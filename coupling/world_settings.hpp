@@ -199,6 +199,12 @@ struct WorldSettings {
   /// Static analytic obstacles (planes, boxes) that deformable objects are
   /// kept out of by projection (coupling/obstacle.hpp).
   std::vector<Obstacle> obstacles;
+  /// Test against the obstacles only the dense vertices that may be near
+  /// one (a bound from the coarse nodes and the link lengths, see
+  /// World::obstacle_layer; bitwise the same results). false: every vertex
+  /// of an object within reach against every obstacle, each time (the
+  /// reference the cull is tested against).
+  bool obstacle_cull = true;
   /// Keep the dense meshes of moving objects up to date every frame (the
   /// rigid links; for output). Without it they are evaluated only where the
   /// exact reference needs them.

@@ -268,6 +268,75 @@ TEST(ContactResponse, NodeRateCapHoldsEachNodeAtTheCapAndSparesTheOthers) {
   EXPECT_THROW(apply_contact_forces(a, b, r, o, fa, fb), ParameterError);
 }
 
+// A node touched by two objects (the middle one of a row of three): each
+// pair alone loads node 0 of b with k / m = 100 / s^2, under a cap of 150,
+// so capped pair by pair neither is weighted and the node gets 200 in all.
+// With the totals over both pairs (add_contact_rates) both are weighted by
+// 150 / 200 and the node gets exactly the cap; the applied rates are
+// reported for the caller's bound, and each pair's forces stay equal and
+// opposite.
+TEST(ContactResponse, NodeRateCapCountsEveryPairOfANode) {
+  const SphereTree a = make_tree({{0, 0, 0, 0.5}}, {{0}, {0}});
+  const SphereTree b = make_tree({{0, 0, 0.8, 0.5}}, {{0}, {0}});  // the middle object
+  const SphereTree c = make_tree({{0, 0, 1.5, 0.5}}, {{0}, {0}});
+  CollisionResult r;
+  r.colliding = {{1, 1}};  // a-b: penetration 0.2; b-c: 0.3
+  const Eigen::VectorXd ma = Eigen::VectorXd::Constant(1, 10.0);
+  const Eigen::VectorXd mb = Eigen::VectorXd::Constant(1, 1.0);
+  const Eigen::VectorXd mc = Eigen::VectorXd::Constant(1, 10.0);
+  ContactOptions ab, bc;
+  ab.stiffness = bc.stiffness = 100;
+  ab.node_rate_limit = bc.node_rate_limit = 150;
+  ab.mass_a = &ma;
+  ab.mass_b = &mb;
+  bc.mass_a = &mb;
+  bc.mass_b = &mc;
+  // Pair by pair: no weight.
+  MatX3d fa = MatX3d::Zero(1, 3), fb = MatX3d::Zero(1, 3), fc = MatX3d::Zero(1, 3);
+  EXPECT_EQ(apply_contact_forces(a, b, r, ab, fa, fb).capped_pairs, 0);
+  EXPECT_EQ(apply_contact_forces(b, c, r, bc, fb, fc).capped_pairs, 0);
+  EXPECT_NEAR(fb(0, 2), 100 * 0.2 - 100 * 0.3, 1e-12);
+  // Totals over both pairs.
+  Eigen::VectorXd total_a = Eigen::VectorXd::Zero(1), total_b = Eigen::VectorXd::Zero(1),
+                  total_c = Eigen::VectorXd::Zero(1);
+  add_contact_rates(a, b, r, ab, total_a, total_b);
+  add_contact_rates(b, c, r, bc, total_b, total_c);
+  EXPECT_NEAR(total_b[0], 200, 1e-12);
+  EXPECT_NEAR(total_a[0], 10, 1e-12);
+  Eigen::VectorXd applied_a = Eigen::VectorXd::Zero(1), applied_b = Eigen::VectorXd::Zero(1),
+                  applied_c = Eigen::VectorXd::Zero(1);
+  ab.total_rate_a = &total_a;
+  ab.total_rate_b = &total_b;
+  ab.applied_rate_a = &applied_a;
+  ab.applied_rate_b = &applied_b;
+  bc.total_rate_a = &total_b;
+  bc.total_rate_b = &total_c;
+  bc.applied_rate_a = &applied_b;
+  bc.applied_rate_b = &applied_c;
+  fa.setZero();
+  fb.setZero();
+  fc.setZero();
+  const ContactStats s1 = apply_contact_forces(a, b, r, ab, fa, fb);
+  const MatX3d fb_ab = fb;
+  const ContactStats s2 = apply_contact_forces(b, c, r, bc, fb, fc);
+  EXPECT_EQ(s1.capped_pairs, 1);
+  EXPECT_EQ(s2.capped_pairs, 1);
+  EXPECT_NEAR(s1.min_weight, 0.75, 1e-15);
+  EXPECT_NEAR(fa(0, 2), -0.75 * 100 * 0.2, 1e-12);
+  EXPECT_NEAR(fb_ab(0, 2), 0.75 * 100 * 0.2, 1e-12);
+  EXPECT_NEAR(fc(0, 2), 0.75 * 100 * 0.3, 1e-12);
+  EXPECT_NEAR(fb(0, 2), 0.75 * 100 * (0.2 - 0.3), 1e-12);
+  EXPECT_NEAR(applied_b[0], 150, 1e-9);  // the cap, over both pairs
+  EXPECT_NEAR(applied_a[0], 7.5, 1e-12);
+  EXPECT_NEAR(applied_c[0], 7.5, 1e-12);
+  // Totals of the wrong size are refused; rates need the masses.
+  const Eigen::VectorXd wrong = Eigen::VectorXd::Zero(2);
+  ab.total_rate_b = &wrong;
+  EXPECT_THROW(apply_contact_forces(a, b, r, ab, fa, fb), ParameterError);
+  ab.mass_a = nullptr;
+  EXPECT_THROW(add_contact_rates(a, b, r, ab, total_a, total_b), ParameterError);
+}
+
 double kinetic(const MatX3d& v, const Eigen::VectorXd& m) {
   return 0.5 * (v.rowwise().squaredNorm().transpose() * m).value();
 }

@@ -121,6 +121,49 @@ TEST(LinkEvaluator, EqualsReferenceUnderRandomDeformations) {
   std::printf("max relative difference evaluator vs reference: %.3e\n", worst);
 }
 
+// A subset of the triples (every third, in a shuffled order, so lanes pair
+// other triples than in apply()): exactly their links' rows are written,
+// bitwise equal to apply()'s, the other rows untouched; the links of the
+// triples listed by triple_links() are the links using those nodes.
+TEST(LinkEvaluator, ApplyTriplesEqualsApplyBitwiseOnTheirLinks) {
+  const Object o = make_object(3);
+  LinkEvaluator full(o.links), part(o.links);
+  std::mt19937 rng(11);
+  const int N = o.links.num_links();
+  for (int t = 0; t < full.num_triples(); ++t)
+    for (int32_t j = full.links_of_triple(t); j < full.links_of_triple(t + 1); ++j) {
+      const int k = full.triple_links()[static_cast<size_t>(j)];
+      for (int i = 0; i < 3; ++i) ASSERT_EQ(o.links.nodes(k, i), full.triple_nodes(t)[i]);
+    }
+  EXPECT_EQ(full.links_of_triple(full.num_triples()), N);
+  std::vector<int32_t> triples;
+  for (int t = 0; t < full.num_triples(); t += 3) triples.push_back(t);
+  std::shuffle(triples.begin(), triples.end(), rng);
+  std::vector<char> chosen(static_cast<size_t>(N), 0);
+  for (int32_t t : triples)
+    for (int32_t j = full.links_of_triple(t); j < full.links_of_triple(t + 1); ++j)
+      chosen[static_cast<size_t>(full.triple_links()[static_cast<size_t>(j)])] = 1;
+  MatX3d a(N, 3), b(N, 3);
+  for (int trial = 0; trial < 5; ++trial) {
+    const MatX3d X = random_deformation(o.coarse.V, rng, 0.05);
+    full.apply(X, a);
+    b.setConstant(-7.0);
+    part.apply_triples(X, triples, b);
+    int written = 0;
+    for (int k = 0; k < N; ++k) {
+      if (chosen[static_cast<size_t>(k)]) {
+        ++written;
+        for (int d = 0; d < 3; ++d) ASSERT_EQ(a(k, d), b(k, d)) << "link " << k;
+      } else {
+        ASSERT_EQ(b.row(k), Eigen::RowVector3d::Constant(-7.0)) << "link " << k;
+      }
+    }
+    EXPECT_GT(written, 0);
+    EXPECT_LT(written, N);
+  }
+  EXPECT_THROW(part.apply_triples(o.coarse.V, {part.num_triples()}, b), ParameterError);
+}
+
 // The real dragon bundles (made by the CTest fixture real_bundles into
 // <build>/test_bundles; missing: a failure): at rest and under random
 // deformations, against the reference and against the dense rest vertices.

@@ -2,6 +2,7 @@
 // with no scene file, no asset cache and no subprocess.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -65,6 +66,43 @@ TEST(World, RunsFromObjectsInMemoryAndBounces) {
   EXPECT_LT(momentum(o[0]).x() / mass, -0.1);  // moving apart
   EXPECT_GT(momentum(o[1]).x() / mass, 0.1);
   EXPECT_LE(last_energy, 1.05 * first_energy);
+}
+
+// A ball squeezed between two others (three in a row, the outer ones
+// moving in): its nodes take part in two pairs. The per-node rate cap
+// weighs each node against its rate over both pairs, so the springs stay
+// under the stable rate together and no cycle is softened. (Summing each
+// pair's bound instead, 2 x 0.9 / h^2 > 1 / h^2, softened every cycle of
+// the contact, and the scale only falls during a contact: the penalty
+// went soft for good.) The energy stays bounded and the balls do not pass
+// through each other.
+TEST(World, BallBetweenTwoOthersIsNotSoftened) {
+  std::vector<WorldObject> objects;
+  objects.push_back(ball("left", -0.205, 0.4));
+  objects.push_back(ball("middle", 0, 0));
+  objects.push_back(ball("right", 0.205, -0.4));
+  WorldSettings s = head_on_settings();
+  s.collision.contact.stiffness = 1e6;  // far above what 64 cycles hold: the cap acts
+  World world(std::move(objects), s);
+  ASSERT_EQ(world.plan().pairs.size(), 3u);
+  const auto& o = world.objects();
+  int softened = 0, both = 0;
+  int64_t capped = 0;
+  double e0 = 0, e_max = 0;
+  for (int f = 0; f < 20; ++f) {
+    const FrameMetrics m = world.step();
+    if (f == 0) e0 = m.energy;
+    e_max = std::max(e_max, m.energy);
+    softened += m.softened;
+    capped += m.capped_pairs;
+    both += world.results()[0].colliding.size() > 0 && world.results()[2].colliding.size() > 0;
+    ASSERT_LT(o[0].positions.col(0).mean(), o[1].positions.col(0).mean()) << "frame " << f;
+    ASSERT_LT(o[1].positions.col(0).mean(), o[2].positions.col(0).mean()) << "frame " << f;
+  }
+  EXPECT_GT(both, 0);    // the middle ball was in both pairs at once
+  EXPECT_GT(capped, 0);  // and the cap acted
+  EXPECT_EQ(softened, 0);
+  EXPECT_LT(e_max, 1.02 * e0);
 }
 
 TEST(World, RefusesInvalidSettingsAndObjectsByName) {

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include <icd/coupling/link_evaluator.hpp>
 #include <icd/coupling/primitive_asset.hpp>
 #include <icd/coupling/world.hpp>
@@ -165,6 +167,57 @@ TEST(Obstacles, BallComesToRestInATroughOfTiltedPlanes) {
   EXPECT_LT(kinetic, 0.03 * kinetic_max);
   EXPECT_NEAR(centre.x(), 0, 0.01);        // at the bottom of the trough
   EXPECT_LE(e_max, e0 * (1 + 1e-9));
+}
+
+// Only the dense vertices that may be near an obstacle are tested (a bound
+// from the coarse nodes and the link lengths, World::obstacle_layer): a ball
+// thrown along a floor into a corner of a tilted wall, with a far plane that
+// never comes near, runs bitwise the same trajectory as testing every
+// vertex against every obstacle, while the tested layer stays a fraction of
+// the surface.
+TEST(Obstacles, CullingFarVerticesGivesTheSameTrajectoryBitwise) {
+  WorldSettings s;
+  s.gravity = {0, 0, -9.81};
+  Obstacle floor = thin_box();
+  floor.half_extents = {1, 1, 0.01};
+  Obstacle wall;
+  wall.type = Obstacle::Type::Box;
+  wall.point = {0.22, 0.05, 0.2};
+  wall.half_extents = {0.02, 0.3, 0.2};
+  wall.axes = Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Obstacle far = plane_at(-5);
+  s.obstacles = {floor, far, wall};
+  const auto make = [&](bool cull) {
+    WorldSettings w = s;
+    w.obstacle_cull = cull;
+    std::vector<WorldObject> objects;
+    objects.push_back(ball(Eigen::Vector3d(0.06, 0, 0.112)));
+    objects[0].setup.velocity = {1.5, 0.3, 0};
+    return World(std::move(objects), w);
+  };
+  World culled = make(true), every = make(false);
+  const int links = culled.objects()[0].asset.links.num_links();
+  size_t widest = 0;
+  int touching = 0;
+  double reach = -1;
+  for (int f = 0; f < 10; ++f) {
+    const FrameMetrics a = culled.step(), b = every.step();
+    const RuntimeObject& oa = culled.objects()[0];
+    const RuntimeObject& ob = every.objects()[0];
+    ASSERT_EQ(a.cycles, b.cycles) << "frame " << f;
+    ASSERT_EQ(a.obstacle_vertices, b.obstacle_vertices) << "frame " << f;
+    ASSERT_EQ(a.obstacle_depth, b.obstacle_depth) << "frame " << f;
+    ASSERT_EQ(a.energy, b.energy) << "frame " << f;
+    ASSERT_TRUE((oa.positions.array() == ob.positions.array()).all()) << "frame " << f;
+    ASSERT_TRUE((oa.sim->velocities().array() == ob.sim->velocities().array()).all()) << "frame " << f;
+    widest = std::max(widest, oa.obstacle_layer.size());
+    touching += a.obstacle_depth > 0;
+    reach = std::max(reach, oa.positions.col(0).maxCoeff());
+  }
+  EXPECT_GT(touching, 0);                          // it did touch the obstacles
+  EXPECT_GT(reach, 0.19);  // and reached the wall (its nodes start below x = 0.16)
+  EXPECT_LT(widest, static_cast<size_t>(links) / 2);  // a layer, not the whole surface
+  EXPECT_EQ(every.objects()[0].obstacle_layer.size(), static_cast<size_t>(links));
 }
 
 TEST(Obstacles, SignedDistanceOfPlaneAndBox) {
