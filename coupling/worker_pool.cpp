@@ -1,13 +1,36 @@
 #include <icd/coupling/worker_pool.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 
 #include <icd/mesh/core/error.hpp>
 
 namespace icd::coupling {
+namespace {
 
-WorkerPool::WorkerPool(int threads) {
+// Spins until done() or `seconds` have passed; true when done() held.
+template <class Done>
+bool spin_until(Done&& done, double seconds) {
+  if (!(seconds > 0)) return done();
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  for (int i = 0;; ++i) {
+    if (done()) return true;
+    if ((i & 63) == 63 && Clock::now() >= end) return done();
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
+}
+
+}  // namespace
+
+WorkerPool::WorkerPool(int threads, double spin_seconds) : m_spin(spin_seconds) {
   if (threads < 1) throw ParameterError("WorkerPool: threads must be >= 1");
+  if (!(spin_seconds >= 0) || !std::isfinite(spin_seconds))
+    throw ParameterError("WorkerPool: spin_seconds must be >= 0 and finite");
   m_workers.reserve(static_cast<size_t>(threads - 1));
   for (int i = 1; i < threads; ++i) m_workers.emplace_back([this] { work(); });
 }
@@ -23,12 +46,8 @@ WorkerPool::~WorkerPool() {
 
 void WorkerPool::drain(const std::function<void(int)>& f, int n) {
   for (;;) {
-    int k;
-    {
-      std::lock_guard<std::mutex> lock(m_mutex);
-      if (m_next >= n) return;
-      k = m_next++;
-    }
+    const int k = m_next.fetch_add(1, std::memory_order_relaxed);
+    if (k >= n) return;
     f(k);
   }
 }
@@ -43,27 +62,36 @@ void WorkerPool::run(int n, const std::function<void(int)>& f) {
     std::lock_guard<std::mutex> lock(m_mutex);
     m_job = &f;
     m_n = n;
-    m_next = 0;
-    m_busy = static_cast<int>(m_workers.size());
-    ++m_generation;
+    m_next.store(0, std::memory_order_relaxed);
+    m_busy.store(static_cast<int>(m_workers.size()), std::memory_order_relaxed);
+    m_generation.fetch_add(1, std::memory_order_release);
   }
   m_start.notify_all();
   drain(f, n);
-  std::unique_lock<std::mutex> lock(m_mutex);
-  m_done.wait(lock, [this] { return m_busy == 0; });
+  if (!spin_until([this] { return m_busy.load(std::memory_order_acquire) == 0; }, m_spin)) {
+    std::unique_lock<std::mutex> lock(m_mutex);
+    m_done.wait(lock, [this] { return m_busy.load(std::memory_order_acquire) == 0; });
+  }
+  std::lock_guard<std::mutex> lock(m_mutex);  // (the last worker has left its lock)
   m_job = nullptr;
 }
 
 void WorkerPool::work() {
   uint64_t seen = 0;
   for (;;) {
+    spin_until(
+        [&] {
+          return m_stop.load(std::memory_order_acquire) ||
+                 m_generation.load(std::memory_order_acquire) != seen;
+        },
+        m_spin);
     const std::function<void(int)>* job;
     int n;
     {
       std::unique_lock<std::mutex> lock(m_mutex);
-      m_start.wait(lock, [&] { return m_stop || m_generation != seen; });
+      m_start.wait(lock, [&] { return m_stop.load() || m_generation.load() != seen; });
       if (m_stop) return;
-      seen = m_generation;
+      seen = m_generation.load();
       job = m_job;
       n = m_n;
     }
@@ -71,7 +99,7 @@ void WorkerPool::work() {
     bool last;
     {
       std::lock_guard<std::mutex> lock(m_mutex);
-      last = --m_busy == 0;
+      last = m_busy.fetch_sub(1, std::memory_order_acq_rel) == 1;
     }
     if (last) m_done.notify_one();
   }

@@ -22,6 +22,12 @@ namespace icd::coupling {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// collision.cycles_at_fem_step applies when the frame's motion bound
+// (World::motion_cycles) times this is at most the sub-step count: each pair
+// closes at most cycle_motion / kSlowContact leaf radii per cycle.
+constexpr int kSlowContact = 3;
+
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -97,7 +103,8 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
                   ? m_settings.threads
                   : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   if (m_threads > 1 && objects.size() > 1)
-    m_pool = std::make_unique<WorkerPool>(std::min<int>(m_threads, static_cast<int>(objects.size())));
+    m_pool = std::make_unique<WorkerPool>(std::min<int>(m_threads, static_cast<int>(objects.size())),
+                                          m_settings.worker_spin);
   const CollisionSpec& cs = m_settings.collision;
   m_objects.reserve(objects.size());
   for (size_t i = 0; i < objects.size(); ++i) {
@@ -462,12 +469,33 @@ int World::contact_cycles(double dt) const {
   // ~4x fewer cycles but let a head-on bounce gain ~15% energy, left for
   // study. Frames that start apart are tried as one cycle in step(), with a
   // rollback when they end in contact.)
-  const double k = std::max(m_node_stiffness, m_settings.collision.contact.stiffness);
+  const CollisionSpec& cs = m_settings.collision;
+  const double k = std::max(m_node_stiffness, cs.contact.stiffness);
   // (the lightest node of the objects in close pairs once plan_islands has
   // run this frame: an object far from every contact sets no cycle count)
   const double omega = std::sqrt(k / m_close_min_mass);
-  return std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1,
-                    kMaxContactCycles);
+  const int stiff = std::clamp(static_cast<int>(std::ceil(omega * dt / kContactOmegaStep)), 1,
+                               kMaxContactCycles);
+  if (!(cs.node_rate_cap && cs.cycles_at_fem_step)) return stiff;
+  // With the cap every node's penalty rate stays at 0.45 (kContactOmegaLimit
+  // / h)^2 per object whatever h is, so the staggered penalty is stable at
+  // any cycle length: the cycles need not be shorter than the FEM sub-step
+  // of the objects that run them (each cycle then costs each object one
+  // sub-step, none is wasted). On the main job's light nodes the rule above
+  // gave 64 cycles (its maximum) in every contact frame, two per sub-step.
+  double step = std::numeric_limits<double>::infinity();
+  for (const RuntimeObject& o : m_objects)
+    if (o.sim && !o.deferred && o.step_cap > 0) step = std::min(step, o.step_cap);
+  if (!std::isfinite(step)) return stiff;
+  const int at_step = static_cast<int>(std::ceil(dt / (step * (1 - kStepMargin)) * (1 - 1e-12)));
+  // Only for slow contacts: with the cap the penalty is softer the longer
+  // the cycle, and a fast impact then sinks deeper before it is stopped
+  // (Tunnelling.HeadOnContactHoldsAndGainsNoEnergy: balls at 5 m/s each
+  // reached 2.59 leaf radii at these cycles, 1.2-1.6 at the rule above). So
+  // each pair must close by at most cycle_motion / kSlowContact leaf radii
+  // per cycle at this count (the main job: ~0.05 leaf radii per cycle).
+  if (kSlowContact * motion_cycles(dt) > at_step) return stiff;
+  return std::clamp(at_step, 1, stiff);
 }
 
 void World::update_spheres(RuntimeObject& o) const {
@@ -525,11 +553,13 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
   if (obstacles) m_obstacle_near = false;
   if (last) m.obstacle_vertices = 0;
   const bool track_work = m_plan.response && m_settings.collision.passive && m_passive_allowance >= 0;
-  for_each_object([&](int k) {
-    RuntimeObject& o = m_objects[static_cast<size_t>(k)];
+  // (Stages 1-3 of an object run in one task on its worker, one hand-off
+  // per cycle: see the single for_each_object call after stage 3.)
+  const auto deform = [&](RuntimeObject& o) {
     const bool was_near = o.near_obstacle;
     o.near_obstacle = false;
     o.cycle_substeps = 0;
+    o.cycle_products = 0;
     o.cycle_min_step = std::numeric_limits<double>::infinity();
     o.cycle_obstacle_vertices = 0;
     o.cycle_obstacle_depth = 0;
@@ -568,6 +598,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       if (o.obstacle_support.size() > 0)
         support_work += o.obstacle_support.cwiseProduct(o.positions).sum();
       o.cycle_substeps = rep.substeps;
+      o.cycle_products = rep.frequency_products;
       o.cycle_min_step = rep.step;
       o.step_cap = std::min(o.sim->options().max_step, o.sim->options().safety_factor * rep.step_limit);
       if (obstacles) {
@@ -583,39 +614,12 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       o.positions = (o.rest * o.pose.rotation.toRotationMatrix().transpose()).rowwise() +
                     o.pose.translation.transpose();
     }
-  });
-  // Reduced in object order (the same sums for any thread count).
-  for (RuntimeObject& o : m_objects) {
-    if (!o.plan.fem) continue;
-    if (track_work) {
-      m_contact_work -= o.work_before;
-      m_contact_work += o.work_after;
-    }
-    m.substeps += o.cycle_substeps;
-    m.min_step = std::min(m.min_step, o.cycle_min_step);
-    o.substeps += o.cycle_substeps;
-    if (o.cycle_substeps > 0) o.step = o.cycle_min_step;
-    m_obstacle_near = m_obstacle_near || o.near_obstacle;
-    m.obstacle_depth = std::max(m.obstacle_depth, o.cycle_obstacle_depth);
-    if (last) m.obstacle_vertices += o.cycle_obstacle_vertices;
-  }
-  m.times.fem += seconds_since(t0);
+  };
 
   // 2. Dense meshes follow through the rigid links (only where consumed).
-  if (last) {
-    t0 = Clock::now();
-    for_each_object([&](int k) {
-      RuntimeObject& o = m_objects[static_cast<size_t>(k)];
-      if (o.plan.dense_update) update_dense(o);
-    });
-    m.times.links += seconds_since(t0);
-  }
-
   // 3. Sphere trees follow the coarse nodes (paper 4.4).
-  t0 = Clock::now();
   const CollisionSpec& cs = m_settings.collision;
-  for_each_object([&](int k) {
-    RuntimeObject& o = m_objects[static_cast<size_t>(k)];
+  const auto follow = [&](RuntimeObject& o) {
     if (o.plan.sphere_update && o.lag == 0) {  // (a deferred object moves in the last cycle)
       if (cs.swept) {  // the spheres at the end of the cycle (actual positions)
         update_spheres(o);
@@ -643,13 +647,56 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
         std::swap(o.start_spheres, o.end_spheres);  // the next cycle starts at this end
       }
     }
+  };
+  // Each object's stages in one task: a worker is handed the object once per
+  // cycle, not once per stage (each hand-off wakes a parked worker and waits
+  // for the slower object). The region's wall time is shared out among the
+  // stages in proportion to the objects' own times in each.
+  for_each_object([&](int k) {
+    RuntimeObject& o = m_objects[static_cast<size_t>(k)];
+    const Clock::time_point s0 = Clock::now();
+    o.stage_seconds[0] = o.stage_seconds[1] = o.stage_seconds[2] = 0;
+    deform(o);
+    const Clock::time_point s1 = Clock::now();
+    if (last && o.plan.dense_update) update_dense(o);
+    const Clock::time_point s2 = Clock::now();
+    follow(o);
+    o.stage_seconds[0] = std::chrono::duration<double>(s1 - s0).count();
+    o.stage_seconds[1] = std::chrono::duration<double>(s2 - s1).count();
+    o.stage_seconds[2] = std::chrono::duration<double>(Clock::now() - s2).count();
   });
+  // Reduced in object order (the same sums for any thread count).
+  for (RuntimeObject& o : m_objects) {
+    if (!o.plan.fem) continue;
+    if (track_work) {
+      m_contact_work -= o.work_before;
+      m_contact_work += o.work_after;
+    }
+    m.substeps += o.cycle_substeps;
+    m.frequency_products += o.cycle_products;
+    m.min_step = std::min(m.min_step, o.cycle_min_step);
+    o.substeps += o.cycle_substeps;
+    if (o.cycle_substeps > 0) o.step = o.cycle_min_step;
+    m_obstacle_near = m_obstacle_near || o.near_obstacle;
+    m.obstacle_depth = std::max(m.obstacle_depth, o.cycle_obstacle_depth);
+    if (last) m.obstacle_vertices += o.cycle_obstacle_vertices;
+  }
   // Objects that do not move sweep nothing.
   if (cs.swept)
     for (RuntimeObject& o : m_objects)
       if (o.plan.sphere_tree && !o.plan.sphere_update && o.swept.empty())
         collision::still_spheres(o.asset.spheres.spheres, o.swept);
-  m.times.sphere_update += seconds_since(t0);
+  {
+    double part[3] = {0, 0, 0};
+    for (const RuntimeObject& o : m_objects)
+      for (int q = 0; q < 3; ++q) part[q] += o.stage_seconds[q];
+    const double region = seconds_since(t0), sum = part[0] + part[1] + part[2];
+    const double links = sum > 0 ? region * part[1] / sum : 0;
+    const double spheres = sum > 0 ? region * part[2] / sum : 0;
+    m.times.fem += region - links - spheres;
+    m.times.links += links;
+    m.times.sphere_update += spheres;
+  }
 
   // 4. Interruptible collision queries, one per candidate pair: first the
   //    sweeps and the broad phase decide which pairs need a traversal, then
@@ -931,6 +978,7 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
   }
   m.times.response += seconds_since(t0);
   if (last) m.penalty_energy = m_penalty_energy;
+  if (m_cycle_observer) m_cycle_observer(*this);
 }
 
 void World::limit_contact_work(double h, FrameMetrics& m) {
@@ -1311,9 +1359,14 @@ FrameMetrics World::advance(std::optional<double> budget) {
     return any_close ? contact_cycles(dt) : 1;
   };
   int cycles = contact_cycles(dt);
+  const auto bounds = [&] {
+    m.cycles_penalty = stiff_cycles();
+    m.cycles_motion = motion_cycles(dt);
+    return std::max({m.cycles_penalty, m.cycles_motion, 1});
+  };
   if (!contact_free()) {
     plan_islands(dt);
-    cycles = std::max(stiff_cycles(), motion_cycles(dt));
+    cycles = bounds();
   }
   m.cycles = 0;
 
@@ -1344,9 +1397,11 @@ FrameMetrics World::advance(std::optional<double> budget) {
     m.rollback = 1;
     m.times = trial.times;  // the rolled-back work is part of the frame's cost
     m.tests = trial.tests;
+    m.substeps = trial.substeps;  // (as the objects' own counts, RuntimeObject::substeps)
+    m.frequency_products = trial.frequency_products;
     // The trial measured each object's motion over the frame.
     plan_islands(dt);
-    cycles = std::max({stiff_cycles(), motion_cycles(dt), 1});
+    cycles = bounds();
   }
   run_cycles(m_time, dt, aligned_cycles(dt, cycles), 0, true, budget_at, m);
   m.min_budget_queries = floored;
@@ -1395,8 +1450,13 @@ void World::run_cycles(double t0, double length, int n, int depth, bool ends_fra
 
 FrameMetrics World::finish_frame(FrameMetrics& m, Clock::time_point frame_start) {
   m.energy = m_penalty_energy;
-  for (RuntimeObject& o : m_objects)
-    if (o.sim) m.energy += mechanical_energy(*o.sim, m_settings.gravity);
+  // (an element pass per object: on the workers, summed in object order)
+  m_object_energy.assign(m_objects.size(), 0.0);
+  for_each_object([&](int k) {
+    RuntimeObject& o = m_objects[static_cast<size_t>(k)];
+    if (o.sim) m_object_energy[static_cast<size_t>(k)] = mechanical_energy(*o.sim, m_settings.gravity);
+  });
+  for (double e : m_object_energy) m.energy += e;
   // Exact reference: intersecting dense triangles (for accuracy studies).
   if (m_plan.exact_reference) {
     m.exact_contacts = 0;

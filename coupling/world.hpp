@@ -56,6 +56,15 @@ struct FrameMetrics {
   /// passive (collision.passive).
   int limited = 0;
   int substeps = 0;     ///< FEM sub-steps summed over objects
+  /// The two lower bounds the frame's cycle count came from (before it was
+  /// fitted to the sub-steps, World::fit_cycles), 0 for a frame run as one
+  /// contact-free cycle: the penalty's (World::contact_cycles) and the
+  /// motion's (collision.cycle_motion, obstacles; World::motion_cycles).
+  int cycles_penalty = 0;
+  int cycles_motion = 0;
+  /// Lanczos products the objects' stable-step estimates took in the frame
+  /// (fem::AdvanceReport::frequency_products summed; 0: every estimate reused).
+  int frequency_products = 0;
   double min_step = 0;  ///< smallest FEM step used, s
   /// Mechanical energy of the deformable objects, J: kinetic + elastic +
   /// gravity potential, plus the energy in the penalty springs of the last
@@ -169,6 +178,8 @@ struct RuntimeObject {
   /// step, dense vertices found inside obstacles and the deepest.
   double work_before = 0, work_after = 0;
   int cycle_substeps = 0;
+  int cycle_products = 0;
+  double stage_seconds[3] = {0, 0, 0};  ///< wall time of its FEM, links, sphere update in the cycle
   double cycle_min_step = 0;
   int cycle_obstacle_vertices = 0;
   double cycle_obstacle_depth = 0;
@@ -218,6 +229,14 @@ class World {
   void set_kinematic_pose(int i, const RigidPose& pose);
   /// Simulated time at the end of the last frame, s.
   double time() const { return m_time; }
+  /// Called at the end of every detection/response cycle (after the
+  /// response; rolled-back cycles included) with the World, for
+  /// measurements inside frames (e.g. each cycle's query answers against an
+  /// unlimited query, bench_realtime --lod). Its time counts in the frame's
+  /// wall time, in no stage. Empty: none.
+  void set_cycle_observer(std::function<void(const World&)> observer) {
+    m_cycle_observer = std::move(observer);
+  }
 
   /// The last query of each collision pair (same order as plan().pairs).
   const std::vector<collision::CollisionResult>& results() const { return m_results; }
@@ -452,6 +471,8 @@ class World {
   std::vector<collision::NodePair> m_sweep_stack;  ///< reused storage of the swept queries
   /// Per pair: the swept query of the last cycle reported a pair.
   std::vector<char> m_swept_hit;
+  std::function<void(const World&)> m_cycle_observer;
+  std::vector<double> m_object_energy;  ///< per-object mechanical energy (finish_frame scratch)
   int m_frame = 0;
   double m_time = 0;
 };

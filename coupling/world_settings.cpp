@@ -22,6 +22,8 @@ void validate(const WorldSettings& s) {
   if (!(s.min_query_budget > 0) || !std::isfinite(s.min_query_budget))
     fail("min_query_budget", "must be > 0 and finite", s.min_query_budget);
   if (s.threads < 0 || s.threads > 1024) fail("threads", "must be in 0..1024 (0 = all cores)", s.threads);
+  if (!(s.worker_spin >= 0) || !(s.worker_spin <= 1))
+    fail("worker_spin", "must be in [0, 1] s", s.worker_spin);
   if (!s.gravity.allFinite()) throw ParameterError("WorldSettings: gravity: must be finite");
   const CollisionSpec& c = s.collision;
   collision::validate(c.query);

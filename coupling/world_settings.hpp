@@ -163,6 +163,23 @@ struct CollisionSpec {
   /// cycles and a pair 2.90 leaf radii deep without the cap; with it none
   /// and 1.42 with deep_step_ratio). false: the summed stiffness as is.
   bool node_rate_cap = true;
+  /// With node_rate_cap: the penalty asks for no cycles shorter than the
+  /// FEM sub-step of the objects that run them (the shortest of theirs):
+  /// the cap keeps every node's penalty rate under the explicit limit at any
+  /// cycle length, so each cycle may cost each object one sub-step
+  /// (World::contact_cycles). The count is the fewer of that and the rule
+  /// below, for slow contacts only (each pair closing by at most a third of
+  /// collision.cycle_motion per cycle at that count: with the cap, longer
+  /// cycles mean a softer penalty, and balls thrown head-on at 5 m/s sank
+  /// 2.6 leaf radii deep). Off by default: at 0.6 m/s head-on the softer
+  /// capped penalty let the spheres of HeadOn.SoftSpheresBounceApartSymmetrically
+  /// leave with 2.07 % sideways drift (its bound: 2 %); on the main job it
+  /// changed neither the deepest pair (0.54 vs 0.53 leaf radii) nor the energy.
+  /// false, or without the cap: as many cycles as the full stiffness
+  /// (at least contact.stiffness) on the lightest node needs for omega h <=
+  /// 0.25 (on the main job's light nodes its maximum, 64: two cycles per
+  /// sub-step, 128 sub-steps per contact frame instead of ~70).
+  bool cycles_at_fem_step = false;
   /// A colliding leaf pair deeper than this fraction of its smaller radius
   /// that still approaches gets an inelastic velocity step on its coarse
   /// nodes (deep_contact_velocity_step: momentum kept, kinetic energy only
@@ -195,6 +212,9 @@ struct WorldSettings {
   /// force loop of each splits across the rest. Results are bitwise
   /// identical for any count. 0: the hardware concurrency.
   int threads = 0;
+  /// How long an idle worker spins before it blocks, s (>= 0; 0: blocks at
+  /// once, the default: see WorkerPool for the measurements).
+  double worker_spin = 0;
   CollisionSpec collision;
   /// Static analytic obstacles (planes, boxes) that deformable objects are
   /// kept out of by projection (coupling/obstacle.hpp).

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -260,6 +262,96 @@ TEST(WorldScheduling, RefusesANonPositiveCollisionWeight) {
     EXPECT_NE(std::string(e.what()).find("\"b\""), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("collision_weight"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace icd::coupling
+
+namespace icd::coupling {
+namespace {
+
+struct ContactRun {
+  int contact_frames = 0;
+  int apart_substeps = 0;  ///< sub-steps of one ball in the first frame (apart, one cycle)
+  int contact_substeps = 0;  ///< sub-steps of both balls summed over the contact frames
+  int slow_frames = 0;       ///< contact frames whose motion bound is small (see below)
+  int most_slow_penalty = 0;  ///< most penalty cycles of those frames
+  int most_penalty_cycles = 0;
+  double lightest = 0;  ///< lightest coarse node, kg
+};
+
+// Two balls head-on at 0.2 m/s, 1 cm apart (a slow contact, see
+// World::contact_cycles): the frames in contact, with the cycle rule given.
+ContactRun head_on_contact(bool cycles_at_fem_step) {
+  std::vector<WorldObject> v;
+  v.push_back(ball("left", {-0.105, 0, 0}, {0.2, 0, 0}));
+  v.push_back(ball("right", {0.105, 0, 0}, {-0.2, 0, 0}));
+  WorldSettings s = deterministic();
+  s.collision.cycles_at_fem_step = cycles_at_fem_step;
+  World w(std::move(v), s);
+  ContactRun r;
+  r.lightest = std::min(w.objects()[0].node_mass.minCoeff(), w.objects()[1].node_mass.minCoeff());
+  for (int f = 0; f < 20; ++f) {
+    const FrameMetrics m = w.step();
+    if (std::getenv("ICD_TEST_VERBOSE"))
+      std::printf("frame %d cycles %d penalty %d motion %d substeps %d active %d rollback %d\n", f,
+                  m.cycles, m.cycles_penalty, m.cycles_motion, m.substeps, m.active_pairs, m.rollback);
+    if (f == 0) r.apart_substeps = w.objects()[0].substeps;
+    if (m.active_pairs == 0) continue;
+    ++r.contact_frames;
+    r.contact_substeps += m.substeps;
+    r.most_penalty_cycles = std::max(r.most_penalty_cycles, m.cycles_penalty);
+    // Slow: the pair closes at most cycle_motion / 3 leaf radii per cycle
+    // at one cycle per sub-step (the condition of the rule).
+    if (3 * m.cycles_motion <= r.apart_substeps) {
+      ++r.slow_frames;
+      r.most_slow_penalty = std::max(r.most_slow_penalty, m.cycles_penalty);
+    }
+  }
+  return r;
+}
+
+// With the per-node rate cap, a slow contact is cut into cycles as long as
+// the objects' FEM sub-step: no more cycles than the sub-steps a ball takes
+// over a frame apart (one cycle, its own step; +3 % for the cycle fitted
+// kStepMargin below the step, and one for rounding), where the previous rule,
+// omega h <= 0.25 for the full stiffness on the lightest node, asks for
+// sqrt(k / m) dt / 0.25 cycles (worked out here from the node masses, at most
+// 64), here more than the sub-steps: the rule now takes the fewer of the two,
+// and the contact frames cost fewer sub-steps. (That contacts still hold
+// without energy gain or deep pairs: Tunnelling.HeadOnContactHoldsAndGainsNoEnergy.)
+TEST(WorldScheduling, SlowContactCyclesAreAsLongAsTheFemStepWithTheRateCap) {
+  const ContactRun now = head_on_contact(true);
+  const ContactRun before = head_on_contact(false);
+  ASSERT_GT(now.contact_frames, 2);
+  ASSERT_GT(before.contact_frames, 2);
+  ASSERT_GT(now.apart_substeps, 4);
+  // Previous rule, by hand from the lightest node and k = 2000 N/m.
+  const double dt = 1.0 / 60;
+  const int expected = std::min(64, static_cast<int>(std::ceil(std::sqrt(2000 / before.lightest) * dt / 0.25)));
+  EXPECT_GE(before.most_penalty_cycles, expected);  // (the node stiffness may exceed k)
+  ASSERT_GT(expected, now.apart_substeps + 2);  // (else the two rules agree here)
+  ASSERT_GE(now.slow_frames, 2);
+  EXPECT_LE(now.most_slow_penalty, static_cast<int>(std::ceil(1.04 * now.apart_substeps)) + 1);
+  EXPECT_LT(now.contact_substeps, before.contact_substeps);
+}
+
+// The pool hands every index to exactly one thread, job after job, whether
+// its workers spin between jobs or block at once (the World's hand-off,
+// thousands of times per second).
+TEST(WorkerPool, RunsEveryIndexOnceWhetherWorkersSpinOrBlock) {
+  for (const double spin : {0.0, 100e-6}) {
+    WorkerPool pool(3, spin);
+    ASSERT_EQ(pool.threads(), 3);
+    for (int job = 0; job < 2000; ++job) {
+      const int n = 1 + job % 5;
+      std::vector<int> hits(static_cast<size_t>(n), 0);
+      pool.run(n, [&](int k) { ++hits[static_cast<size_t>(k)]; });
+      for (int k = 0; k < n; ++k) ASSERT_EQ(hits[static_cast<size_t>(k)], 1) << "job " << job << " index " << k;
+    }
+  }
+  EXPECT_THROW(WorkerPool(2, -1e-6), ParameterError);
+  EXPECT_THROW(WorkerPool(0), ParameterError);
 }
 
 }  // namespace

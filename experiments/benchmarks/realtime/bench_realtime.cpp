@@ -12,19 +12,24 @@
 #include <time.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <limits>
+#include <numeric>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <icd/collision/traversal.hpp>
 #include <icd/config.hpp>
 #include <icd/coupling/contact_response.hpp>
+#include <icd/coupling/worker_pool.hpp>
 #include <icd/mesh/core/error.hpp>
 #include "experiments/runner/run.hpp"
 #include "experiments/runner/scene.hpp"
@@ -75,8 +80,70 @@ FrameMetrics timed_step(World& w, Series& s) {
   return m;
 }
 
+// The ceiling of the 2-thread speed-up on this machine: the first two
+// objects' FEM alone, advanced frame by frame (free flight, no contact) for
+// `frames` frames, first one after the other on one thread (each timed),
+// then on two threads that never synchronise (fresh copies of the same
+// start). ideal = (t0 + t1) / max(t0, t1): the objects' imbalance alone;
+// measured = (t0 + t1) / parallel; their ratio is what running two cores
+// at once costs each of them (shared caches, memory, the host's scheduling).
+void measure_ceiling(World& serial, World& parallel, int frames, double dt) {
+  if (serial.objects().size() < 2 || !serial.objects()[0].sim || !serial.objects()[1].sim) return;
+  const auto advance = [&](World& w, int k) {
+    for (int f = 0; f < frames; ++f) w.objects()[static_cast<size_t>(k)].sim->advance(dt);
+  };
+  double t[2];
+  for (int k = 0; k < 2; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    advance(serial, k);
+    t[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  const double c0 = cpu_seconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::thread other([&] { advance(parallel, 1); });
+  advance(parallel, 0);
+  other.join();
+  const double both = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = cpu_seconds() - c0;
+  std::printf("FEM alone, %d frames: object 0 %.2f ms/frame, object 1 %.2f ms/frame (1 thread); both on 2 "
+              "threads %.2f ms/frame wall, %.2f CPU: speed-up %.2fx (ideal for this imbalance %.2fx; "
+              "each object %.0f%% slower than alone)\n",
+              frames, 1e3 * t[0] / frames, 1e3 * t[1] / frames, 1e3 * both / frames, 1e3 * cpu / frames,
+              (t[0] + t[1]) / both, (t[0] + t[1]) / std::max(t[0], t[1]),
+              100 * (both / std::max(t[0], t[1]) - 1));
+}
+
+// The cost of one hand-off of the objects to the workers (WorkerPool::run of
+// two trivial tasks), median over 2000, with `gap_us` of serial work on the
+// caller between two hand-offs (as the collision stage between two cycles),
+// for a worker that blocks at once and one that spins first.
+void measure_handoff() {
+  for (const double gap_us : {0.0, 50.0}) {
+    for (const double spin : {0.0, 100e-6}) {
+      icd::coupling::WorkerPool pool(2, spin);
+      std::vector<double> t;
+      std::atomic<long> sink{0};
+      const std::function<void(int)> job = [&](int k) { sink.fetch_add(k, std::memory_order_relaxed); };
+      const double c0 = cpu_seconds();
+      const auto w0 = std::chrono::steady_clock::now();
+      for (int i = 0; i < 2000; ++i) {
+        const auto g0 = std::chrono::steady_clock::now();
+        while (std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - g0).count() < gap_us) {
+        }
+        const auto t0 = std::chrono::steady_clock::now();
+        pool.run(2, job);
+        t.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+      }
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+      std::printf("hand-off (2 tasks), %2.0f us serial work between: worker spin %3.0f us: median %.1f us, "
+                  "CPU/wall of the loop %.2f\n",
+                  gap_us, 1e6 * spin, median(t), (cpu_seconds() - c0) / wall);
+    }
+  }
+}
+
 void run_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides, int frames,
-               const std::filesystem::path& tools) {
+               const std::filesystem::path& tools, bool trace) {
   icd::runner::Scene scene = icd::runner::load_scene(path, overrides);
   const std::filesystem::path cache = std::filesystem::path(ICD_SOURCE_DIR) / "assets";
   const double dt = 1.0 / scene.world.frame_rate;
@@ -90,59 +157,104 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
     std::printf("%s\n", line.c_str());
   scene.world.threads = 2;
   World two = icd::runner::make_world(scene, cache, tools);
-  Series s1, s2;
-  for (int f = 0; f < frames; ++f) {  // interleaved, alternating which goes first
-    if (f % 2 == 0) {
-      timed_step(one, s1);
-      timed_step(two, s2);
-    } else {
-      timed_step(two, s2);
-      timed_step(one, s1);
+  scene.world.worker_spin = 100e-6;  // (workers that spin 100 us before they block)
+  World spinning = icd::runner::make_world(scene, cache, tools);
+  scene.world.worker_spin = icd::coupling::WorldSettings{}.worker_spin;
+  Series s1, s2, s2b;
+  for (int f = 0; f < frames; ++f) {  // interleaved, rotating which goes first
+    World* worlds[3] = {&one, &two, &spinning};
+    Series* series[3] = {&s1, &s2, &s2b};
+    for (int k = 0; k < 3; ++k) timed_step(*worlds[(f + k) % 3], *series[(f + k) % 3]);
+  }
+  {
+    scene.world.threads = 1;
+    World a = icd::runner::make_world(scene, cache, tools);
+    World b = icd::runner::make_world(scene, cache, tools);
+    measure_ceiling(a, b, frames, dt);
+    scene.world.threads = 2;
+  }
+  // 60 Hz real-time mode on 2 threads: slow contacts cycled at the FEM
+  // sub-step (collision.cycles_at_fem_step), then the default rule (contact
+  // cycles from the full penalty stiffness on the lightest node).
+  struct Rt {
+    Series s;
+    int met = 0, fem_over = 0, floored = 0, contact_frames = 0, deep_steps = 0;
+    double worst = 0, depth_ratio = 0, penetration = 0, e0 = 0, e_end = 0;
+    std::string warning;
+  };
+  const auto run_rt = [&](bool fem_step_cycles, const char* label) {
+    scene.world.target_fps = 60;
+    scene.world.collision.cycles_at_fem_step = fem_step_cycles;
+    World rt = icd::runner::make_world(scene, cache, tools);
+    Rt r;
+    if (trace)
+      std::printf("trace (%s): frame wall_ms fem_ms coll_ms cycles penalty motion substeps products "
+                  "rollback split active depth_ratio deep_steps capped softened energy met\n",
+                  label);
+    for (int f = 0; f < frames; ++f) {
+      const FrameMetrics m = timed_step(rt, r.s);
+      r.met += m.deadline_met == 1;
+      r.fem_over += m.fem_over_deadline;
+      r.floored += m.min_budget_queries;
+      r.worst = std::max(r.worst, m.lateness);
+      r.contact_frames += m.active_pairs > 0;
+      r.deep_steps += m.deep_steps;
+      r.depth_ratio = std::max(r.depth_ratio, m.depth_ratio);
+      r.penetration = std::max(r.penetration, m.max_penetration);
+      if (f == 0) r.e0 = m.energy;
+      r.e_end = m.energy;
+      if (!m.deadline_warning.empty()) r.warning = m.deadline_warning;
+      if (trace)
+        std::printf("  %3d %7.2f %7.2f %6.2f %4d %4d %4d %4d %5d %d %d %5d %6.2f %4d %6lld %3d %.4f %d\n",
+                    m.frame, 1e3 * m.wall, 1e3 * m.times.fem, 1e3 * m.times.collision, m.cycles,
+                    m.cycles_penalty, m.cycles_motion, m.substeps, m.frequency_products, m.rollback,
+                    m.subdivided, m.active_pairs, m.depth_ratio, m.deep_steps,
+                    static_cast<long long>(m.capped_pairs), m.softened, m.energy, m.deadline_met);
     }
-  }
-  scene.world.target_fps = 60;
-  World rt = icd::runner::make_world(scene, cache, tools);
-  Series s3;
-  int met = 0, fem_over = 0, floored = 0;
-  double worst = 0;
-  std::string warning;
-  for (int f = 0; f < frames; ++f) {
-    const FrameMetrics m = timed_step(rt, s3);
-    met += m.deadline_met == 1;
-    fem_over += m.fem_over_deadline;
-    floored += m.min_budget_queries;
-    worst = std::max(worst, m.lateness);
-    if (!m.deadline_warning.empty()) warning = m.deadline_warning;
-  }
+    return r;
+  };
+  const Rt s3 = run_rt(true, "cycles_at_fem_step");
+  const Rt s4 = run_rt(false, "default cycle rule");
   const double sim = frames * dt;
-  std::printf("%-22s %12s %12s %10s %10s %14s %12s %12s\n", "", "wall ms/fr", "CPU ms/fr", "x real",
+  std::printf("%-26s %12s %12s %10s %10s %14s %12s %12s\n", "", "wall ms/fr", "CPU ms/fr", "x real",
               "FEM ms/fr", "sub-steps/fr", "us/sub-step", "max sub/fr");
   const auto row = [&](const char* label, const Series& s) {
     const double sub = median(s.substeps);
-    std::printf("%-22s %12.2f %12.2f %10.2f %10.2f %14.0f %12.1f %12.0f\n", label, 1e3 * median(s.wall),
+    std::printf("%-26s %12.2f %12.2f %10.2f %10.2f %14.0f %12.1f %12.0f\n", label, 1e3 * median(s.wall),
                 1e3 * median(s.cpu), sim / s.total_wall, 1e3 * median(s.fem), sub,
                 sub > 0 ? 1e6 * median(s.fem) / sub : 0.0,
                 *std::max_element(s.substeps.begin(), s.substeps.end()));
   };
   row("1 thread (old path)", s1);
   row("2 threads", s2);
-  row("2 threads, 60 Hz RT", s3);
-  std::printf("speed-up 2 vs 1 thread (median wall per frame): %.2fx\n",
-              median(s1.wall) / median(s2.wall));
-  std::printf("real-time mode at 60 Hz: %d of %d frames met the deadline (%.1f%%), worst lateness "
-              "%.2f ms, FEM alone over the deadline in %d frames, %d queries at the minimum budget\n",
-              met, frames, 100.0 * met / frames, 1e3 * worst, fem_over, floored);
-  if (!warning.empty()) std::printf("  %s\n", warning.c_str());
+  row("2 threads, workers spin", s2b);
+  row("2 thr, 60 Hz RT, at step", s3.s);
+  row("2 threads, 60 Hz RT", s4.s);
+  std::printf("speed-up 2 vs 1 thread (median wall per frame): %.2fx (workers that spin 100 us: %.2fx)\n",
+              median(s1.wall) / median(s2.wall), median(s1.wall) / median(s2b.wall));
+  const std::pair<const char*, const Rt*> rts[] = {{" (cycles_at_fem_step)", &s3}, {"", &s4}};
+  for (const auto& [label, r] : rts) {
+    std::printf("real-time mode at 60 Hz%s: %d of %d frames met the deadline (%.1f%%), worst lateness "
+                "%.2f ms, FEM alone over the deadline in %d frames, %d queries at the minimum budget\n",
+                label, r->met, frames, 100.0 * r->met / frames, 1e3 * r->worst, r->fem_over, r->floored);
+    std::printf("  contact: %d frames with contact, deepest leaf pair %.2f leaf radii (%.2f mm), %d "
+                "deep velocity steps, energy %.4f -> %.4f J\n",
+                r->contact_frames, r->depth_ratio, 1e3 * r->penetration, r->deep_steps, r->e0, r->e_end);
+    if (!r->warning.empty()) std::printf("  %s\n", r->warning.c_str());
+  }
   std::printf("load after %s\n", loadavg().c_str());
   std::fflush(stdout);
 }
 
 // Level of detail for many pairs (--lod): the scene with its own query
 // budget, shared among the pairs evenly and by priority (two runs). After
-// every frame each pair's last query is compared with an unlimited query on
-// the same spheres (the oracle): the penalty force (Eq. 11, the paper's
-// response to the query as it stands) of each pair with a contact, relative
-// error |F - F_exact| / |F_exact|, and the collision time per frame.
+// every detection/response cycle (World::set_cycle_observer, rolled-back
+// cycles included) each pair's query answer is compared with an unlimited
+// query on the same spheres (the oracle): the penalty force (Eq. 11, the
+// paper's response to the query as it stands) of each pair the oracle finds
+// in contact, relative error |F - F_exact| / |F_exact| (1 for a contact the
+// query missed). Time: the collision stage per frame (mean), and the
+// frame's wall time without the oracle's (median).
 void run_lod(const std::filesystem::path& path, const std::vector<std::string>& overrides,
              int frames, const std::filesystem::path& tools) {
   icd::runner::Scene scene = icd::runner::load_scene(path, overrides);
@@ -150,32 +262,36 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
   std::printf("\n== %s, level of detail: %d frames, budget %g s / %lld tests per query, load %s\n",
               scene.name.c_str(), frames, scene.world.collision.query.budget_seconds,
               static_cast<long long>(scene.world.collision.query.budget_tests), loadavg().c_str());
-  std::printf("%-10s %8s %12s %12s %12s %12s %12s %10s\n", "split", "samples", "median err",
-              "p90 err", "max err", "collision ms", "wall ms/fr", "interrupt");
+  std::printf("%-10s %8s %12s %12s %12s %8s %12s %12s %10s\n", "split", "samples", "median err",
+              "p90 err", "max err", "missed", "coll ms/fr", "wall ms/fr", "interrupt");
+  struct PairErrors {
+    std::vector<double> even, priority;
+  };
+  std::vector<PairErrors> per_pair;
   for (const icd::coupling::BudgetSplit split :
        {icd::coupling::BudgetSplit::Even, icd::coupling::BudgetSplit::Priority}) {
+    const bool even = split == icd::coupling::BudgetSplit::Even;
     scene.world.collision.budget_split = split;
     scene.world.target_fps = 0;
     World w = icd::runner::make_world(scene, cache, tools);
+    per_pair.resize(w.plan().pairs.size());
     std::vector<double> err, coll, wall;
-    int interrupted = 0;
+    int interrupted = 0, missed = 0;
+    double oracle_seconds = 0;
     icd::collision::CollisionRequest exact = scene.world.collision.query;
     exact.budget_seconds = std::numeric_limits<double>::infinity();
     exact.budget_tests = -1;
     exact.start_front = nullptr;
     exact.record_front = false;
     icd::collision::CollisionResult oracle;
-    for (int f = 0; f < frames; ++f) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const FrameMetrics m = w.step();
-      wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      coll.push_back(m.times.collision);
-      interrupted += m.interrupted;
-      const auto& pairs = w.plan().pairs;
+    w.set_cycle_observer([&](const World& world) {
+      const auto o0 = std::chrono::steady_clock::now();
+      const auto& pairs = world.plan().pairs;
       for (size_t p = 0; p < pairs.size(); ++p) {
-        const auto& a = w.objects()[pairs[p].first];
-        const auto& b = w.objects()[pairs[p].second];
+        const auto& a = world.objects()[pairs[p].first];
+        const auto& b = world.objects()[pairs[p].second];
         icd::collision::collide(a.asset.spheres, b.asset.spheres, exact, oracle);
+        if (oracle.colliding.empty()) continue;
         icd::coupling::ContactOptions co = scene.world.collision.contact;
         icd::MatX3d fa = icd::MatX3d::Zero(a.positions.rows(), 3), fb = icd::MatX3d::Zero(b.positions.rows(), 3);
         const Eigen::Vector3d truth = icd::coupling::apply_contact_forces(
@@ -183,19 +299,43 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
         if (truth.norm() == 0) continue;
         fa.setZero();
         fb.setZero();
+        const icd::collision::CollisionResult& got_r = world.results()[p];
         const Eigen::Vector3d got = icd::coupling::apply_contact_forces(
-            a.asset.spheres, b.asset.spheres, w.results()[p], co, fa, fb).total_force_a;
-        err.push_back((got - truth).norm() / truth.norm());
+            a.asset.spheres, b.asset.spheres, got_r, co, fa, fb).total_force_a;
+        const double e = (got - truth).norm() / truth.norm();
+        missed += got_r.colliding.empty() && got_r.untested.empty();
+        err.push_back(e);
+        (even ? per_pair[p].even : per_pair[p].priority).push_back(e);
       }
+      oracle_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - o0).count();
+    });
+    for (int f = 0; f < frames; ++f) {
+      const double before = oracle_seconds;
+      const auto t0 = std::chrono::steady_clock::now();
+      const FrameMetrics m = w.step();
+      wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() -
+                     (oracle_seconds - before));
+      coll.push_back(m.times.collision);
+      interrupted += m.interrupted;
     }
     std::vector<double> sorted = err;
     std::sort(sorted.begin(), sorted.end());
     const double p90 = sorted.empty() ? 0 : sorted[static_cast<size_t>(0.9 * (sorted.size() - 1))];
-    std::printf("%-10s %8zu %12.3f %12.3f %12.3f %12.3f %12.2f %10d\n",
-                split == icd::coupling::BudgetSplit::Even ? "even" : "priority", err.size(),
-                median(err), p90, sorted.empty() ? 0 : sorted.back(), 1e3 * median(coll),
-                1e3 * median(wall), interrupted);
+    std::printf("%-10s %8zu %12.3f %12.3f %12.3f %8d %12.3f %12.2f %10d\n", even ? "even" : "priority",
+                err.size(), median(err), p90, sorted.empty() ? 0 : sorted.back(), missed,
+                1e3 * std::accumulate(coll.begin(), coll.end(), 0.0) / frames, 1e3 * median(wall),
+                interrupted);
     std::fflush(stdout);
+    if (!even) {
+      std::printf("per pair (samples: cycles the oracle found the pair in contact): median error even / priority\n");
+      for (size_t p = 0; p < per_pair.size(); ++p) {
+        if (per_pair[p].even.empty() && per_pair[p].priority.empty()) continue;
+        const auto& pr = w.plan().pairs[p];
+        std::printf("  %-12s %-12s %6zu %8.3f   %6zu %8.3f\n", w.objects()[pr.first].setup.name.c_str(),
+                    w.objects()[pr.second].setup.name.c_str(), per_pair[p].even.size(),
+                    median(per_pair[p].even), per_pair[p].priority.size(), median(per_pair[p].priority));
+      }
+    }
   }
   std::printf("load after %s\n", loadavg().c_str());
 }
@@ -204,7 +344,7 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
 
 int main(int argc, char** argv) {
   int frames = 120;
-  bool lod = false;
+  bool lod = false, trace = false;
   std::vector<std::filesystem::path> scenes;
   std::vector<std::string> overrides;
   icd::experiments::Cli cli(
@@ -218,6 +358,9 @@ int main(int argc, char** argv) {
             "level of detail for many pairs instead: the scene's query budget shared evenly and "
             "by priority, per-pair contact force error against an unlimited query of the same "
             "spheres, and collision time")
+      .flag("--trace", trace,
+            "print one line per frame of the real-time runs: wall, FEM and collision ms, cycles and "
+            "the bounds they came from, sub-steps, Lanczos products, contact depth, energy")
       .scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
   if (scenes.empty()) {
@@ -230,9 +373,10 @@ int main(int argc, char** argv) {
   std::printf("bench_realtime: %u hardware threads; load %s\n",
               std::max(1u, static_cast<unsigned>(std::thread::hardware_concurrency())),
               loadavg().c_str());
+  if (!lod) measure_handoff();
   try {
     for (const auto& s : scenes)
-      lod ? run_lod(s, overrides, frames, tools) : run_scene(s, overrides, frames, tools);
+      lod ? run_lod(s, overrides, frames, tools) : run_scene(s, overrides, frames, tools, trace);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_realtime: %s\n", e.what());
     return 1;
