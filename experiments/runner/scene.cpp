@@ -593,6 +593,7 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
   c.midpoint = f.boolean("midpoint", c.midpoint);
   c.passive = f.boolean("passive", c.passive);
   c.node_rate_cap = f.boolean("node_rate_cap", c.node_rate_cap);
+  c.cycles_at_fem_step = f.boolean("cycles_at_fem_step", c.cycles_at_fem_step);
   c.deep_step_ratio = f.number("deep_step_ratio", c.deep_step_ratio, 0, 1e3);
   const bool paper_update = c.update.mode == collision::SphereUpdateMode::PaperRatio;
   const std::string upd =

@@ -167,8 +167,9 @@ TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
           "position": [-0.3, 0, 0], "collision_weight": 2.5},
          {"name": "b", "primitive": {"type": "sphere", "radius": 0.1, "cells": 3},
           "position": [0.3, 0, 0]})",
-      R"("collision": {"budget_split": "priority"})"));
+      R"("collision": {"budget_split": "priority", "cycles_at_fem_step": true})"));
   EXPECT_EQ(s.world.collision.budget_split, coupling::BudgetSplit::Priority);
+  EXPECT_TRUE(s.world.collision.cycles_at_fem_step);
   EXPECT_EQ(s.objects[0].collision_weight, 2.5);
   EXPECT_EQ(s.objects[1].collision_weight, coupling::ObjectSetup{}.collision_weight);
   const World world = make_world(s, "", "");
@@ -180,6 +181,7 @@ TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
   EXPECT_EQ(even.world.collision.budget_split, coupling::BudgetSplit::Even);
   const Scene plain = parse(with_objects(kSphere));
   EXPECT_EQ(plain.world.collision.budget_split, coupling::CollisionSpec{}.budget_split);
+  EXPECT_EQ(plain.world.collision.cycles_at_fem_step, coupling::CollisionSpec{}.cycles_at_fem_step);
   EXPECT_EQ(plain.objects[0].collision_weight, coupling::ObjectSetup{}.collision_weight);
 
   // Bad values: an InputError naming the file and the field.
@@ -188,6 +190,8 @@ TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
        "collision.budget_split", "must be one of"},
       {with_objects(kSphere, R"("collision": {"budget_split": 1})"), "collision.budget_split",
        "string"},
+      {with_objects(kSphere, R"("collision": {"cycles_at_fem_step": "yes"})"),
+       "collision.cycles_at_fem_step", "true or false"},
       {with_objects(R"({"primitive": {}, "collision_weight": 0})"), "objects[0].collision_weight",
        "must be in (0"},
       {with_objects(R"({"primitive": {}, "collision_weight": -2})"), "objects[0].collision_weight",
