@@ -29,6 +29,18 @@ Vec normalized(const Vec& v) {
   return {v.x / s, v.y / s, v.z / s};
 }
 
+// One link: p = ((a0 q0 + a1 q1) + a2 q2) + c0 e0 + c1 e1 + c2 e2 from the
+// triple's 24-double frame packet m and the link's 6 weights w, summed left
+// to right on (x, y, z, pad) packets; written to row[0..2].
+inline void write_link(const double* m, const double* w, double* row) {
+  using Packet = Eigen::Map<const Eigen::Vector4d, Eigen::Aligned16>;
+  const Eigen::Vector4d p = w[0] * Packet(m) + w[1] * Packet(m + 4) + w[2] * Packet(m + 8) +
+                            w[3] * Packet(m + 12) + w[4] * Packet(m + 16) + w[5] * Packet(m + 20);
+  row[0] = p[0];
+  row[1] = p[1];
+  row[2] = p[2];
+}
+
 }  // namespace
 
 LinkEvaluator::LinkEvaluator(const RigidLinks& links, const LinkEvaluatorOptions& options)
@@ -116,7 +128,6 @@ LinkApplyResult LinkEvaluator::apply_triples(const Eigen::Ref<const MatX3d>& coa
   const int count = static_cast<int>(triples.size());
   const LinkApplyResult result =
       update_triples(coarse_positions, count, [&](int i) { return triples[static_cast<size_t>(i)]; });
-  using Packet = Eigen::Map<const Eigen::Vector4d, Eigen::Aligned16>;
   const double* table = m_table.data();
   const double* weights = m_weights.data();
   double* out = dense_out.data();
@@ -125,14 +136,8 @@ LinkApplyResult LinkEvaluator::apply_triples(const Eigen::Ref<const MatX3d>& coa
     const double* m = table + 24 * static_cast<Eigen::Index>(t);
     for (int32_t j = m_triple_offset[t]; j < m_triple_offset[t + 1]; ++j) {
       const int32_t k = m_triple_links[j];
-      const double* w = weights + 6 * static_cast<Eigen::Index>(k);
-      // (the expression of evaluate_links(): the same rounding)
-      const Eigen::Vector4d p = w[0] * Packet(m) + w[1] * Packet(m + 4) + w[2] * Packet(m + 8) +
-                                w[3] * Packet(m + 12) + w[4] * Packet(m + 16) + w[5] * Packet(m + 20);
-      double* row = out + k * stride;
-      row[0] = p[0];
-      row[1] = p[1];
-      row[2] = p[2];
+      // (the kernel of evaluate_links(): the same rounding)
+      write_link(m, weights + 6 * static_cast<Eigen::Index>(k), out + k * stride);
     }
   }
   return result;
@@ -264,7 +269,6 @@ void LinkEvaluator::fallback_frame(int t) {
 // p = ((a0 q0 + a1 q1) + a2 q2) + c0 e0 + c1 e1 + c2 e2, summed left to right as
 // in apply_reference() (Eqs. 1, 9, 10), on (x, y, z, pad) packets.
 void LinkEvaluator::evaluate_links(Eigen::Ref<MatX3d> dense_out) const {
-  using Packet = Eigen::Map<const Eigen::Vector4d, Eigen::Aligned16>;
   const int N = num_links();
   const int32_t* triple = m_link_triple.data();
   const double* table = m_table.data();
@@ -273,13 +277,7 @@ void LinkEvaluator::evaluate_links(Eigen::Ref<MatX3d> dense_out) const {
   const Eigen::Index stride = dense_out.outerStride();
   for (int k = 0; k < N; ++k) {
     const double* m = table + 24 * static_cast<Eigen::Index>(triple[k]);
-    const double* w = weights + 6 * static_cast<Eigen::Index>(k);
-    const Eigen::Vector4d p = w[0] * Packet(m) + w[1] * Packet(m + 4) + w[2] * Packet(m + 8) +
-                              w[3] * Packet(m + 12) + w[4] * Packet(m + 16) + w[5] * Packet(m + 20);
-    double* row = out + k * stride;
-    row[0] = p[0];
-    row[1] = p[1];
-    row[2] = p[2];
+    write_link(m, weights + 6 * static_cast<Eigen::Index>(k), out + k * stride);
   }
 }
 
