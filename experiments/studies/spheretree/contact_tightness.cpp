@@ -19,9 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
-#include <iostream>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -32,6 +30,7 @@
 
 #include <icd/collision/traversal.hpp>
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/studies/spheretree/approach.hpp"
 #include "experiments/studies/spheretree/tree_report.hpp"
 #include <icd/mesh/io/surface_reader.hpp>
@@ -185,10 +184,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "contact_tightness: " << e.what() << "\n";
-    return 1;
-  }
+  return icd::experiments::guarded_main("contact_tightness", run, argc, argv);
 }

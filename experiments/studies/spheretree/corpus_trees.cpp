@@ -13,13 +13,12 @@
 // and writes the corpus table.
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
-#include <iostream>
 #include <string>
 #include <vector>
 
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/studies/spheretree/tree_report.hpp"
 #include <icd/collision/sph_io.hpp>
 #include <icd/coupling/asset_bundle.hpp>
@@ -96,10 +95,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "corpus_trees: " << e.what() << "\n";
-    return 1;
-  }
+  return icd::experiments::guarded_main("corpus_trees", run, argc, argv);
 }

@@ -31,9 +31,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
-#include <exception>
 #include <filesystem>
-#include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -43,6 +41,7 @@
 #include <icd/collision/sph_io.hpp>
 #include <icd/collision/sphere_tree.hpp>
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/studies/spheretree/tree_report.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
@@ -340,10 +339,5 @@ int run(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "sphere_tree_table: " << e.what() << "\n";
-    return 1;
-  }
+  return icd::experiments::guarded_main("sphere_tree_table", run, argc, argv);
 }
