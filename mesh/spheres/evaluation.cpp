@@ -160,6 +160,35 @@ Eigen::Matrix3d toolkit_probe_frame() {
   return frame;
 }
 
+double visit_coverage_samples(const SurfaceMesh& mesh, double spacing,
+                              const CoverageSampleVisitor& visit) {
+  if (!(spacing > 0)) throw ParameterError("visit_coverage_samples: spacing must be > 0");
+  double total_area = 0;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                          c = mesh.V.row(mesh.F(f, 2));
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const Eigen::Vector3d normal = cross.normalized();
+    const int n = std::max(1, static_cast<int>(std::ceil(longest / spacing)));
+    const double sub_area = 0.5 * cross.norm() / (static_cast<double>(n) * n);
+    total_area += sub_area * n * n;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i + j <= n; ++i) {
+        // Number of sub-triangles having lattice point (i, j) as a corner.
+        const bool corner = (i == 0 && j == 0) || (i == n && j == 0) || (i == 0 && j == n);
+        const bool edge = (i == 0 || j == 0 || i + j == n);
+        const int incident = corner ? 1 : (edge ? 3 : 6);
+        const double weight = sub_area * incident / 3.0;
+        const Eigen::Vector3d p =
+            a + (b - a) * (static_cast<double>(i) / n) + (c - a) * (static_cast<double>(j) / n);
+        visit(p, normal, weight);
+      }
+    }
+  }
+  return total_area;
+}
+
 std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
                                                const collision::SphereTree& tree,
                                                const EvaluationOptions& options) {
@@ -269,25 +298,9 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
   constexpr int kThicknessBins = 16000;  // the last bin takes everything beyond
   std::vector<std::vector<double>> thickness(static_cast<size_t>(num_levels),
                                              std::vector<double>(kThicknessBins, 0.0));
-  double total_area = 0;
-  for (Eigen::Index f = 0; f < scaled.F.rows(); ++f) {
-    const Eigen::Vector3d a = scaled.V.row(scaled.F(f, 0)), b = scaled.V.row(scaled.F(f, 1)),
-                          c = scaled.V.row(scaled.F(f, 2));
-    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-    const Eigen::Vector3d cross = (b - a).cross(c - a);
-    const Eigen::Vector3d normal = cross.normalized();
-    const int n = std::max(1, static_cast<int>(std::ceil(longest / options.coverage_spacing)));
-    const double sub_area = 0.5 * cross.norm() / (static_cast<double>(n) * n);
-    total_area += sub_area * n * n;
-    for (int j = 0; j <= n; ++j) {
-      for (int i = 0; i + j <= n; ++i) {
-        // Number of sub-triangles having lattice point (i, j) as a corner.
-        const bool corner = (i == 0 && j == 0) || (i == n && j == 0) || (i == 0 && j == n);
-        const bool edge = (i == 0 || j == 0 || i + j == n);
-        const int incident = corner ? 1 : (edge ? 3 : 6);
-        const double weight = sub_area * incident / 3.0;
-        const Eigen::Vector3d p =
-            a + (b - a) * (static_cast<double>(i) / n) + (c - a) * (static_cast<double>(j) / n);
+  const double total_area = visit_coverage_samples(
+      scaled, options.coverage_spacing,
+      [&](const Eigen::Vector3d& p, const Eigen::Vector3d& normal, double weight) {
         for (int l = 0; l < num_levels; ++l) {
           LevelMetrics& m = out[static_cast<size_t>(l)];
           ++m.num_dense_samples;
@@ -301,9 +314,7 @@ std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
           uncovered_area[static_cast<size_t>(l)] += weight;
           m.max_uncovered_gap = std::max(m.max_uncovered_gap, grids[static_cast<size_t>(l)].gap(p));
         }
-      }
-    }
-  }
+      });
   // Shell volume: each sphere's part beyond the depth of its centre (the
   // rest is inside the object), sampled uniformly by volume; a sample outside
   // the object counts 1 / (spheres containing it), so the sum is the volume

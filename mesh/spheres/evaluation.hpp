@@ -1,5 +1,6 @@
 #pragma once
 /// Per-level quality of a sphere tree against its surface (issue 5 metrics).
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -46,11 +47,11 @@ struct LevelMetrics {
   double worst_error_162 = 0, mean_error_162 = 0;
   /// The 42-probe error of each sphere averaged over
   /// EvaluationOptions::probe_rotations uniformly random orientations of the
-  /// probes (one set per sphere, seeded by its centre and radius, so independent of the sphere order); worst and mean over the level.
-  /// A tree fitted against one fixed set of probe directions (as the
-  /// reference toolkit fits its spheres against its own 42 points) looks
-  /// better on those directions than on any other 42; these numbers belong
-  /// to no frame and are the 42-probe figures to compare trees by.
+  /// probes (one set per sphere, seeded by its centre and radius, so independent of the sphere
+  /// order); worst and mean over the level. A tree fitted against one fixed set of probe directions
+  /// (as the reference toolkit fits its spheres against its own 42 points) looks better on those
+  /// directions than on any other 42; these numbers belong to no frame and are the 42-probe figures
+  /// to compare trees by.
   double worst_error_42_rotated = 0, mean_error_42_rotated = 0;
   double uncovered_area_fraction = 0;   ///< area of dense samples outside every sphere / total area
   long long num_dense_samples = 0;      ///< dense samples tested
@@ -96,6 +97,21 @@ struct LevelMetrics {
 std::vector<LevelMetrics> evaluate_sphere_tree(const SurfaceMesh& mesh,
                                                const collision::SphereTree& tree,
                                                const EvaluationOptions& options = {});
+
+/// Called with a coverage sample, its triangle's unit outward normal and its
+/// area weight.
+using CoverageSampleVisitor =
+    std::function<void(const Eigen::Vector3d& p, const Eigen::Vector3d& normal, double weight)>;
+
+/// The dense coverage samples of evaluate_sphere_tree() (there in normalized
+/// units): each triangle of `mesh` (V #V x 3, F #F x 3) is split into n x n
+/// sub-triangles (n = ceil(longest edge / spacing), spacing in the mesh's
+/// units, > 0) whose corners are visited, each weighted by a third of the
+/// area of the sub-triangles it is a corner of (a point shared by triangles
+/// is visited once per triangle). Returns the surface area (the sum of the
+/// weights). Throws ParameterError for spacing <= 0.
+double visit_coverage_samples(const SurfaceMesh& mesh, double spacing,
+                              const CoverageSampleVisitor& visit);
 
 /// The probe directions: vertices of the icosahedron subdivided `subdivisions`
 /// times (12, 42, 162, ... unit vectors).

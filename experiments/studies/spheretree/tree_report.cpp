@@ -1,8 +1,11 @@
 #include "experiments/studies/spheretree/tree_report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 
+#include <icd/mesh/core/error.hpp>
 #include <icd/mesh/spheres/mesh_oracle.hpp>
 #include <icd/mesh/spheres/protrusion.hpp>
 
@@ -90,6 +93,166 @@ collision::SphereTree read_sph_for_mesh(const std::string& path, const SurfaceMe
     tree.rest_spheres = tree.spheres;
   }
   return tree;
+}
+
+namespace {
+
+/// The mesh scaled to normalized units (longest side 2000) about its
+/// bounding-box centre, which goes to the origin when `centre_origin`.
+SurfaceMesh normalized_mesh(const SurfaceMesh& mesh, bool centre_origin) {
+  SurfaceMesh scaled = mesh;
+  if (centre_origin) scaled.V.rowwise() -= bounding_box_centre(mesh).transpose();
+  scaled.V *= to_normalized_units(mesh);
+  return scaled;
+}
+
+/// The leaf level (the last) in normalized units, about the same origin.
+std::vector<collision::Sphere> normalized_leaves(const SurfaceMesh& mesh,
+                                                 const collision::SphereTree& tree,
+                                                 bool centre_origin) {
+  const double scale = to_normalized_units(mesh);
+  const Eigen::Vector3d centre =
+      centre_origin ? bounding_box_centre(mesh) : Eigen::Vector3d::Zero();
+  const int begin = tree.level_offset[static_cast<size_t>(tree.num_levels() - 1)];
+  std::vector<collision::Sphere> leaves;
+  for (int i = begin; i < tree.num_nodes(); ++i) {
+    collision::Sphere s = tree.spheres[static_cast<size_t>(i)];
+    s.x = (s.x - centre.x()) * scale, s.y = (s.y - centre.y()) * scale;
+    s.z = (s.z - centre.z()) * scale, s.r *= scale;
+    leaves.push_back(s);
+  }
+  return leaves;
+}
+
+}  // namespace
+
+GrownLeaves grow_leaves_to_cover(const SurfaceMesh& mesh, const collision::SphereTree& tree,
+                                 double spacing) {
+  // The evaluator's frame: scaled, not moved (the same doubles as its samples).
+  const double scale = to_normalized_units(mesh);
+  const SurfaceMesh scaled = normalized_mesh(mesh, false);
+  const std::vector<collision::Sphere> leaves = normalized_leaves(mesh, tree, false);
+  std::vector<double> reach2(leaves.size());  // squared radius each leaf needs
+  for (size_t j = 0; j < leaves.size(); ++j) reach2[j] = leaves[j].r * leaves[j].r;
+  GrownLeaves out;
+  size_t last = 0;  // the leaf that covered the previous sample (tried first)
+  mesh::visit_coverage_samples(
+      scaled, spacing, [&](const Eigen::Vector3d& p, const Eigen::Vector3d&, double) {
+        auto covers = [&](size_t j) {
+          return (p - leaves[j].center()).squaredNorm() <= leaves[j].r * leaves[j].r;
+        };
+        if (!leaves.empty() && covers(last)) return;
+        for (size_t j = 0; j < leaves.size(); ++j) {
+          if (covers(j)) {
+            last = j;
+            return;
+          }
+        }
+        ++out.uncovered_samples;
+        size_t best = 0;
+        double best_gap = std::numeric_limits<double>::infinity();
+        for (size_t j = 0; j < leaves.size(); ++j) {
+          const double gap = (p - leaves[j].center()).norm() - leaves[j].r;
+          if (gap < best_gap) best_gap = gap, best = j;
+        }
+        reach2[best] = std::max(reach2[best], (p - leaves[best].center()).squaredNorm());
+      });
+  out.tree = tree;
+  const int begin = tree.level_offset[static_cast<size_t>(tree.num_levels() - 1)];
+  for (size_t j = 0; j < leaves.size(); ++j) {
+    const double r = std::sqrt(reach2[j]);
+    if (r <= leaves[j].r) continue;
+    ++out.grown;
+    out.largest_growth = std::max(out.largest_growth, r - leaves[j].r);
+    out.tree.spheres[static_cast<size_t>(begin) + j].r = r * (1 + 1e-9) / scale;
+  }
+  out.tree.rest_spheres = out.tree.spheres;
+  return out;
+}
+
+ShrunkLeaves shrink_leaves_to_coverage_of(const SurfaceMesh& mesh,
+                                          const collision::SphereTree& tree,
+                                          const collision::SphereTree& other, double spacing) {
+  const double scale = to_normalized_units(mesh);
+  const std::vector<collision::Sphere> leaves = normalized_leaves(mesh, tree, false),
+                                       others = normalized_leaves(mesh, other, false);
+  std::vector<double> reach2(leaves.size(), 0.0);
+  ShrunkLeaves out;
+  size_t last = 0;
+  auto inside = [](const collision::Sphere& s, const Eigen::Vector3d& p) {
+    return (p - s.center()).squaredNorm() <= s.r * s.r;
+  };
+  mesh::visit_coverage_samples(
+      normalized_mesh(mesh, false), spacing,
+      [&](const Eigen::Vector3d& p, const Eigen::Vector3d&, double) {
+        if (others.empty() || !inside(others[last], p)) {
+          const auto it = std::find_if(others.begin(), others.end(),
+                                       [&](const collision::Sphere& s) { return inside(s, p); });
+          if (it == others.end()) {
+            ++out.dropped_samples;
+            return;
+          }
+          last = static_cast<size_t>(it - others.begin());
+        }
+        size_t best = leaves.size();
+        double best_depth = std::numeric_limits<double>::infinity();
+        for (size_t j = 0; j < leaves.size(); ++j) {
+          const double d = (p - leaves[j].center()).norm() - leaves[j].r;
+          if (d <= 0 && d < best_depth) best_depth = d, best = j;
+        }
+        if (best == leaves.size())
+          throw ParameterError("shrink_leaves_to_coverage_of: the tree leaves a sample uncovered");
+        reach2[best] = std::max(reach2[best], (p - leaves[best].center()).squaredNorm());
+      });
+  out.tree = tree;
+  const int begin = tree.level_offset[static_cast<size_t>(tree.num_levels() - 1)];
+  for (size_t j = 0; j < leaves.size(); ++j) {
+    if (reach2[j] == 0) ++out.emptied;
+    out.tree.spheres[static_cast<size_t>(begin) + j].r = std::sqrt(reach2[j]) * (1 + 1e-9) / scale;
+  }
+  out.tree.rest_spheres = out.tree.spheres;
+  return out;
+}
+
+void write_leaf_table(std::ostream& out, const SurfaceMesh& mesh,
+                      const collision::SphereTree& tree) {
+  const mesh::MeshOracle oracle(mesh::close_holes(normalized_mesh(mesh, true)));
+  const MatX3d dirs162 = mesh::probe_directions(2), dirs2562 = mesh::probe_directions(4);
+  out << "leaf,x,y,z,r,depth,sx,sy,sz,e162,e2562\n";
+  char line[512];
+  int index = 0;
+  for (const collision::Sphere& s : normalized_leaves(mesh, tree, true)) {
+    const Eigen::Vector3d c = s.center(), q = oracle.closest_point(c);
+    std::snprintf(line, sizeof line, "%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+                  index++, c.x(), c.y(), c.z(), s.r, oracle.signed_distance(c), q.x(), q.y(), q.z(),
+                  mesh::sphere_protrusion(oracle, c, s.r, dirs162),
+                  mesh::sphere_protrusion(oracle, c, s.r, dirs2562));
+    out << line;
+  }
+}
+
+void write_sample_table(std::ostream& out, const SurfaceMesh& mesh,
+                        const collision::SphereTree& tree, double spacing) {
+  const std::vector<collision::Sphere> leaves = normalized_leaves(mesh, tree, true);
+  out << "x,y,z,nx,ny,nz,w,leaves,reach\n";
+  char line[512];
+  mesh::visit_coverage_samples(
+      normalized_mesh(mesh, true), spacing,
+      [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n, double weight) {
+        int count = 0;
+        double reach = 0;
+        for (const collision::Sphere& s : leaves) {
+          const Eigen::Vector3d d = s.center() - p;
+          if (d.squaredNorm() > s.r * s.r) continue;
+          ++count;
+          const double along = d.dot(n);
+          reach = std::max(
+              reach, along + std::sqrt(std::max(0.0, s.r * s.r - d.squaredNorm() + along * along)));
+        }
+        std::snprintf(line, sizeof line, "%.3f,%.3f,%.3f,%.4f,%.4f,%.4f,%.5g,%d,%.3f\n", p.x(),
+                      p.y(), p.z(), n.x(), n.y(), n.z(), weight, count, reach);
+        out << line;
+      });
 }
 
 }  // namespace icd::experiments

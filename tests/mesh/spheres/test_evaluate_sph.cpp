@@ -4,6 +4,7 @@
 // and its refusals of bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -15,10 +16,11 @@
 
 #include <Eigen/Geometry>
 
+#include <icd/collision/sph_io.hpp>
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/io/surface_writer.hpp>
-#include "mesh/program_run.hpp"
 #include <icd/mesh/spheres/evaluation.hpp>
+#include "mesh/program_run.hpp"
 
 namespace {
 
@@ -124,6 +126,38 @@ TEST(EvaluateSphProgram, EvaluatesAToolkitFileInBothFramesAndRefusesBadInput) {
       run_program(mesh_arg + (dir / "cube-medial.sph").string() + common, dir);
   ASSERT_EQ(uncentred.status, 0) << uncentred.output;
   EXPECT_NE(row(uncentred.output, "ours", 1).at(4), a[4]);
+
+  // --cover-leaves: the one leaf gets every uncovered sample, so its radius
+  // becomes the distance to the farthest point of the cube, a corner (the
+  // corners are samples); the grown tree is evaluated covering.
+  const ProgramRun grown = run_program(mesh_arg + (dir / "cube.sph").string() + common +
+                                           " --cover-leaves " + (dir / "grown.sph").string(),
+                                       dir);
+  ASSERT_EQ(grown.status, 0) << grown.output;
+  double farthest = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d v(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1);
+    farthest = std::max(farthest, (kTurn * v - child).norm());
+  }
+  const icd::collision::SphereTree grown_tree =
+      icd::collision::read_sph((dir / "grown.sph").string());
+  ASSERT_EQ(grown_tree.num_nodes(), 2);
+  EXPECT_NEAR(grown_tree.spheres[1].r, farthest, 1e-8);
+  EXPECT_EQ(grown_tree.spheres[0].r, 1.8);  // upper levels unchanged
+  EXPECT_EQ(row(grown.output, "ours", 1).at(10), "0.00000%");
+  EXPECT_NE(a[10], "0.00000%");  // the leaf did not cover before
+  // --cover-only-as the tree itself: the leaf shrinks to the farthest sample
+  // it covers, within one sample spacing (40 of 2000 units) of its radius.
+  const ProgramRun shrunk =
+      run_program(mesh_arg + (dir / "cube.sph").string() + common + " --cover-only-as " +
+                      (dir / "cube.sph").string() + " --shrunk " + (dir / "shrunk.sph").string(),
+                  dir);
+  ASSERT_EQ(shrunk.status, 0) << shrunk.output;
+  const icd::collision::SphereTree shrunk_tree =
+      icd::collision::read_sph((dir / "shrunk.sph").string());
+  EXPECT_LE(shrunk_tree.spheres[1].r, child_r * (1 + 1e-8));
+  EXPECT_GE(shrunk_tree.spheres[1].r, child_r - 40.0 * side / 2000.0);
+  EXPECT_EQ(row(shrunk.output, "ours", 1).at(10), a[10]);  // the same samples uncovered
 
   // A NaN radius: status 1, the file and the node named.
   {
