@@ -6,10 +6,14 @@
 // probe frame, the trees it wrote for the dragon and the bunny (committed
 // as reference data, experiments/studies/spheretree/results/reference/) must give
 // those numbers: an independent check of our inside tests, distances and
-// probe frame. Skipped when the meshes have not been fetched
-// (scripts/fetch_meshes.sh).
+// probe frame. The corpus hand (issue 30) too: its toolkit tree has one leaf
+// written with radius 0.000000 that the toolkit's evaluation skips (its
+// count is ours minus one; the dragon's and bunny's such leaves it counts).
+// A model whose mesh has not been fetched (scripts/fetch_meshes.sh,
+// scripts/fetch_corpus.sh) is skipped.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -51,11 +55,13 @@ std::vector<ToolkitLevel> toolkit_evaluation(const fs::path& sph) {
 TEST(ReferenceToolkit, OurEvaluationInItsFrameGivesItsOwnNumbers) {
   const char* env = std::getenv("ICD_DATA_DIR");
   const fs::path data = fs::path(env ? env : ICD_DATA_DIR);
-  const fs::path reference = fs::path(ICD_SOURCE_DIR) / "experiments/studies/spheretree/results/reference";
+  const fs::path reference =
+      fs::path(ICD_SOURCE_DIR) / "experiments/studies/spheretree/results/reference";
   int checked = 0;
   for (const auto& [mesh_file, tree_file] :
        {std::pair{"ChineseDragon-10kv.off", "dragon_readme-medial.sph"},
-        std::pair{"bunny00.off", "bunny_readme-medial.sph"}}) {
+        std::pair{"bunny00.off", "bunny_readme-medial.sph"},
+        std::pair{"corpus/hand.off", "hand_readme-medial.sph"}}) {
     SCOPED_TRACE(tree_file);
     const fs::path mesh_path = data / mesh_file;
     if (!fs::exists(mesh_path)) continue;
@@ -79,12 +85,22 @@ TEST(ReferenceToolkit, OurEvaluationInItsFrameGivesItsOwnNumbers) {
     ASSERT_EQ(toolkit_frame.size(), 4u);
     for (size_t l = 0; l < 4; ++l) {
       SCOPED_TRACE("level " + std::to_string(l));
-      EXPECT_EQ(toolkit_frame[l].num_spheres, expected[l].num);
+      // Spheres of radius 0 (centres on the surface, error < 1e-3): the
+      // toolkit may have left them out of its count and mean.
+      const int begin = tree.level_offset[l], end = tree.level_offset[l + 1];
+      int zero = 0;
+      for (int i = begin; i < end; ++i) {
+        if (tree.spheres[static_cast<size_t>(i)].r == 0) ++zero;
+      }
+      const int ours = toolkit_frame[l].num_spheres;
+      EXPECT_TRUE(ours == expected[l].num || ours - zero == expected[l].num)
+          << ours << " spheres (" << zero << " of radius 0), the toolkit's " << expected[l].num;
       // The toolkit computes in single precision and prints 3 decimals
       // (measured: within 5e-4 at every level).
       EXPECT_NEAR(toolkit_frame[l].worst_error_42, expected[l].worst,
                   1e-3 + 1e-5 * expected[l].worst);
-      EXPECT_NEAR(toolkit_frame[l].mean_error_42, expected[l].mean, 1e-3 + 1e-5 * expected[l].mean);
+      const double mean = toolkit_frame[l].mean_error_42 * ours / std::max(1, expected[l].num);
+      EXPECT_NEAR(mean, expected[l].mean, 1e-3 + 1e-5 * expected[l].mean);
     }
     // The tree was fitted against those 42 points: in our frame (another 42
     // directions) its leaves stick out much further.
