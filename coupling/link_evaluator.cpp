@@ -98,13 +98,7 @@ void LinkEvaluator::reset_frames() { std::fill(m_has_frame.begin(), m_has_frame.
 
 LinkApplyResult LinkEvaluator::apply(const Eigen::Ref<const MatX3d>& coarse_positions,
                                      Eigen::Ref<MatX3d> dense_out) {
-  if (coarse_positions.rows() != m_num_coarse_nodes)
-    throw ParameterError("LinkEvaluator::apply: coarse_positions has " +
-                         std::to_string(coarse_positions.rows()) + " rows, the links expect " +
-                         std::to_string(m_num_coarse_nodes));
-  if (dense_out.rows() != num_links())
-    throw ParameterError("LinkEvaluator::apply: dense_out has " + std::to_string(dense_out.rows()) +
-                         " rows, expected " + std::to_string(num_links()));
+  check_sizes("apply", coarse_positions.rows(), dense_out.rows());
   const LinkApplyResult result =
       update_triples(coarse_positions, num_triples(), [](int i) { return i; });
   evaluate_links(dense_out);
@@ -114,14 +108,7 @@ LinkApplyResult LinkEvaluator::apply(const Eigen::Ref<const MatX3d>& coarse_posi
 LinkApplyResult LinkEvaluator::apply_triples(const Eigen::Ref<const MatX3d>& coarse_positions,
                                              const std::vector<int32_t>& triples,
                                              Eigen::Ref<MatX3d> dense_out) {
-  if (coarse_positions.rows() != m_num_coarse_nodes)
-    throw ParameterError("LinkEvaluator::apply_triples: coarse_positions has " +
-                         std::to_string(coarse_positions.rows()) + " rows, the links expect " +
-                         std::to_string(m_num_coarse_nodes));
-  if (dense_out.rows() != num_links())
-    throw ParameterError("LinkEvaluator::apply_triples: dense_out has " +
-                         std::to_string(dense_out.rows()) + " rows, expected " +
-                         std::to_string(num_links()));
+  check_sizes("apply_triples", coarse_positions.rows(), dense_out.rows());
   for (int32_t t : triples)
     if (t < 0 || t >= num_triples())
       throw ParameterError("LinkEvaluator::apply_triples: no triple " + std::to_string(t));
@@ -141,6 +128,17 @@ LinkApplyResult LinkEvaluator::apply_triples(const Eigen::Ref<const MatX3d>& coa
     }
   }
   return result;
+}
+
+void LinkEvaluator::check_sizes(const char* who, Eigen::Index coarse_rows,
+                                Eigen::Index dense_rows) const {
+  if (coarse_rows != m_num_coarse_nodes)
+    throw ParameterError(std::string("LinkEvaluator::") + who + ": coarse_positions has " +
+                         std::to_string(coarse_rows) + " rows, the links expect " +
+                         std::to_string(m_num_coarse_nodes));
+  if (dense_rows != num_links())
+    throw ParameterError(std::string("LinkEvaluator::") + who + ": dense_out has " +
+                         std::to_string(dense_rows) + " rows, expected " + std::to_string(num_links()));
 }
 
 void LinkEvaluator::check_finite(const Eigen::Ref<const MatX3d>& coarse_positions) const {

@@ -106,6 +106,8 @@ class LinkEvaluator {
   const std::vector<int32_t>& triple_links() const { return m_triple_links; }
 
  private:
+  /// The size checks of apply() and apply_triples() (`who` names the caller).
+  void check_sizes(const char* who, Eigen::Index coarse_rows, Eigen::Index dense_rows) const;
   void check_finite(const Eigen::Ref<const MatX3d>& coarse_positions) const;
   /// Frames of the triples index(0), ..., index(count - 1).
   template <class Index>

@@ -327,9 +327,9 @@ void World::share_budget() {
                    [&](size_t x, size_t y) { return m_pair_weight[x] < m_pair_weight[y]; });
 }
 
-int World::motion_cycles(double dt) const {
+int World::motion_cycles(double dt, bool pairs_only) const {
   double cycles = 1;
-  if (m_obstacle_near) {
+  if (m_obstacle_near && !pairs_only) {
     // Near an obstacle: each object moves at most cycle_motion of its scale
     // (and of half the thinnest box) per cycle, gravity included.
     // and a cycle is at most kObstacleCycle long: the support of a resting
@@ -339,9 +339,12 @@ int World::motion_cycles(double dt) const {
     double thin = std::numeric_limits<double>::infinity();
     for (const Obstacle& ob : m_settings.obstacles) thin = std::min(thin, 0.5 * ob.thickness());
     for (const RuntimeObject& o : m_objects) {
-      // (only the objects that came near one: the others are not projected)
-      if (!o.sim || o.obstacle_scale <= 0 || !o.near_obstacle) continue;
-      const double v = o.sim->velocities().rowwise().norm().maxCoeff();
+      // (the objects that came near one or may reach one within the frame:
+      // obstacle_approach is 0 for the others)
+      if (!o.sim || o.obstacle_scale <= 0 || o.deferred) continue;
+      // How far the surface may sink into an obstacle over the frame: its
+      // approach (not the speed of nodes moving along or away from it).
+      const double v = obstacle_approach(o, dt);
       const double motion = v * dt + 0.5 * m_settings.gravity.norm() * dt * dt;
       const double step =
           std::min(m_settings.collision.cycle_motion * std::min(o.obstacle_scale, thin), kObstacleStep);
@@ -364,6 +367,59 @@ int World::motion_cycles(double dt) const {
     if (step > 0) cycles = std::max(cycles, std::ceil(motion / step));
   }
   return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
+}
+
+double World::obstacle_approach(const RuntimeObject& o, double dt) const {
+  const MatX3d& v = o.sim->velocities();
+  const Eigen::VectorXd speed = v.rowwise().norm();
+  const double fall = 0.5 * m_settings.gravity.norm() * dt * dt;
+  double approach = o.near_obstacle ? o.obstacle_rate : 0.0;
+  // The obstacles any vertex may reach within the frame at the fastest
+  // node's speed (the surface lies within max_link of the nodes' box).
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(speed.maxCoeff() * dt + fall + o.max_link);
+  const Eigen::Vector3d lo = o.positions.colwise().minCoeff().transpose() - pad;
+  const Eigen::Vector3d hi = o.positions.colwise().maxCoeff().transpose() + pad;
+  const int n = static_cast<int>(o.positions.rows());
+  MatX3d q, w;  // node coordinates and velocities in the obstacle's frame
+  for (const Obstacle& ob : m_settings.obstacles) {
+    if (ob.lower_bound(lo, hi) > 0) continue;
+    const bool plane = ob.type == Obstacle::Type::Plane;
+    if (plane) {
+      q.resize(n, 3);  // (column 0 only)
+      w.resize(n, 3);
+      q.col(0) = (o.positions.rowwise() - ob.point.transpose()) * ob.normal;
+      w.col(0) = v * ob.normal;
+    } else {
+      q = (o.positions.rowwise() - ob.point.transpose()) * ob.axes;
+      w = v * ob.axes;
+    }
+    for (int t = 0; t < o.links.num_triples(); ++t) {
+      const int32_t* nodes = o.links.triple_nodes(t);
+      const double r = o.triple_reach[static_cast<size_t>(t)];
+      // The lower bound of its vertices' signed distance (obstacle_layer):
+      // bound_k - reach on its binding axis k, the side s the triple is on.
+      int axis = 0;
+      double side = 1, bound = -std::numeric_limits<double>::infinity();
+      for (int k = 0; k < (plane ? 1 : 3); ++k) {
+        const double a = std::min({q(nodes[0], k), q(nodes[1], k), q(nodes[2], k)});
+        const double b = -std::max({q(nodes[0], k), q(nodes[1], k), q(nodes[2], k)});
+        const double f = plane ? a : std::max(a, b) - ob.half_extents[k];
+        if (f > bound || k == 0) {
+          bound = f;
+          axis = k;
+          side = plane || a >= b ? 1.0 : -1.0;
+        }
+      }
+      bound -= r < 0 ? o.max_link : r;
+      const double vt = std::max({speed[nodes[0]], speed[nodes[1]], speed[nodes[2]]});
+      // Out of reach for the frame at its own speed: max_k f_k decreases no
+      // faster than f_axis, whose decrease is its nodes' motion toward the
+      // obstacle along the axis (at most vt per second).
+      if (bound > vt * dt + fall + 1e-9) continue;  // (NaN: counted)
+      for (int i = 0; i < 3; ++i) approach = std::max(approach, -side * w(nodes[i], axis));
+    }
+  }
+  return approach;
 }
 
 int World::fit_cycles(double dt, int n, const std::vector<CycleLoad>& loads) {
@@ -494,7 +550,9 @@ int World::contact_cycles(double dt) const {
   // reached 2.59 leaf radii at these cycles, 1.2-1.6 at the rule above). So
   // each pair must close by at most cycle_motion / kSlowContact leaf radii
   // per cycle at this count (the main job: ~0.05 leaf radii per cycle).
-  if (kSlowContact * motion_cycles(dt) > at_step) return stiff;
+  // (the pairs' motion only: the obstacles' cycles bound the projection
+  // step, not how fast a pair closes)
+  if (kSlowContact * motion_cycles(dt, /*pairs_only=*/true) > at_step) return stiff;
   return std::clamp(at_step, 1, stiff);
 }
 
@@ -1092,6 +1150,7 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
   const Eigen::Vector3d pad = Eigen::Vector3d::Constant(o.max_link);
   const Eigen::Vector3d lo = lo_in - pad, hi = hi_in + pad;
   o.obstacle_near.clear();
+  o.obstacle_rate = 0;
   for (size_t b = 0; b < m_settings.obstacles.size(); ++b)
     if (m_settings.obstacles[b].lower_bound(lo, hi) <= 0) o.obstacle_near.push_back(static_cast<int>(b));
   if (o.obstacle_near.empty()) return;
@@ -1150,6 +1209,7 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
         }
       }
     }
+    if (pass == 0 && o.advanced > 0) o.obstacle_rate = o.cycle_obstacle_depth / o.advanced;
     if (!inside) break;
     if (!moved) e_before = mechanical_energy(*o.sim, m_settings.gravity);
     double largest = 0;
@@ -1169,7 +1229,7 @@ void World::resolve_obstacles(RuntimeObject& o, const Eigen::Vector3d& lo_in,
       const double vn = vel.row(j).dot(dir.row(j));
       if (vn < 0) vel.row(j) -= vn * dir.row(j);
     }
-    o.sim->set_positions(o.positions);
+    o.sim->correct_positions(o.positions);  // (keeps the step estimate: strain-checked)
     o.sim->set_velocities(vel);
   }
   // Never a source of energy. Moving nodes out stores elastic energy (only

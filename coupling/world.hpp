@@ -148,6 +148,10 @@ struct RuntimeObject {
   /// median leaf radius, m), and scratch dense positions.
   double max_link = 0;
   double obstacle_scale = 0;
+  /// Deepest a dense vertex was found inside an obstacle by the last
+  /// cycle's projection over that cycle's length, m/s (a measured
+  /// approach speed, World::obstacle_approach).
+  double obstacle_rate = 0;
   MatX3d obstacle_dense;
   /// Per link triple (LinkEvaluator): the longest link vector |c| of its
   /// links, m (-1: some link has a negative origin weight, no bound: always
@@ -331,8 +335,11 @@ class World {
   std::vector<char> m_pair_close;
   /// Cycles a frame of dt needs so that no pair moves more than
   /// collision.cycle_motion leaf radii relative to each other per cycle,
-  /// from each object's last measured sphere speed.
-  int motion_cycles(double dt) const;
+  /// from each object's last measured sphere speed; near static obstacles,
+  /// also as many as keep each object's approach to them under
+  /// kObstacleStep per cycle (obstacle_approach). pairs_only: the pairs'
+  /// bound alone.
+  int motion_cycles(double dt, bool pairs_only = false) const;
   /// fit_cycles for the frame of dt: the deformable objects that run the
   /// cycles (not deferred), each weighted by its tets, at its step_cap.
   int aligned_cycles(double dt, int n) const;
@@ -372,6 +379,18 @@ class World {
   /// positions (for a caller that knows the nodes have not moved enough to
   /// change it).
   void obstacle_layer(RuntimeObject& o, double threshold, bool same_triples = false) const;
+  /// How fast object o's dense surface may approach the static obstacles
+  /// over the coming frame of dt, m/s: per link triple that could reach an
+  /// obstacle within the frame at its nodes' speeds, the fastest of its
+  /// nodes' velocity components toward that obstacle along the axis that
+  /// bounds the triple's distance (a lower bound of the signed distance,
+  /// as in obstacle_layer, decreases no faster than that); the largest over
+  /// triples, and at least the penetration speed its last cycle's projection
+  /// measured (RuntimeObject::obstacle_rate: what the velocities at the
+  /// frame's start do not show, e.g. an acceleration into the obstacle).
+  /// A node vibrating along the floor, or fast far from any obstacle, sets
+  /// no cycles; its speed into the floor does.
+  double obstacle_approach(const RuntimeObject& o, double dt) const;
   /// Some object came within reach of an obstacle in the last cycle.
   bool m_obstacle_near = false;
   /// Detection/response cycles a frame of dt needs for a stable penalty.

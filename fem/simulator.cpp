@@ -49,6 +49,14 @@ void Simulator::set_positions(const Eigen::Ref<const MatX3d>& x) {
   m_end_force_valid = false;
 }
 
+void Simulator::correct_positions(const Eigen::Ref<const MatX3d>& x) {
+  const double estimate_time = m_estimate_time;
+  set_positions(x);
+  // (the estimate's edge lengths stay: deformed_since_estimate() measures
+  // the correction together with the motion since the estimate)
+  m_estimate_time = estimate_time;
+}
+
 void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
   if (v.rows() != m_model.num_nodes() || !v.allFinite())
     throw ParameterError("fem::Simulator::set_velocities: expected a finite #V x 3 array, #V = " +

@@ -130,6 +130,14 @@ class Simulator {
   double time() const { return m_time; }
   /// Sets positions / velocities (#V x 3); ParameterError on shape or non-finite values.
   void set_positions(const Eigen::Ref<const MatX3d>& x);
+  /// As set_positions, for a small correction of the current state (e.g. a
+  /// static obstacle projecting the surface out): the last stable-step
+  /// estimate is kept under the same reuse rules as the motion of the
+  /// simulation itself (frequency_reuse_time, and dropped once any edge has
+  /// changed length by more than frequency_reuse_strain since it was made),
+  /// where set_positions always estimates again. The forces and health of
+  /// the new state are computed again as after set_positions.
+  void correct_positions(const Eigen::Ref<const MatX3d>& x);
   void set_velocities(const Eigen::Ref<const MatX3d>& v);
   /// Forwards to Model::set_external_forces.
   void set_external_forces(const Eigen::Ref<const MatX3d>& f) { m_model.set_external_forces(f); }

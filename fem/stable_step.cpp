@@ -38,6 +38,14 @@ double rk4_mode_limit(double omega, double c) {
   return lo;
 }
 
+// Whether RK4 at step h is stable for the mode (omega, c) (both roots, as
+// rk4_mode_limit tests them).
+bool rk4_step_stable(double omega, double c, double h) {
+  const std::complex<double> disc = std::sqrt(std::complex<double>(c * c - 4 * omega * omega, 0.0));
+  const std::complex<double> s1 = 0.5 * (-c + disc), s2 = 0.5 * (-c - disc);
+  return rk4_stable(h * s1) && rk4_stable(h * s2);
+}
+
 double symplectic_euler_mode_limit(double omega, double c) {
   double h = (std::sqrt(c * c + 4 * omega * omega) - c) / (omega * omega);
   if (c > 0) h = std::min(h, 2.0 / c);
@@ -58,14 +66,22 @@ double stable_step_limit(Integrator integrator, double omega_max, const Rayleigh
   double limit = std::numeric_limits<double>::infinity();
   // Extra modal damping in [0, max_damping_rate]: 9 levels (0 and the maximum included).
   const int levels = max_damping_rate > 0 ? 8 : 0;
-  for (int k = 0; k <= 96; ++k) {  // omega_max * 10^(-6 .. 0)
+  // From the top mode down (it usually sets the limit): a mode for which
+  // the limit found so far is already stable cannot lower it (the stable
+  // steps of a mode form an interval [0, its limit], as rk4_mode_limit's
+  // search assumes), so RK4 skips its bisection (one stability test
+  // instead of ~60: the limit was ~20 % of a many_objects contact cycle).
+  for (int k = 96; k >= 0; --k) {  // omega_max * 10^(0 .. -6)
     const double omega = omega_max * std::pow(10.0, -6.0 * (96 - k) / 96.0);
     for (int j = 0; j <= levels; ++j) {
       const double c = damping.alpha + damping.beta * omega * omega +
                        (levels ? max_damping_rate * j / levels : 0.0);
-      const double h = integrator == Integrator::RK4 ? rk4_mode_limit(omega, c)
-                                                     : symplectic_euler_mode_limit(omega, c);
-      limit = std::min(limit, h);
+      if (integrator == Integrator::RK4) {
+        if (std::isfinite(limit) && rk4_step_stable(omega, c, limit)) continue;
+        limit = std::min(limit, rk4_mode_limit(omega, c));
+      } else {
+        limit = std::min(limit, symplectic_euler_mode_limit(omega, c));
+      }
     }
   }
   return limit;

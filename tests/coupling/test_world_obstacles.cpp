@@ -220,6 +220,62 @@ TEST(Obstacles, CullingFarVerticesGivesTheSameTrajectoryBitwise) {
   EXPECT_EQ(every.objects()[0].obstacle_layer.size(), static_cast<size_t>(links));
 }
 
+// The cycles near an obstacle come from how fast the surface approaches it
+// (World::obstacle_approach), not from how fast its nodes move: a ball
+// sliding along a frictionless floor at 3 m/s keeps the 1 ms cycles (17 per
+// frame; the node speed, 3 m/s x 16.7 ms / 1 mm, would ask for 51), while a
+// ball thrown down at the thin box at 10 m/s gets at least its approach per
+// 1 mm step (167 cycles) and never passes into it by more than 1 mm.
+struct Throw {
+  int min_cycles_near = 1 << 30, max_cycles_near = 0;  // frames with the ball near the obstacle
+  double lowest = std::numeric_limits<double>::infinity();  // over frame ends, above the top, m
+  double depth = 0;  // deepest vertex found inside before its projection, m
+};
+Throw throw_ball(const Eigen::Vector3d& velocity, int frames) {
+  WorldSettings s;
+  s.gravity = {0, 0, -9.81};
+  Obstacle floor = thin_box();
+  floor.half_extents = {5, 5, 0.01};
+  s.obstacles.push_back(floor);
+  std::vector<WorldObject> objects;
+  objects.push_back(ball(0.112));  // lowest dense vertex ~2 mm above the top
+  objects[0].setup.velocity = velocity;
+  World world(std::move(objects), s);
+  const RuntimeObject& o = world.objects()[0];
+  LinkEvaluator links(o.asset.links);
+  MatX3d dense(o.asset.links.num_links(), 3);
+  Throw t;
+  for (int f = 0; f < frames; ++f) {
+    const FrameMetrics m = world.step();
+    if (o.near_obstacle) {
+      t.min_cycles_near = std::min(t.min_cycles_near, m.cycles_motion);
+      t.max_cycles_near = std::max(t.max_cycles_near, m.cycles_motion);
+    }
+    links.apply(o.positions, dense);
+    t.lowest = std::min(t.lowest, dense.col(2).minCoeff() - 0.01);
+    t.depth = std::max(t.depth, m.obstacle_depth);
+    if (std::getenv("ICD_TEST_VERBOSE"))
+      std::printf("frame %d cycles %d motion %d depth %.3g lowest %.3g\n", f, m.cycles,
+                  m.cycles_motion, m.obstacle_depth, dense.col(2).minCoeff() - 0.01);
+  }
+  return t;
+}
+
+TEST(Obstacles, SlidingAlongTheFloorAsksNoMoreCyclesThanResting) {
+  const Throw t = throw_ball({3, 0, 0}, 8);
+  EXPECT_GT(t.max_cycles_near, 0);     // it came near the floor
+  EXPECT_LE(t.max_cycles_near, 20);    // the 1 ms cycles (17) and gravity, not 51
+  EXPECT_GT(t.lowest, -1e-3);
+  EXPECT_LT(t.lowest, 1e-3);           // and it rests on it
+}
+
+TEST(Obstacles, FastApproachGetsItsCyclesAndDoesNotSinkIn) {
+  const Throw t = throw_ball({0, 0, -10}, 2);
+  EXPECT_GE(t.max_cycles_near, 167);   // 10 m/s x 16.7 ms / 1 mm
+  EXPECT_GT(t.lowest, -1e-3);
+  EXPECT_LT(t.depth, 2e-3);            // found inside by at most about one step
+}
+
 TEST(Obstacles, SignedDistanceOfPlaneAndBox) {
   Obstacle p = plane_at(0);
   p.normal = {0, 0, 2};

@@ -345,5 +345,46 @@ TEST(StableStep, AmortisedEstimateNeverStepsAboveTheTrueLimitOfAnyCycle) {
   }
 }
 
+// Simulator::correct_positions (a static obstacle's projection in
+// coupling::World): a correction that strains no edge by more than
+// frequency_reuse_strain keeps the estimate (no Lanczos product in the next
+// advance), one that compresses the cube by 5% has it estimated again, and
+// the next step stays below the dense oracle's limit of the corrected state
+// either way; set_positions always estimates again.
+TEST(StableStep, PositionCorrectionKeepsTheEstimateUntilTheStrainTrigger) {
+  const TetMesh m = test::box(3, 3, 3, {0.3, 0.3, 0.3});
+  const Material mat = test::material(MaterialModel::StableNeoHookean, 1e6, 0.45);
+  Model reference(m.V, m.T, mat);
+  SimulatorOptions o;
+  o.integrator = Integrator::RK4;
+  o.frequency_reuse_time = 1e-2;
+  Simulator sim(Model(m.V, m.T, mat), o);
+  const double cycle = 1e-3;
+  EXPECT_GT(sim.advance(cycle).frequency_products, 0);  // the first estimate
+  EXPECT_EQ(sim.advance(cycle).frequency_products, 0);  // reused
+  // A 1 mm lift (a projection out of a floor): rigid, no strain.
+  MatX3d x = sim.positions();
+  x.col(2).array() += 1e-3;
+  sim.correct_positions(x);
+  AdvanceReport rep = sim.advance(cycle);
+  EXPECT_EQ(rep.frequency_products, 0);
+  EXPECT_LE(rep.step, stable_step_limit(Integrator::RK4, dense_omega_max(reference, x), {}));
+  // The same lift through set_positions: estimated again.
+  x = sim.positions();
+  x.col(2).array() += 1e-3;
+  sim.set_positions(x);
+  EXPECT_GT(sim.advance(cycle).frequency_products, 0);
+  // 5% compression in z (the object stiffens): estimated again, below the new limit.
+  x = sim.positions();
+  const double z0 = x.col(2).minCoeff();
+  x.col(2) = (x.col(2).array() - z0) * 0.95 + z0;
+  sim.correct_positions(x);
+  const double truth = dense_omega_max(reference, x);
+  rep = sim.advance(cycle);
+  EXPECT_GT(rep.frequency_products, 0);
+  EXPECT_GE(rep.omega_max, 0.97 * truth);
+  EXPECT_LE(rep.step, stable_step_limit(Integrator::RK4, truth, {}));
+}
+
 }  // namespace
 }  // namespace icd::fem
