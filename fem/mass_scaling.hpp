@@ -32,6 +32,10 @@ struct MassScaling {
   /// The scaling stops (target not reached, reported) rather than add more
   /// than this fraction of the object's mass, in (0, 1].
   double max_added_fraction = 0.05;
+  /// Lanczos-checked passes at most (each lowers the node threshold towards
+  /// the target); the scaling stops earlier when the target is reached or
+  /// the next pass would exceed max_added_fraction. >= 1.
+  int max_passes = 32;
 };
 
 /// What the scaling did (Model::mass_scaling()). Frequencies are Lanczos
@@ -54,9 +58,17 @@ struct MassScalingReport {
   double max_factor = 1;      ///< largest scaled / lumped node mass
   int estimates = 0;          ///< Lanczos estimates spent (passes + the first)
   bool reached = false;       ///< ratio_after >= target_ratio
+  int passes = 0;             ///< passes run (each one Lanczos estimate)
+  /// Why the scaling stopped short of the target (both false when reached):
+  /// the next pass would have added more than max_added_fraction ...
+  bool mass_limited = false;
+  bool pass_limited = false;  ///< ... or max_passes ran out first
   /// One line for summaries, e.g. "mass scaling to 0.4: +1.32 % mass on 138
   /// nodes (max x 8.2), step ratio 0.197 -> 0.400".
   std::string to_string() const;
+  /// Empty when reached, else " (target not reached: <why>)": the pass
+  /// limit, the added-mass limit, or the first pass already beyond it.
+  std::string shortfall() const;
 };
 
 /// The near-regular reference mesh: a cube of n x n x n cells of edge h cut
@@ -80,9 +92,12 @@ Eigen::VectorXd node_stiffness(Model& model, const Eigen::Ref<const MatX3d>& x);
 /// The scaling itself (the Model constructor calls it with its rest state):
 /// nodes whose own frequency exceeds a threshold get m_i = lambda_max(K_ii) /
 /// threshold^2, starting from the threshold ideal / target_ratio and lowered
-/// by the ratio of the Lanczos estimate to the target until the estimate of
-/// the scaled model is within the target (coupled light nodes share modes
-/// above their own frequencies; at most 8 passes). Sets the model's masses
+/// by the ratio of the Lanczos estimate to the target (raised to the power
+/// 1 / the top frequency's measured sensitivity to the threshold, from the
+/// last two passes) until the estimate of the scaled model is within the
+/// target (coupled light nodes share modes above their own frequencies), the
+/// next pass would exceed the added-mass limit, or max_passes ran out (the
+/// report says which). Sets the model's masses
 /// (Model::set_masses) and returns what it did. Throws ParameterError for bad options.
 MassScalingReport apply_mass_scaling(Model& model, const Eigen::Ref<const MatX3d>& rest,
                                      const MassScaling& options);

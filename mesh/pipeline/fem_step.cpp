@@ -89,7 +89,7 @@ StableStepReport stable_step_report(const TetMesh& mesh, const StableStepOptions
 
 std::string StableStepReport::to_string(const StableStepOptions& o) const {
   if (!error.empty()) return "stable step: not computed (" + error + ")";
-  char buf[512];
+  char buf[640];
   std::snprintf(buf, sizeof buf,
                 "stable step (%s, %s E %.3g Pa nu %.3g rho %.4g, Rayleigh [%g, %g], the mesh "
                 "in metres) %.4g s, ideal %.4g s (near-regular tets of the same mean volume): "
@@ -108,7 +108,7 @@ std::string StableStepReport::to_string(const StableStepOptions& o) const {
                     "+%.3g %% mass on %d nodes (max x %.3g), step %.4g s, ratio %.3f%s",
                     scaling.target_ratio, 100.0 * scaling.added_fraction, scaling.scaled_nodes,
                     scaling.max_factor, scaled_step, scaled_ratio,
-                    scaling.reached ? "" : " (target not reached: added-mass limit)");
+                    scaling.shortfall().c_str());
     }
     out += buf;
   }

@@ -236,6 +236,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     TetrahedralizeOptions to = o.tetrahedralize;
     to.limits = limits;
     to.cell_size *= s;
+    to.wrapped_surface = r.repair.wrap_cause != 0;
     TetrahedralizeResult tet;
     // The passes run in child processes: a failed attempt's CPU time is the
     // children's, which the retry adds to this stage's.
@@ -274,6 +275,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       try {
         repair_once(ro, &ru, beat);
         simplify_once(&su, beat);
+        to.wrapped_surface = true;
         tet = tetrahedralize_surface(simplified, to, beat);
       } catch (const ParameterError&) {
         throw;
@@ -305,10 +307,10 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       std::snprintf(buf, sizeof buf,
                     "tetrahedralize: stable-step post-pass collapsed %d node(s) (node estimate of "
                     "the step ratio %.3f -> %.3f, volume %+.2f %%, %d node(s) left above the "
-                    "target; --step-target); dihedral phase: %d collapse(s), %d relocation(s), "
-                    "smallest angle %.2f -> %.2f deg",
+                    "target; --step-target); dihedral phase: %d collapse(s), %d flip(s), %d "
+                    "surface sliver(s) dropped, %d relocation(s), smallest angle %.2f -> %.2f deg",
                     c.collapses, c.ratio_before, c.ratio_after, 100.0 * c.volume_change, c.stuck,
-                    c.dihedral_collapses, c.relocations, c.min_dihedral_before,
+                    c.dihedral_collapses, c.flips, c.drops, c.relocations, c.min_dihedral_before,
                     c.min_dihedral_after);
       r.notes.push_back(buf);
     }

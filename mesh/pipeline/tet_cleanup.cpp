@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numeric>
 #include <set>
 #include <unordered_map>
@@ -134,9 +135,11 @@ double ideal_omega(double mean_volume, double poisson) {
 
 StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) {
   if (!(o.target_ratio >= 0) || !(o.max_shift >= 0) || !(o.max_volume_change >= 0) ||
-      o.max_collapses < 0 || o.max_relocation_sweeps < 0 || !(o.poisson > -1 && o.poisson < 0.5))
+      o.max_collapses < 0 || o.max_relocation_sweeps < 0 || !(o.poisson > -1 && o.poisson < 0.5) ||
+      !(o.dihedral_volume_change >= 0))
     throw ParameterError("raise_stable_step: need target_ratio, max_shift, max_volume_change, "
-                         "max_collapses, max_relocation_sweeps >= 0 and poisson in (-1, 0.5)");
+                         "dihedral_volume_change, max_collapses, max_relocation_sweeps >= 0 and "
+                         "poisson in (-1, 0.5)");
   StepCleanupReport rep;
   const int n = static_cast<int>(mesh.V.rows());
   if (mesh.T.rows() == 0 || o.target_ratio == 0) return rep;
@@ -156,6 +159,15 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
   const Topology topo0 = topology(T, n);
   if (!topo0.ok) return rep;  // not a mesh this pass can keep valid
   double volume = volume0;
+  // The volume bound: max_volume_change from the start; in the dihedral
+  // phases also anything within dihedral_volume_change of where the step
+  // phase left it.
+  bool dihedral_phase = false;
+  double volume_d0 = volume0;
+  const auto volume_ok = [&](double vol) {
+    if (std::abs(vol / volume0 - 1) <= o.max_volume_change) return true;
+    return dihedral_phase && std::abs(vol - volume_d0) <= o.dihedral_volume_change * volume0;
+  };
   Eigen::VectorXd w = node_frequencies(mesh.V, T, o.poisson);
   rep.ratio_before = ideal / w.maxCoeff();
   // Positions of the surface as it was, where a peel or collapse moved it:
@@ -273,7 +285,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       changed.push_back(static_cast<int>(m.T.size()));
       m.T.push_back(t);
     }
-    if (std::abs(vol / volume0 - 1) > o.max_volume_change) return false;
+    if (!volume_ok(vol)) return false;
     const Topology topo = topology(m.T, n);
     if (!topo.ok || topo.euler != topo0.euler || topo.components != topo0.components) return false;
     {  // an interior collapse may expose nothing; the check is cheap
@@ -343,6 +355,8 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
   // or today's (the step does not get worse).
   rep.min_dihedral_before = 180;
   for (const Tet& t : T) rep.min_dihedral_before = std::min(rep.min_dihedral_before, min_dihedral(mesh.V, t));
+  dihedral_phase = true;
+  volume_d0 = volume;
   std::set<Tet> stuck_tets;
   while (o.dihedral_target_deg > 0 && rep.collapses + rep.dihedral_collapses < o.max_collapses &&
          attempts++ < 8L * n) {
@@ -387,6 +401,209 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     apply(L, best_i, best);
     ++rep.dihedral_collapses;
   }
+  // Flips and drops of the tets below the dihedral target (the smallest
+  // first): a 2-3 flip across one of its faces, the removal of one of its
+  // edges when that edge's tets form a closed ring of 3..7 (the ring
+  // polygon re-triangulated as a fan from each of its corners, joined to the
+  // edge's two ends), or, with a face on the boundary, the tet dropped. Each
+  // flip keeps the region (checked: positive tets, the same volume, the
+  // same boundary) and is taken when its new tets' smallest angle beats the
+  // sliver's; a drop keeps the bounds of the collapses. Flips that reach the
+  // target come first, then a drop, then any flip that improves.
+  const auto topological_phase = [&] {
+    if (o.dihedral_target_deg <= 0 || !o.flips) return;
+    const auto key_of = [](Tet t) {
+      std::sort(t.begin(), t.end());
+      return t;
+    };
+    const auto has = [](const Tet& t, int v) { return std::find(t.begin(), t.end(), v) != t.end(); };
+    std::set<Tet> stuck_flip;
+    struct Cand {
+      std::vector<int> removed;  // indices into T
+      std::vector<Tet> added;
+      double score = 0;          // smallest angle of the added tets (drops: the target)
+      bool drop = false;
+    };
+    for (long guard = 0; guard < 4L * static_cast<long>(T.size()) + 16; ++guard) {
+      int bad = -1;
+      double angle = o.dihedral_target_deg;
+      for (size_t e = 0; e < T.size(); ++e) {
+        const double d = min_dihedral(mesh.V, T[e]);
+        if (d < angle && !stuck_flip.count(key_of(T[e]))) {
+          angle = d;
+          bad = static_cast<int>(e);
+        }
+      }
+      if (bad < 0) break;
+      const Local L = local();
+      const double cap = std::max(threshold, w.maxCoeff());
+      const Tet t = T[static_cast<size_t>(bad)];
+      std::vector<Cand> cands;
+      const auto oriented = [&](Tet x) {  // positive orientation, or x[0] = -1 when flat
+        const double v = tet_volume(mesh.V, x);
+        if (v < 0) std::swap(x[2], x[3]);
+        if (v == 0) x[0] = -1;
+        return x;
+      };
+      const auto score_of = [&](const std::vector<Tet>& added) {
+        double d = 180;
+        for (const Tet& x : added) {
+          if (x[0] < 0 || !(tet_volume(mesh.V, x) > 0)) return -1.0;
+          d = std::min(d, min_dihedral(mesh.V, x));
+        }
+        return d;
+      };
+      bool on_boundary = false;
+      static constexpr int kOpp[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+      for (int k = 0; k < 4; ++k) {  // 2-3 flips across each face
+        const int p0 = t[kOpp[k][0]], p1 = t[kOpp[k][1]], p2 = t[kOpp[k][2]];
+        int other = -1;
+        for (int e : L.around[static_cast<size_t>(p0)])
+          if (e != bad && has(T[static_cast<size_t>(e)], p1) && has(T[static_cast<size_t>(e)], p2)) other = e;
+        if (other < 0) {
+          on_boundary = true;
+          continue;
+        }
+        int b = -1;
+        for (int v : T[static_cast<size_t>(other)])
+          if (v != p0 && v != p1 && v != p2) b = v;
+        const int a = t[k];
+        Cand c;
+        c.removed = {bad, other};
+        // Consistent orientation: every (a, b, p, q) along the face's cycle has one sign.
+        const int cyc[3] = {p0, p1, p2};
+        int sign = 0;
+        bool ok = true;
+        for (int m = 0; m < 3 && ok; ++m) {
+          const double v = tet_volume(mesh.V, Tet{a, b, cyc[m], cyc[(m + 1) % 3]});
+          const int sg = v > 0 ? 1 : v < 0 ? -1 : 0;
+          if (sg == 0 || (sign != 0 && sg != sign)) ok = false;
+          sign = sg;
+          c.added.push_back(oriented(Tet{a, b, cyc[m], cyc[(m + 1) % 3]}));
+        }
+        if (!ok) continue;
+        c.score = score_of(c.added);
+        if (c.score > angle) cands.push_back(std::move(c));
+      }
+      for (int ea = 0; ea < 4; ++ea)  // removal of each edge with a closed ring
+        for (int eb = ea + 1; eb < 4; ++eb) {
+          const int a = t[ea], b = t[eb];
+          std::vector<int> ring_tets;
+          for (int e : L.around[static_cast<size_t>(a)])
+            if (has(T[static_cast<size_t>(e)], b)) ring_tets.push_back(e);
+          if (ring_tets.size() < 3 || ring_tets.size() > 7) continue;
+          std::map<int, int> next;
+          bool ok = true;
+          for (int e : ring_tets) {
+            int cd[2], m = 0;
+            for (int v : T[static_cast<size_t>(e)])
+              if (v != a && v != b) cd[m++] = v;
+            if (tet_volume(mesh.V, Tet{a, b, cd[0], cd[1]}) < 0) std::swap(cd[0], cd[1]);
+            if (!next.emplace(cd[0], cd[1]).second) ok = false;
+          }
+          if (!ok) continue;
+          std::vector<int> ring{next.begin()->first};
+          while (ring.size() <= ring_tets.size()) {
+            const auto it = next.find(ring.back());
+            if (it == next.end()) break;
+            ring.push_back(it->second);
+          }
+          // Closed: back at the start after exactly |ring_tets| steps.
+          if (ring.size() != ring_tets.size() + 1 || ring.back() != ring.front()) continue;
+          ring.pop_back();
+          const int k = static_cast<int>(ring.size());
+          for (int apex = 0; apex < (k == 3 ? 1 : k); ++apex) {
+            Cand c;
+            c.removed = ring_tets;
+            int sa = 0;
+            bool good = true;
+            for (int j = 1; j + 1 < k && good; ++j) {
+              const int p = ring[static_cast<size_t>(apex)], q = ring[static_cast<size_t>((apex + j) % k)],
+                        r = ring[static_cast<size_t>((apex + j + 1) % k)];
+              const double va = tet_volume(mesh.V, Tet{p, q, r, a}), vb = tet_volume(mesh.V, Tet{p, q, r, b});
+              const int ga = va > 0 ? 1 : va < 0 ? -1 : 0, gb = vb > 0 ? 1 : vb < 0 ? -1 : 0;
+              if (ga == 0 || gb != -ga || (sa != 0 && ga != sa)) good = false;
+              sa = ga;
+              c.added.push_back(oriented(Tet{p, q, r, a}));
+              c.added.push_back(oriented(Tet{p, q, r, b}));
+            }
+            if (!good) continue;
+            c.score = score_of(c.added);
+            if (c.score > angle) cands.push_back(std::move(c));
+          }
+        }
+      if (on_boundary) {
+        Cand c;
+        c.removed = {bad};
+        c.score = o.dihedral_target_deg;
+        c.drop = true;
+        cands.push_back(std::move(c));
+      }
+      // Best first: flips reaching the target above a drop, a drop above
+      // flips that only improve.
+      std::stable_sort(cands.begin(), cands.end(), [](const Cand& x, const Cand& y) {
+        return x.score > y.score || (x.score == y.score && x.drop && !y.drop);
+      });
+      bool applied = false;
+      for (Cand& c : cands) {
+        std::vector<Tet> nt;
+        nt.reserve(T.size() + c.added.size());
+        double removed_volume = 0, added_volume = 0;
+        std::vector<char> gone(T.size(), 0);
+        for (int e : c.removed) {
+          gone[static_cast<size_t>(e)] = 1;
+          removed_volume += tet_volume(mesh.V, T[static_cast<size_t>(e)]);
+        }
+        for (size_t e = 0; e < T.size(); ++e)
+          if (!gone[e]) nt.push_back(T[e]);
+        for (const Tet& x : c.added) {
+          added_volume += tet_volume(mesh.V, x);
+          nt.push_back(x);
+        }
+        std::set<int> touched;
+        for (int e : c.removed)
+          for (int v : T[static_cast<size_t>(e)]) touched.insert(v);
+        std::vector<Eigen::Vector3d> pts = moved;
+        if (c.drop) {
+          if (!volume_ok(volume - removed_volume)) continue;
+          for (int k = 0; k < 4; ++k)  // the dropped boundary faces' centroids
+            pts.push_back((mesh.V.row(t[kOpp[k][0]]) + mesh.V.row(t[kOpp[k][1]]) + mesh.V.row(t[kOpp[k][2]]))
+                              .transpose() / 3.0);
+        } else if (std::abs(added_volume - removed_volume) > 1e-9 * removed_volume) {
+          continue;  // not the same region
+        }
+        const Topology topo = topology(nt, n);
+        if (!topo.ok || topo.euler != topo0.euler || topo.components != topo0.components) continue;
+        if (c.drop && !within(nt, pts, touched)) continue;
+        const Eigen::VectorXd wc = node_frequencies(mesh.V, nt, o.poisson);
+        bool capped = true;
+        for (int v : touched)
+          if (wc[v] > cap) capped = false;
+        if (!capped) continue;
+        if (c.drop) {
+          for (int k = 0; k < 4; ++k) {  // record the surface as it was
+            const int f0 = t[kOpp[k][0]], f1 = t[kOpp[k][1]], f2 = t[kOpp[k][2]];
+            bool shared = false;
+            for (int e : L.around[static_cast<size_t>(f0)])
+              if (e != bad && has(T[static_cast<size_t>(e)], f1) && has(T[static_cast<size_t>(e)], f2))
+                shared = true;
+            if (!shared)
+              moved.emplace_back((mesh.V.row(f0) + mesh.V.row(f1) + mesh.V.row(f2)).transpose() / 3.0);
+          }
+          volume -= removed_volume;
+          ++rep.drops;
+        } else {
+          ++rep.flips;
+        }
+        T = std::move(nt);
+        w = wc;
+        applied = true;
+        break;
+      }
+      if (!applied) stuck_flip.insert(key_of(t));
+    }
+  };
+  topological_phase();
   // Third phase: the tets still below the dihedral target (collapses found
   // no valid move) get one of their nodes relocated, the connectivity kept:
   // an interior node anywhere, a surface node along the boundary as it was
@@ -527,8 +744,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
             for (int t : L.around[static_cast<size_t>(i)]) dv += tet_volume(mesh.V, T[static_cast<size_t>(t)]);
             const Eigen::VectorXd wc = node_frequencies(mesh.V, T, o.poisson);
             mesh.V.row(i) = keep;
-            if (wc.maxCoeff() > cap || std::abs((volume + dv) / volume0 - 1) > o.max_volume_change)
-              continue;
+            if (wc.maxCoeff() > cap || !volume_ok(volume + dv)) continue;
             best_i = i;
             best_gain = gain;
             best_to = to;
@@ -547,13 +763,15 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     }
     if (rep.relocations > 0) w = node_frequencies(mesh.V, T, o.poisson);
   }
+  if (rep.relocations > 0) topological_phase();
   rep.min_dihedral_after = 180;
   for (const Tet& t : T) rep.min_dihedral_after = std::min(rep.min_dihedral_after, min_dihedral(mesh.V, t));
   for (int v = 0; v < n; ++v)
     if (w[v] > threshold) ++rep.stuck;
   rep.ratio_after = ideal / w.maxCoeff();
   rep.volume_change = volume / volume0 - 1;
-  if (rep.collapses + rep.dihedral_collapses == 0) return rep;  // mesh.V holds the relocations
+  if (rep.collapses + rep.dihedral_collapses + rep.flips + rep.drops == 0)
+    return rep;  // mesh.V holds the relocations
   // Compact: drop unused nodes, keep the order of the others.
   std::vector<int> id(static_cast<size_t>(n), -1);
   for (const Tet& t : T)

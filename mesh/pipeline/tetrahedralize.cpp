@@ -360,9 +360,14 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     for (const std::string& f : failures) s << "; " << f;
     if (failures.empty() && !last_cause.empty()) s << ": " << last_cause;
     s << ". Options that change this: --coarse-tets N or --cell-size H (other sizes), "
-         "--time-limit S and --memory-limit MB (the stage's limits), --wrap always (mesh an "
-         "alpha-wrapped surface instead: near-contact gaps narrower than --wrap-alpha, which "
-         "can stall the mesher, are closed)";
+         "--time-limit S and --memory-limit MB (the stage's limits), ";
+    if (o.wrapped_surface)
+      s << "--wrap-alpha A (this surface is already an alpha wrap: a larger alpha, a fraction "
+           "of the diagonal, closes wider gaps and thickens the wrap of thin sheets, which "
+           "stall the mesher; the wrap must stay within 3 % of the diagonal of the input)";
+    else
+      s << "--wrap always (mesh an alpha-wrapped surface instead: near-contact gaps narrower "
+           "than --wrap-alpha, which can stall the mesher, are closed)";
     throw InputError(s.str());
   }
   if (res.failed_passes > 0 && heartbeat)

@@ -65,6 +65,9 @@ struct TetrahedralizeOptions {
   /// is retried at most once, at a coarser size. 0: no cap.
   double over_refinement_factor = 20.0;
   int min_vertex_cap = 20000;
+  /// The surface is already an alpha wrap (repair's or the automatic wrap
+  /// retry's): a refusal names --wrap-alpha instead of --wrap always.
+  bool wrapped_surface = false;
 };
 
 /// Result of tetrahedralize_surface().

@@ -163,6 +163,46 @@ TEST(MassScaling, AddedMassLimitStopsTheScaling) {
   EXPECT_FALSE(r.reached);
   EXPECT_LE(r.added_fraction, 1e-3);
   EXPECT_NE(r.to_string().find("not reached"), std::string::npos) << r.to_string();
+  EXPECT_TRUE(r.mass_limited);
+  EXPECT_FALSE(r.pass_limited);
+  EXPECT_NE(r.to_string().find("added-mass limit"), std::string::npos) << r.to_string();
+  EXPECT_EQ(r.to_string().find("ran out of passes"), std::string::npos) << r.to_string();
+}
+
+TEST(MassScaling, PassLimitIsNamedAndFurtherPassesReachTheTarget) {
+  // At 0.6 the threshold must fall to ~0.58 x its first value (the light
+  // nodes' neighbours share the top mode), so one pass cannot reach it: the
+  // scaling stops at its pass limit, far below the added-mass limit, and says
+  // so (it used to blame the mass); with the default passes it reaches it.
+  const Mesh m = block_with_light_nodes({0.03, 0.08});
+  const Material mat;
+  Model plain(m.V, m.T, mat);
+  const Eigen::MatrixXd K = dense_stiffness(plain, m.V);
+  const double ideal = dense_ideal_omega(mat, plain.mesh().rest_volume.mean());
+  ModelOptions mo;
+  mo.mass_scaling.target_ratio = 0.6;
+  mo.mass_scaling.max_passes = 1;
+  Model one(m.V, m.T, mat, mo);
+  const MassScalingReport& r1 = one.mass_scaling();
+  EXPECT_EQ(r1.passes, 1);
+  EXPECT_FALSE(r1.reached);
+  EXPECT_TRUE(r1.pass_limited);
+  EXPECT_FALSE(r1.mass_limited);
+  EXPECT_LT(r1.added_fraction, 0.5 * mo.mass_scaling.max_added_fraction);
+  EXPECT_LT(ideal / std::sqrt(dense_eigenvalues(K, one.mass()).maxCoeff()), 0.6);
+  EXPECT_NE(r1.to_string().find("ran out of passes (1, MassScaling::max_passes) below the added-mass limit"), std::string::npos)
+      << r1.to_string();
+  EXPECT_EQ(r1.to_string().find("would exceed"), std::string::npos) << r1.to_string();
+  mo.mass_scaling.max_passes = MassScaling{}.max_passes;
+  Model all(m.V, m.T, mat, mo);
+  const MassScalingReport& r = all.mass_scaling();
+  EXPECT_TRUE(r.reached);
+  EXPECT_GT(r.passes, 1);
+  EXPECT_FALSE(r.pass_limited || r.mass_limited);
+  EXPECT_GE(ideal / std::sqrt(dense_eigenvalues(K, all.mass()).maxCoeff()), 0.6 * (1 - 1e-6));
+  EXPECT_EQ(r.to_string().find("not reached"), std::string::npos) << r.to_string();
+  mo.mass_scaling.max_passes = 0;
+  EXPECT_THROW(Model(m.V, m.T, mat, mo), ParameterError);
 }
 
 TEST(MassScaling, TheSimulatorStepsWithTheScaledMassesBelowTheTrueLimit) {

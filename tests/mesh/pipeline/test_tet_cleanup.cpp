@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -125,8 +127,9 @@ TEST(TetCleanup, SliverIsRelocatedAwayWhenNoCollapseIsAllowed) {
   const double volume0 = signed_tet_volumes(m.V, m.T).sum();
   StepCleanupOptions o;
   o.max_collapses = 0;
+  o.flips = false;  // this test is about the relocation phase (flips: the next test)
   const StepCleanupReport r = raise_stable_step(m, o);
-  EXPECT_EQ(r.collapses + r.dihedral_collapses, 0);
+  EXPECT_EQ(r.collapses + r.dihedral_collapses + r.flips + r.drops, 0);
   EXPECT_GE(r.relocations, 1);
   EXPECT_EQ(m.T, before.T);
   EXPECT_EQ(m.F, before.F);
@@ -146,6 +149,106 @@ TEST(TetCleanup, SliverIsRelocatedAwayWhenNoCollapseIsAllowed) {
   EXPECT_EQ(off.V, before.V);
 }
 
+// Boundary faces as sorted triples (the boundary as a set, whatever its order).
+std::set<std::array<int, 3>> face_set(const MatX3i& F) {
+  std::set<std::array<int, 3>> s;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    std::array<int, 3> k{F(f, 0), F(f, 1), F(f, 2)};
+    std::sort(k.begin(), k.end());
+    s.insert(k);
+  }
+  return s;
+}
+
+TEST(TetCleanup, SliverIsFlippedAwayWhenNoCollapseOrRelocationIsAllowed) {
+  // The centre sliver with collapses and relocations off: the flips replace
+  // it and its neighbours by tets of the same nodes filling the same region
+  // (every node where it was, the same boundary and volume, positive tets).
+  TetMesh m;
+  ASSERT_TRUE(test::bcc_block_with_centre_sliver(m));
+  const TetMesh before = m;
+  const double volume0 = signed_tet_volumes(m.V, m.T).sum();
+  StepCleanupOptions o;
+  o.max_collapses = 0;
+  o.max_relocation_sweeps = 0;
+  TetMesh off = m;
+  o.flips = false;
+  const StepCleanupReport r_off = raise_stable_step(off, o);
+  EXPECT_EQ(r_off.flips + r_off.drops, 0);
+  EXPECT_EQ(off.T, before.T);
+  o.flips = true;
+  const StepCleanupReport r = raise_stable_step(m, o);
+  EXPECT_EQ(r.collapses + r.dihedral_collapses + r.relocations + r.drops, 0);
+  EXPECT_GE(r.flips, 1);
+  EXPECT_EQ(m.V, before.V);
+  EXPECT_EQ(face_set(m.F), face_set(before.F));
+  EXPECT_NE(m.T, before.T);
+  const TetQuality q0 = tet_quality(before), q = tet_quality(m);
+  EXPECT_LT(q0.min_dihedral_deg, 10.0);
+  EXPECT_GE(q.min_dihedral_deg, 12.0);
+  EXPECT_NEAR(r.min_dihedral_after, q.min_dihedral_deg, 1e-9);
+  EXPECT_GT(q.min_volume, 0.0);
+  EXPECT_NEAR(signed_tet_volumes(m.V, m.T).sum(), volume0, 1e-12 * volume0);
+  EXPECT_TRUE(closed_manifold(m));
+  // No face in more than two tets (the flips made a tet mesh, not overlaps).
+  std::map<std::array<int, 3>, int> faces;
+  for (Eigen::Index e = 0; e < m.T.rows(); ++e)
+    for (int k = 0; k < 4; ++k) {
+      std::array<int, 3> f{m.T(e, (k + 1) % 4), m.T(e, (k + 2) % 4), m.T(e, (k + 3) % 4)};
+      std::sort(f.begin(), f.end());
+      EXPECT_LE(++faces[f], 2);
+    }
+}
+
+TEST(TetCleanup, BoundarySliverIsDropped) {
+  // A structured (Kuhn) cube of 3^3 cells with a flat tet glued on a
+  // boundary face (a, b, c): its apex d 5 % of an edge above the plane, over
+  // a point beyond the edge ab, so that no flip can replace it (the segment
+  // from d to the tet under the face misses the face; its other edges are on
+  // the boundary or in no other tet) and collapses and relocations are not
+  // allowed here. The drop removes it: the cube's own tets and boundary come
+  // back, d (in no other tet) is gone.
+  BoxMeshOptions bo;
+  bo.size = {1, 1, 1};
+  bo.nx = bo.ny = bo.nz = 3;
+  const TetMesh block = make_box_tet_mesh(bo);
+  const int a = block.F(0, 0), b = block.F(0, 1), c = block.F(0, 2);
+  const Eigen::Vector3d pa = block.V.row(a), pb = block.V.row(b), pc = block.V.row(c);
+  const Eigen::Vector3d n = (pb - pa).cross(pc - pa).normalized();  // outward
+  const Eigen::Vector3d g = (pa + pb + pc) / 3, mid = (pa + pb) / 2;
+  TetMesh m = block;
+  const int d = static_cast<int>(m.V.rows());
+  m.V.conservativeResize(d + 1, 3);
+  m.V.row(d) = (mid + 0.6 * (mid - g) + 0.05 * (pa - pb).norm() * n).transpose();
+  Eigen::RowVector4i t(a, b, c, d);
+  if (signed_tet_volumes(m.V, MatX4i(t)).minCoeff() < 0) std::swap(t[2], t[3]);
+  m.T.conservativeResize(m.T.rows() + 1, 4);
+  m.T.row(m.T.rows() - 1) = t;
+  m.F = boundary_faces(m.T);
+  ASSERT_TRUE(closed_manifold(m));
+  ASSERT_GT(signed_tet_volumes(m.V, m.T).minCoeff(), 0.0);
+  ASSERT_LT(tet_quality(m).min_dihedral_deg, 10.0);
+  ASSERT_GE(tet_quality(block).min_dihedral_deg, 12.0);
+  const double volume_block = signed_tet_volumes(block.V, block.T).sum();
+  const double volume_cap = signed_tet_volumes(m.V, MatX4i(t)).sum();
+  StepCleanupOptions o;
+  o.max_collapses = 0;
+  o.max_relocation_sweeps = 0;
+  TetMesh off = m;
+  const StepCleanupReport r = raise_stable_step(m, o);
+  EXPECT_EQ(r.drops, 1);
+  EXPECT_EQ(r.flips, 0);
+  EXPECT_EQ(m.V, block.V);
+  EXPECT_EQ(m.T, block.T);
+  EXPECT_EQ(face_set(m.F), face_set(block.F));
+  EXPECT_GE(r.min_dihedral_after, 12.0);
+  EXPECT_NEAR(r.volume_change, volume_block / (volume_block + volume_cap) - 1, 1e-12);
+  // Off: the sliver stays.
+  o.flips = false;
+  EXPECT_EQ(raise_stable_step(off, o).drops, 0);
+  EXPECT_EQ(off.T.rows(), block.T.rows() + 1);
+}
+
 TEST(TetCleanup, BadOptionsAreRefused) {
   TetMesh m = bcc_block(2, 1.0);
   StepCleanupOptions o;
@@ -156,6 +259,9 @@ TEST(TetCleanup, BadOptionsAreRefused) {
   EXPECT_THROW(raise_stable_step(m, o), ParameterError);
   o = {};
   o.max_relocation_sweeps = -1;
+  EXPECT_THROW(raise_stable_step(m, o), ParameterError);
+  o = {};
+  o.dihedral_volume_change = -0.01;
   EXPECT_THROW(raise_stable_step(m, o), ParameterError);
 }
 

@@ -70,6 +70,25 @@ TEST(Tetrahedralize, NearContactGapFailsFastNamingTheCause) {
   }
 }
 
+TEST(Tetrahedralize, RefusalOfAWrappedSurfaceNamesTheWrapAlphaNotWrapAlways) {
+  // The same failing gap on a surface marked as an alpha wrap already (the
+  // automatic wrap retry's or --wrap always's): --wrap always would change
+  // nothing, so the refusal names --wrap-alpha (and the sizes and limits).
+  TetrahedralizeOptions o = small_options();
+  o.wrapped_surface = true;
+  try {
+    tetrahedralize_surface(two_boxes(1e-3), o);
+    FAIL() << "a gap of 1e-3 meshed at 500 tets";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(count(m, "the mesher over-refined"), 2) << m;
+    EXPECT_EQ(m.find("--wrap always"), std::string::npos) << m;
+    EXPECT_NE(m.find("--wrap-alpha A (this surface is already an alpha wrap"), std::string::npos) << m;
+    EXPECT_NE(m.find("--coarse-tets N"), std::string::npos) << m;
+    EXPECT_NE(m.find("--time-limit S"), std::string::npos) << m;
+  }
+}
+
 TEST(Preprocess, MesherFailureIsRetriedOnTheAlphaWrap) {
   PreprocessOptions o;
   o.sphere_builder = SphereBuilder::none;
