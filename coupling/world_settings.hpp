@@ -126,6 +126,11 @@ struct CollisionSpec {
   /// cycle, rolled back and re-run in full cycles if its closing query finds
   /// a contact (see World::step). false: every frame runs all its cycles.
   bool single_cycle_when_apart = true;
+  /// With single_cycle_when_apart and swept: skip the trial when the spheres
+  /// moved on with their node velocities touch within the frame (the trial
+  /// would be rolled back): such a frame runs in cycles at once
+  /// (World::contact_ahead, FrameMetrics::predicted). false: always the trial.
+  bool predict_contact = true;
   /// Continuous detection (not in the paper): each cycle first queries the
   /// swept trees (every sphere grown to enclose its positions at the cycle's
   /// start and end, collision/swept_spheres.hpp), so two objects that cross
