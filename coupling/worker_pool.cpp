@@ -49,6 +49,10 @@ void WorkerPool::drain(const std::function<void(int)>& f, int n) {
     const int k = m_next.fetch_add(1, std::memory_order_relaxed);
     if (k >= n) return;
     f(k);
+    if (m_finished.fetch_add(1, std::memory_order_acq_rel) + 1 == n) {
+      std::lock_guard<std::mutex> lock(m_mutex);  // (the caller may be waiting)
+      m_done.notify_one();
+    }
   }
 }
 
@@ -63,16 +67,22 @@ void WorkerPool::run(int n, const std::function<void(int)>& f) {
     m_job = &f;
     m_n = n;
     m_next.store(0, std::memory_order_relaxed);
-    m_busy.store(static_cast<int>(m_workers.size()), std::memory_order_relaxed);
+    m_finished.store(0, std::memory_order_relaxed);
+    m_busy.store(0, std::memory_order_relaxed);
     m_generation.fetch_add(1, std::memory_order_release);
   }
   m_start.notify_all();
   drain(f, n);
-  if (!spin_until([this] { return m_busy.load(std::memory_order_acquire) == 0; }, m_spin)) {
-    std::unique_lock<std::mutex> lock(m_mutex);
-    m_done.wait(lock, [this] { return m_busy.load(std::memory_order_acquire) == 0; });
-  }
-  std::lock_guard<std::mutex> lock(m_mutex);  // (the last worker has left its lock)
+  // Every task done and no worker inside the job. A worker joins only under
+  // the lock while m_job is set, and the job is withdrawn under the same
+  // lock as the last check: a late worker finds none and goes back to wait.
+  const auto done = [&] {
+    return m_finished.load(std::memory_order_acquire) == n &&
+           m_busy.load(std::memory_order_acquire) == 0;
+  };
+  spin_until(done, m_spin);
+  std::unique_lock<std::mutex> lock(m_mutex);
+  m_done.wait(lock, done);
   m_job = nullptr;
 }
 
@@ -94,14 +104,14 @@ void WorkerPool::work() {
       seen = m_generation.load();
       job = m_job;
       n = m_n;
+      if (!job || m_next.load(std::memory_order_relaxed) >= n) continue;  // (done without it)
+      m_busy.fetch_add(1, std::memory_order_relaxed);
     }
     drain(*job, n);
-    bool last;
     {
       std::lock_guard<std::mutex> lock(m_mutex);
-      last = m_busy.fetch_sub(1, std::memory_order_acq_rel) == 1;
+      if (m_busy.fetch_sub(1, std::memory_order_acq_rel) == 1) m_done.notify_one();
     }
-    if (last) m_done.notify_one();
   }
 }
 

@@ -31,7 +31,10 @@ class WorkerPool {
   int threads() const { return static_cast<int>(m_workers.size()) + 1; }
   /// Runs f(k) once for every k in [0, n) on the caller and the workers and
   /// returns when all are done. Which thread runs which k is not fixed: f(k)
-  /// must touch only what belongs to k. f must not throw.
+  /// must touch only what belongs to k. f must not throw. The caller takes
+  /// k = 0 first. It waits for the tasks, not for every worker: a worker
+  /// still waking up (or not scheduled: a loaded machine) when the others
+  /// have done every task joins no job, and the caller does not wait for it.
   void run(int n, const std::function<void(int)>& f);
 
  private:
@@ -46,8 +49,11 @@ class WorkerPool {
   const std::function<void(int)>* m_job = nullptr;
   int m_n = 0;
   std::atomic<int> m_next{0};  ///< next index to take
-  /// Workers still on the current job, and the job counter: changed under
-  /// m_mutex (for the condition variables), read while spinning.
+  /// Tasks of the current job done (a worker taking the last one notifies
+  /// under m_mutex), workers that joined the job and have not left it, and
+  /// the job counter: m_busy and m_generation change under m_mutex (for the
+  /// condition variables); all three are read while spinning.
+  std::atomic<int> m_finished{0};
   std::atomic<int> m_busy{0};
   std::atomic<uint64_t> m_generation{0};
   std::atomic<bool> m_stop{false};

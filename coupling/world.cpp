@@ -81,7 +81,18 @@ void World::for_each_object(F&& f) {
   std::vector<std::exception_ptr> errors(static_cast<size_t>(n));
   // Objects differ in cost: each worker takes the next object; each
   // object's work is the same on any worker, so no result depends on it.
-  m_pool->run(n, [&](int k) {
+  // The costliest first (by its time in the last cycle; ties in object
+  // order): the calling thread takes the first at once, while a parked
+  // worker is still waking up, so the wake-up delays the cheaper object.
+  m_order.resize(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) m_order[static_cast<size_t>(k)] = k;
+  const auto cost = [&](int k) {
+    const RuntimeObject& o = m_objects[static_cast<size_t>(k)];
+    return o.stage_seconds[0] + o.stage_seconds[1] + o.stage_seconds[2];
+  };
+  std::stable_sort(m_order.begin(), m_order.end(), [&](int x, int y) { return cost(x) > cost(y); });
+  m_pool->run(n, [&](int q) {
+    const int k = m_order[static_cast<size_t>(q)];
     try {
       f(k);
     } catch (...) {
@@ -1301,6 +1312,75 @@ bool World::contact_free() const {
   return true;
 }
 
+bool World::contact_ahead(double dt) {
+  const CollisionSpec& cs = m_settings.collision;
+  if (!cs.swept || !cs.predict_contact || m_plan.pairs.empty()) return false;
+  // The stretch the trial's sweep covers: the frame, then half a frame to
+  // the midpoint prediction of the next cycle.
+  const double ahead = cs.midpoint && m_plan.response ? 1.5 * dt : dt;
+  const size_t n = m_objects.size();
+  m_ahead_saved.resize(n);
+  m_ahead_swept.resize(n);
+  m_ahead_motion.assign(n, 0.0);
+  m_ahead_done.assign(n, 0);
+  // Deformable objects move with their node velocities; static ones stay.
+  const auto predictable = [](const RuntimeObject& o) {
+    return o.plan.sphere_tree && (o.sim ? o.plan.sphere_update : !o.plan.kinematic);
+  };
+  const auto predict = [&](size_t k) {
+    if (m_ahead_done[k]) return;
+    m_ahead_done[k] = 1;
+    RuntimeObject& o = m_objects[k];
+    std::vector<collision::SweptSphere>& sw = m_ahead_swept[k];
+    if (!o.sim) {
+      collision::still_spheres(o.asset.spheres.spheres, sw);
+      return;
+    }
+    m_ahead_saved[k] = o.asset.spheres.spheres;
+    const MatX3d x = o.positions + ahead * o.sim->velocities();
+    update_deformed_spheres(o, x);
+    if (cs.layered) collision::enclose_children(o.asset.spheres);
+    // (no margin: a sweep grown by a fraction of a leaf touched at its start
+    // in the frame after the main job's contact, the objects just apart)
+    m_ahead_motion[k] = collision::sweep_spheres(o.start_spheres, o.asset.spheres.spheres, sw);
+    std::swap(m_ahead_saved[k], o.asset.spheres.spheres);  // the spheres as they were
+  };
+  bool touched = false;
+  for (size_t p = 0; p < m_plan.pairs.size() && !touched; ++p) {
+    const auto [i, j] = m_plan.pairs[p];
+    RuntimeObject& a = m_objects[i];
+    RuntimeObject& b = m_objects[j];
+    if (!predictable(a) || !predictable(b)) continue;
+    // (the sweep starts at the spheres of the current positions)
+    // and the cycles are sized by the objects' sub-steps, known once they
+    // have advanced: in a World's first frame the trial measures them)
+    const auto ready = [](const RuntimeObject& o) {
+      return !o.sim || (o.start_spheres.size() == o.asset.spheres.spheres.size() && o.step_cap > 0);
+    };
+    if (!ready(a) || !ready(b)) continue;
+    // Root spheres farther apart than the nodes can move (at their present
+    // speeds) plus the margins: nothing to sweep.
+    const auto reach_of = [&](const RuntimeObject& o) {
+      // (a leaf radius more: the spheres may grow as the object deforms)
+      return o.sim ? ahead * o.sim->velocities().rowwise().norm().maxCoeff() + o.leaf_radius : 0.0;
+    };
+    const collision::Sphere& ra = a.asset.spheres.spheres[0];
+    const collision::Sphere& rb = b.asset.spheres.spheres[0];
+    const double gap = (ra.center() - rb.center()).norm() - ra.r - rb.r;
+    if (gap > reach_of(a) + reach_of(b)) continue;  // (NaN: swept)
+    predict(i);
+    predict(j);
+    collision::SweptRequest req;
+    touched = collision::swept_contact(a.asset.spheres, m_ahead_swept[i], b.asset.spheres,
+                                       m_ahead_swept[j], req, m_sweep_stack)
+                  .touched;
+  }
+  if (touched)
+    for (size_t k = 0; k < n; ++k)
+      if (m_ahead_done[k] && m_objects[k].sim) m_objects[k].speed = m_ahead_motion[k] / dt;
+  return touched;
+}
+
 void World::save(Snapshot& s) const {
   s.positions.resize(m_objects.size());
   s.velocities.resize(m_objects.size());
@@ -1438,7 +1518,13 @@ FrameMetrics World::advance(std::optional<double> budget) {
   // contact begins, as if every frame had been cycled. (Without the sweep, a
   // contact that begins and ends inside one trial frame is missed.)
   const bool swept = m_settings.collision.swept;
-  if ((cycles > 1 || swept) && m_settings.collision.single_cycle_when_apart && contact_free()) {
+  if ((cycles > 1 || swept) && m_settings.collision.single_cycle_when_apart && contact_free() &&
+      contact_ahead(dt)) {
+    // A trial would find the contact and be rolled back: cycles at once.
+    m.predicted = 1;
+    plan_islands(dt);
+    cycles = bounds();
+  } else if ((cycles > 1 || swept) && m_settings.collision.single_cycle_when_apart && contact_free()) {
     save(m_snapshot);
     FrameMetrics trial = m;
     trial.cycles = 1;

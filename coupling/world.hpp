@@ -45,6 +45,10 @@ struct FrameMetrics {
   /// 1 when the frame was first tried as one contact-free cycle, found a
   /// contact at its end, and was rolled back and re-run in `cycles` cycles.
   int rollback = 0;
+  /// 1 when the frame started contact-free but was run in cycles at once,
+  /// without the single-cycle trial, because the objects' spheres moved on
+  /// with their node velocities touched within it (World::contact_ahead).
+  int predicted = 0;
   /// Interrupted queries whose response used the pair's previous complete
   /// answer (collision.on_interrupt = "previous").
   int reused = 0;
@@ -398,6 +402,29 @@ class World {
   /// True when the last queries reported no pair at all (every pair pruned:
   /// the covered surfaces are apart).
   bool contact_free() const;
+  /// For a frame of dt that starts contact-free (collision.swept): would the
+  /// single-cycle trial find a contact? Each pair whose root spheres are
+  /// within reach is swept from its current spheres to the spheres at the
+  /// nodes moved on with their velocities over the stretch the trial sweeps
+  /// (dt, plus dt / 2 with collision.midpoint), as the trial's sweep would
+  /// with a motion that keeps its velocities. True when one touches: the
+  /// frame then runs in cycles at once instead of paying for a trial it
+  /// would roll back (the first contact frame of the main job: 70 of its
+  /// 147-199 sub-steps). Only deformable and static objects are predicted
+  /// (a scripted object's pair answers false: the trial decides). A wrong
+  /// answer costs time, never a contact: false runs the trial as before,
+  /// true cycles a frame that stays apart. Leaves the spheres as they were;
+  /// sets the predicted objects' speed (RuntimeObject::speed) from the
+  /// motion, as the trial would. Serial, in pair order: any thread count.
+  /// Not before the objects have advanced once (their sub-steps, which size
+  /// the cycles, are not known yet): a World's first frame takes the trial.
+  bool contact_ahead(double dt);
+  /// Scratch of contact_ahead: the spheres of each object before, predicted
+  /// and swept.
+  std::vector<std::vector<collision::Sphere>> m_ahead_saved;
+  std::vector<std::vector<collision::SweptSphere>> m_ahead_swept;
+  std::vector<char> m_ahead_done;
+  std::vector<double> m_ahead_motion;
   /// State a rolled-back frame returns to.
   struct Snapshot {
     std::vector<MatX3d> positions, velocities;
@@ -437,6 +464,7 @@ class World {
   template <class F>
   void for_each_object(F&& f);
   int m_threads = 1;
+  std::vector<int> m_order;  ///< for_each_object: the objects in the order they are handed out
   std::unique_ptr<WorkerPool> m_pool;  ///< the workers (none with 1 thread or 1 object)
   bool m_deadline_warned = false;
   /// Node mass standing for "does not move under contact" (static, rigid objects).

@@ -45,6 +45,14 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+// CPU time of the calling thread alone (the World's own thread; its
+// workers and any other thread of the process excluded).
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -59,25 +67,81 @@ std::string loadavg() {
   return a + " " + b + " " + c;
 }
 
+// Where a World's frames go: the parallel region (each object's FEM, links
+// and sphere update; FrameMetrics::times), the serial collision and
+// response between cycles, and the rest (planning, snapshots, energy).
+// Per cycle (World::set_cycle_observer) each object's own time in the
+// region is summed, and the slower object's: the region's critical path.
+struct Breakdown {
+  std::vector<double> region, collision, response, rest, slower, cycles;
+  std::vector<std::vector<double>> own;  ///< per object
+  std::vector<double> frame_own;         ///< scratch: this frame's per object
+  double frame_slower = 0;
+  int frame_cycles = 0;
+  void observe(const World& w) {
+    frame_own.resize(w.objects().size(), 0.0);
+    double slowest = 0;
+    for (size_t k = 0; k < w.objects().size(); ++k) {
+      const auto& o = w.objects()[k];
+      const double t = o.stage_seconds[0] + o.stage_seconds[1] + o.stage_seconds[2];
+      frame_own[k] += t;
+      slowest = std::max(slowest, t);
+    }
+    frame_slower += slowest;
+    ++frame_cycles;
+  }
+  void end_frame(const FrameMetrics& m, double wall) {
+    const double r = m.times.fem + m.times.links + m.times.sphere_update;
+    region.push_back(r);
+    collision.push_back(m.times.collision);
+    response.push_back(m.times.response);
+    rest.push_back(wall - m.times.total());
+    slower.push_back(frame_slower);
+    cycles.push_back(frame_cycles);
+    own.resize(frame_own.size());
+    for (size_t k = 0; k < frame_own.size(); ++k) own[k].push_back(frame_own[k]);
+    frame_own.assign(frame_own.size(), 0.0);
+    frame_slower = 0;
+    frame_cycles = 0;
+  }
+};
+
 struct Series {
-  std::vector<double> wall, cpu, fem, substeps;
+  std::vector<double> wall, cpu, thread_cpu, fem, substeps;
   double total_wall = 0;
-  void add(const FrameMetrics& m, double wall_s, double cpu_s) {
+  Breakdown parts;
+  void add(const FrameMetrics& m, double wall_s, double cpu_s, double thread_cpu_s) {
     wall.push_back(wall_s);
     cpu.push_back(cpu_s);
+    thread_cpu.push_back(thread_cpu_s);
     fem.push_back(m.times.fem);
     substeps.push_back(m.substeps);
     total_wall += wall_s;
+    parts.end_frame(m, wall_s);
+  }
+  void watch(World& w) {
+    w.set_cycle_observer([this](const World& world) { parts.observe(world); });
   }
 };
 
 FrameMetrics timed_step(World& w, Series& s) {
-  const double c0 = cpu_seconds();
+  const double c0 = cpu_seconds(), tc0 = thread_cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   const FrameMetrics m = w.step();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  s.add(m, wall, cpu_seconds() - c0);
+  s.add(m, wall, cpu_seconds() - c0, thread_cpu_seconds() - tc0);
   return m;
+}
+
+// The breakdown of a series, medians per frame, ms.
+void print_breakdown(const char* label, const Series& s, const World& w) {
+  const Breakdown& b = s.parts;
+  std::printf("  %-24s wall %.2f = region %.2f (critical path %.2f; own:", label, 1e3 * median(s.wall),
+              1e3 * median(b.region), 1e3 * median(b.slower));
+  for (size_t k = 0; k < b.own.size(); ++k)
+    std::printf(" %s %.2f", w.objects()[k].setup.name.c_str(), 1e3 * median(b.own[k]));
+  std::printf(") + collision %.2f + response %.2f + rest %.2f; cycles %.0f\n", 1e3 * median(b.collision),
+              1e3 * median(b.response), 1e3 * median(b.rest), median(b.cycles));
 }
 
 // The ceiling of the 2-thread speed-up on this machine: the first two
@@ -161,6 +225,8 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
   World spinning = icd::runner::make_world(scene, cache, tools);
   scene.world.worker_spin = icd::coupling::WorldSettings{}.worker_spin;
   Series s1, s2, s2b;
+  s1.watch(one);
+  s2.watch(two);
   for (int f = 0; f < frames; ++f) {  // interleaved, rotating which goes first
     World* worlds[3] = {&one, &two, &spinning};
     Series* series[3] = {&s1, &s2, &s2b};
@@ -173,23 +239,28 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
     measure_ceiling(a, b, frames, dt);
     scene.world.threads = 2;
   }
-  // 60 Hz real-time mode on 2 threads: slow contacts cycled at the FEM
-  // sub-step (collision.cycles_at_fem_step), then the default rule (contact
-  // cycles from the full penalty stiffness on the lightest node).
+  // 60 Hz real-time mode on 2 threads: the other cycle rule than the
+  // scene's (collision.cycles_at_fem_step flipped), the scene's, and the
+  // scene's with the single-cycle trial in every frame that starts apart
+  // (collision.predict_contact off: the previous path).
   struct Rt {
     Series s;
-    int met = 0, fem_over = 0, floored = 0, contact_frames = 0, deep_steps = 0;
+    int met = 0, fem_over = 0, floored = 0, contact_frames = 0, deep_steps = 0, rollbacks = 0,
+        predicted = 0;
     double worst = 0, depth_ratio = 0, penetration = 0, e0 = 0, e_end = 0;
     std::string warning;
   };
-  const auto run_rt = [&](bool fem_step_cycles, const char* label) {
+  const auto run_rt = [&](bool fem_step_cycles, bool predict, const char* label) {
     scene.world.target_fps = 60;
     scene.world.collision.cycles_at_fem_step = fem_step_cycles;
+    scene.world.collision.predict_contact = predict;
     World rt = icd::runner::make_world(scene, cache, tools);
     Rt r;
+    r.s.watch(rt);
     if (trace)
-      std::printf("trace (%s): frame wall_ms fem_ms coll_ms cycles penalty motion substeps products "
-                  "rollback split active depth_ratio deep_steps capped softened energy met\n",
+      std::printf("trace (%s): frame wall_ms fem_ms coll_ms resp_ms rest_ms cycles penalty motion "
+                  "substeps products rollback predicted split active depth_ratio deep_steps capped "
+                  "softened energy met\n",
                   label);
     for (int f = 0; f < frames; ++f) {
       const FrameMetrics m = timed_step(rt, r.s);
@@ -199,47 +270,66 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
       r.worst = std::max(r.worst, m.lateness);
       r.contact_frames += m.active_pairs > 0;
       r.deep_steps += m.deep_steps;
+      r.rollbacks += m.rollback;
+      r.predicted += m.predicted;
       r.depth_ratio = std::max(r.depth_ratio, m.depth_ratio);
       r.penetration = std::max(r.penetration, m.max_penetration);
       if (f == 0) r.e0 = m.energy;
       r.e_end = m.energy;
       if (!m.deadline_warning.empty()) r.warning = m.deadline_warning;
       if (trace)
-        std::printf("  %3d %7.2f %7.2f %6.2f %4d %4d %4d %4d %5d %d %d %5d %6.2f %4d %6lld %3d %.4f %d\n",
-                    m.frame, 1e3 * m.wall, 1e3 * m.times.fem, 1e3 * m.times.collision, m.cycles,
+        std::printf("  %3d %7.2f %7.2f %6.2f %6.2f %6.2f %4d %4d %4d %4d %5d %d %d %d %5d %6.2f %4d "
+                    "%6lld %3d %.4f %d\n",
+                    m.frame, 1e3 * m.wall, 1e3 * m.times.fem, 1e3 * m.times.collision,
+                    1e3 * m.times.response, 1e3 * (m.wall - m.times.total()), m.cycles,
                     m.cycles_penalty, m.cycles_motion, m.substeps, m.frequency_products, m.rollback,
-                    m.subdivided, m.active_pairs, m.depth_ratio, m.deep_steps,
+                    m.predicted, m.subdivided, m.active_pairs, m.depth_ratio, m.deep_steps,
                     static_cast<long long>(m.capped_pairs), m.softened, m.energy, m.deadline_met);
     }
     return r;
   };
-  const Rt s3 = run_rt(true, "cycles_at_fem_step");
-  const Rt s4 = run_rt(false, "default cycle rule");
+  const bool at_step = scene.world.collision.cycles_at_fem_step;  // (the scene's or the default)
+  const Rt s3 = run_rt(!at_step, true, at_step ? "default cycle rule" : "cycles_at_fem_step");
+  const Rt s4 = run_rt(at_step, true, at_step ? "cycles_at_fem_step (the scene's)" : "the scene's cycle rule");
+  const Rt s5 = run_rt(at_step, false, "the scene's cycle rule, always the trial");
+  scene.world.collision.predict_contact = true;
+  scene.world.collision.cycles_at_fem_step = at_step;
   const double sim = frames * dt;
-  std::printf("%-26s %12s %12s %10s %10s %14s %12s %12s\n", "", "wall ms/fr", "CPU ms/fr", "x real",
-              "FEM ms/fr", "sub-steps/fr", "us/sub-step", "max sub/fr");
+  std::printf("%-26s %12s %12s %12s %10s %10s %14s %12s %12s\n", "", "wall ms/fr", "CPU ms/fr",
+              "thread CPU", "x real", "FEM ms/fr", "sub-steps/fr", "us/sub-step", "max sub/fr");
   const auto row = [&](const char* label, const Series& s) {
     const double sub = median(s.substeps);
-    std::printf("%-26s %12.2f %12.2f %10.2f %10.2f %14.0f %12.1f %12.0f\n", label, 1e3 * median(s.wall),
-                1e3 * median(s.cpu), sim / s.total_wall, 1e3 * median(s.fem), sub,
+    std::printf("%-26s %12.2f %12.2f %12.2f %10.2f %10.2f %14.0f %12.1f %12.0f\n", label,
+                1e3 * median(s.wall), 1e3 * median(s.cpu), 1e3 * median(s.thread_cpu),
+                sim / s.total_wall, 1e3 * median(s.fem), sub,
                 sub > 0 ? 1e6 * median(s.fem) / sub : 0.0,
                 *std::max_element(s.substeps.begin(), s.substeps.end()));
   };
   row("1 thread (old path)", s1);
   row("2 threads", s2);
   row("2 threads, workers spin", s2b);
-  row("2 thr, 60 Hz RT, at step", s3.s);
+  row(at_step ? "2 thr, 60 Hz RT, old rule" : "2 thr, 60 Hz RT, at step", s3.s);
   row("2 threads, 60 Hz RT", s4.s);
+  row("2 thr, 60 Hz RT, trial", s5.s);
   std::printf("speed-up 2 vs 1 thread (median wall per frame): %.2fx (workers that spin 100 us: %.2fx)\n",
               median(s1.wall) / median(s2.wall), median(s1.wall) / median(s2b.wall));
-  const std::pair<const char*, const Rt*> rts[] = {{" (cycles_at_fem_step)", &s3}, {"", &s4}};
+  std::printf("where the frames go (medians per frame, ms; CPU: the whole process, thread CPU: the "
+              "World's own thread):\n");
+  print_breakdown("1 thread", s1, one);
+  print_breakdown("2 threads", s2, two);
+  const std::pair<const char*, const Rt*> rts[] = {
+      {at_step ? " (default cycle rule)" : " (cycles_at_fem_step)", &s3},
+      {"", &s4},
+      {" (always the single-cycle trial)", &s5}};
   for (const auto& [label, r] : rts) {
     std::printf("real-time mode at 60 Hz%s: %d of %d frames met the deadline (%.1f%%), worst lateness "
                 "%.2f ms, FEM alone over the deadline in %d frames, %d queries at the minimum budget\n",
                 label, r->met, frames, 100.0 * r->met / frames, 1e3 * r->worst, r->fem_over, r->floored);
     std::printf("  contact: %d frames with contact, deepest leaf pair %.2f leaf radii (%.2f mm), %d "
-                "deep velocity steps, energy %.4f -> %.4f J\n",
-                r->contact_frames, r->depth_ratio, 1e3 * r->penetration, r->deep_steps, r->e0, r->e_end);
+                "deep velocity steps, energy %.4f -> %.4f J; %d frames cycled at once (contact "
+                "predicted), %d single-cycle trials rolled back\n",
+                r->contact_frames, r->depth_ratio, 1e3 * r->penetration, r->deep_steps, r->e0, r->e_end,
+                r->predicted, r->rollbacks);
     if (!r->warning.empty()) std::printf("  %s\n", r->warning.c_str());
   }
   std::printf("load after %s\n", loadavg().c_str());
@@ -266,6 +356,9 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
               "p90 err", "max err", "missed", "coll ms/fr", "wall ms/fr", "interrupt");
   struct PairErrors {
     std::vector<double> even, priority;
+    // Same state (the priority run's cycles): the World's priority answer
+    // and the even split's answer of the same spheres, with the tests each used.
+    std::vector<double> same_even, same_priority, tests_even, tests_priority;
   };
   std::vector<PairErrors> per_pair;
   for (const icd::coupling::BudgetSplit split :
@@ -283,7 +376,10 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
     exact.budget_tests = -1;
     exact.start_front = nullptr;
     exact.record_front = false;
-    icd::collision::CollisionResult oracle;
+    icd::collision::CollisionResult oracle, even_answer;
+    icd::collision::CollisionRequest even_request = scene.world.collision.query;
+    even_request.start_front = nullptr;
+    even_request.record_front = false;
     w.set_cycle_observer([&](const World& world) {
       const auto o0 = std::chrono::steady_clock::now();
       const auto& pairs = world.plan().pairs;
@@ -306,6 +402,19 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
         missed += got_r.colliding.empty() && got_r.untested.empty();
         err.push_back(e);
         (even ? per_pair[p].even : per_pair[p].priority).push_back(e);
+        if (!even && !scene.world.collision.temporal_coherence) {
+          // The even split's answer in the same state: every pair its own
+          // budget (World: CollisionSpec::query as is).
+          icd::collision::collide(a.asset.spheres, b.asset.spheres, even_request, even_answer);
+          fa.setZero();
+          fb.setZero();
+          const Eigen::Vector3d alt = icd::coupling::apply_contact_forces(
+              a.asset.spheres, b.asset.spheres, even_answer, co, fa, fb).total_force_a;
+          per_pair[p].same_even.push_back((alt - truth).norm() / truth.norm());
+          per_pair[p].same_priority.push_back(e);
+          per_pair[p].tests_even.push_back(static_cast<double>(even_answer.tests));
+          per_pair[p].tests_priority.push_back(static_cast<double>(got_r.tests));
+        }
       }
       oracle_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - o0).count();
     });
@@ -335,6 +444,29 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
                     w.objects()[pr.second].setup.name.c_str(), per_pair[p].even.size(),
                     median(per_pair[p].even), per_pair[p].priority.size(), median(per_pair[p].priority));
       }
+      std::printf("same state (the priority run's cycles; each pair's answer with its priority "
+                  "budget and with the even budget of the same spheres): samples, median error "
+                  "even / priority, mean error even / priority, median tests even / priority\n");
+      std::vector<double> all_even, all_prio;
+      for (size_t p = 0; p < per_pair.size(); ++p) {
+        const PairErrors& pe = per_pair[p];
+        if (pe.same_even.empty()) continue;
+        const auto mean = [](const std::vector<double>& v) {
+          return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+        };
+        const auto& pr = w.plan().pairs[p];
+        std::printf("  %-12s %-12s %6zu %8.3f %8.3f   %8.3f %8.3f   %7.0f %7.0f\n",
+                    w.objects()[pr.first].setup.name.c_str(), w.objects()[pr.second].setup.name.c_str(),
+                    pe.same_even.size(), median(pe.same_even), median(pe.same_priority), mean(pe.same_even),
+                    mean(pe.same_priority), median(pe.tests_even), median(pe.tests_priority));
+        all_even.insert(all_even.end(), pe.same_even.begin(), pe.same_even.end());
+        all_prio.insert(all_prio.end(), pe.same_priority.begin(), pe.same_priority.end());
+      }
+      if (!all_even.empty())
+        std::printf("  all pairs    %6zu samples: median error even %.3f, priority %.3f; mean %.3f, %.3f\n",
+                    all_even.size(), median(all_even), median(all_prio),
+                    std::accumulate(all_even.begin(), all_even.end(), 0.0) / all_even.size(),
+                    std::accumulate(all_prio.begin(), all_prio.end(), 0.0) / all_prio.size());
     }
   }
   std::printf("load after %s\n", loadavg().c_str());
