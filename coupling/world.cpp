@@ -1351,9 +1351,9 @@ bool World::contact_ahead(double dt) {
     RuntimeObject& a = m_objects[i];
     RuntimeObject& b = m_objects[j];
     if (!predictable(a) || !predictable(b)) continue;
-    // (the sweep starts at the spheres of the current positions)
-    // and the cycles are sized by the objects' sub-steps, known once they
-    // have advanced: in a World's first frame the trial measures them)
+    // (the sweep starts at the spheres of the current positions, and the
+    // cycles are sized by the objects' sub-steps, known once they have
+    // advanced: in a World's first frame the trial measures them)
     const auto ready = [](const RuntimeObject& o) {
       return !o.sim || (o.start_spheres.size() == o.asset.spheres.spheres.size() && o.step_cap > 0);
     };
@@ -1518,13 +1518,13 @@ FrameMetrics World::advance(std::optional<double> budget) {
   // contact begins, as if every frame had been cycled. (Without the sweep, a
   // contact that begins and ends inside one trial frame is missed.)
   const bool swept = m_settings.collision.swept;
-  if ((cycles > 1 || swept) && m_settings.collision.single_cycle_when_apart && contact_free() &&
-      contact_ahead(dt)) {
+  const bool apart = (cycles > 1 || swept) && m_settings.collision.single_cycle_when_apart && contact_free();
+  if (apart && contact_ahead(dt)) {
     // A trial would find the contact and be rolled back: cycles at once.
     m.predicted = 1;
     plan_islands(dt);
     cycles = bounds();
-  } else if ((cycles > 1 || swept) && m_settings.collision.single_cycle_when_apart && contact_free()) {
+  } else if (apart) {
     save(m_snapshot);
     FrameMetrics trial = m;
     trial.cycles = 1;
