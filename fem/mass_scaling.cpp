@@ -189,18 +189,36 @@ MassScalingReport apply_mass_scaling(Model& model, const Eigen::Ref<const MatX3d
       if (m0[i] > 0) m[i] = std::max(m0[i], lambda[i] / (th * th));
     return m;
   };
+  const auto over_limit = [&](double th) {
+    return masses_at(th).sum() - total > o.max_added_fraction * total;
+  };
   double prev_threshold = 0, prev_omega = 0;
-  double missed = 0;  // the last threshold whose pass did not reach the target
-  for (int pass = 0;; ++pass) {
-    if (pass == o.max_passes) {
+  double missed = 0;     // the last threshold whose pass did not reach the target
+  bool at_limit = false;  // this pass's threshold puts the added mass at the limit
+  for (;;) {
+    if (r.passes == o.max_passes) {
       r.pass_limited = true;
       break;
     }
-    const Eigen::VectorXd m = masses_at(threshold);
-    if ((m.sum() - total) > o.max_added_fraction * total) {
-      r.mass_limited = true;
-      break;
+    if (over_limit(threshold)) {
+      // A pass that would exceed the limit after one within it: the threshold
+      // between the two whose added mass is the limit (the mass falls
+      // monotonically with the threshold), one more pass there. Without it a
+      // large step (s small) stopped the scaling with most of its budget
+      // unused (the corpus' refined_elephant: +0.22 % of 5 %, ratio 0.32).
+      if (r.node_omega == 0 || at_limit) {
+        r.mass_limited = true;
+        break;
+      }
+      double lo = threshold, hi = r.node_omega;  // over the limit, within it
+      for (int k = 0; k < 40 && hi > lo * (1 + 1e-9); ++k) {
+        const double mid = std::sqrt(lo * hi);
+        (over_limit(mid) ? lo : hi) = mid;
+      }
+      threshold = hi;
+      at_limit = true;
     }
+    const Eigen::VectorXd m = masses_at(threshold);
     model.set_masses(m);
     kept = m;
     ++r.passes;

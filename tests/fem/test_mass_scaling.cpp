@@ -169,6 +169,35 @@ TEST(MassScaling, AddedMassLimitStopsTheScaling) {
   EXPECT_EQ(r.to_string().find("ran out of passes"), std::string::npos) << r.to_string();
 }
 
+TEST(MassScaling, AMassLimitedScalingSpendsItsWholeBudget) {
+  // The target 0.6 needs several passes; with an added-mass limit between
+  // what the first pass adds and what the target needs, the scaling must end
+  // at the limit (the threshold whose added mass is the limit), not at the
+  // last pass before a step that would have crossed it.
+  const Mesh m = block_with_light_nodes({0.03, 0.08});
+  const Material mat;
+  ModelOptions mo;
+  mo.mass_scaling.target_ratio = 0.6;
+  mo.mass_scaling.max_passes = 1;
+  const double first = Model(m.V, m.T, mat, mo).mass_scaling().added_fraction;
+  mo.mass_scaling.max_passes = MassScaling{}.max_passes;
+  const MassScalingReport full = Model(m.V, m.T, mat, mo).mass_scaling();
+  ASSERT_TRUE(full.reached);
+  ASSERT_GT(full.added_fraction, 1.5 * first);
+  for (const double share : {0.1, 0.5, 0.9}) {
+    mo.mass_scaling.max_added_fraction = first + share * (full.added_fraction - first);
+    Model model(m.V, m.T, mat, mo);
+    const MassScalingReport& r = model.mass_scaling();
+    EXPECT_FALSE(r.reached) << share;
+    EXPECT_TRUE(r.mass_limited) << share;
+    EXPECT_LE(r.added_fraction, mo.mass_scaling.max_added_fraction * (1 + 1e-9)) << share;
+    EXPECT_GE(r.added_fraction, 0.999 * mo.mass_scaling.max_added_fraction) << share;
+    const double added = (model.mass().sum() - Model(m.V, m.T, mat).mass().sum()) /
+                         Model(m.V, m.T, mat).mass().sum();
+    EXPECT_NEAR(added, r.added_fraction, 1e-12) << share;
+  }
+}
+
 TEST(MassScaling, PassLimitIsNamedAndFurtherPassesReachTheTarget) {
   // At 0.6 the threshold must fall to ~0.58 x its first value (the light
   // nodes' neighbours share the top mode), so one pass cannot reach it: the
