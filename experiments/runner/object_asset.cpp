@@ -58,7 +58,7 @@ void place_object(ObjectAsset& asset, const ObjectSpec& spec) {
 // Bumped whenever icd-preprocess produces different bundles for the same
 // input and options (e.g. a better sphere-tree builder), so that cached
 // bundles of an older pipeline are not reused.
-constexpr const char* kPreprocessVersion = " pipeline-12";
+constexpr const char* kPreprocessVersion = " pipeline-13";
 
 namespace {
 

@@ -181,9 +181,9 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   // (b.dense, r.repair, in the input's order) and its canonical order and
   // simplification.
   const auto repair_once = [&](const RepairOptions& ro, StageUsage* usage,
-                               const HeartbeatFn& beat) {
+                               const HeartbeatFn& beat, const StageLimits& lim) {
     ByteReader in(run_bounded(
-        "repair", limits,
+        "repair", lim,
         [&] {
           RepairResult rep = repair_surface(input, ro, name);
           ByteWriter w;
@@ -197,13 +197,14 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     r.bbox_diagonal = (b.dense.V.colwise().maxCoeff() - b.dense.V.colwise().minCoeff()).norm();
   };
   SurfaceMesh canonical, simplified;
-  const auto simplify_once = [&](StageUsage* usage, const HeartbeatFn& beat) {
+  const auto simplify_once = [&](StageUsage* usage, const HeartbeatFn& beat,
+                                 const StageLimits& lim) {
     // The stages below see the repaired surface in an order fixed by its
     // geometry (canonical.hpp): permuted input gives the same coarse mesh and
     // sphere tree. The bundle keeps the repaired surface in the input's order.
     canonical = canonical_order(b.dense);
     ByteReader in(run_bounded(
-        "simplify", limits,
+        "simplify", lim,
         [&] {
           SimplifyResult sr = simplify_surface(canonical, o.simplify);
           ByteWriter w;
@@ -218,7 +219,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   {
     Stage t(r, progress, "repair");
     StageUsage u;
-    repair_once(o.repair, &u, t.heartbeat());
+    repair_once(o.repair, &u, t.heartbeat(), limits);
     t.set_usage(u);
     t.done(std::to_string(b.dense.V.rows()) + " vertices, " + std::to_string(b.dense.F.rows()) +
            " faces, " + std::to_string(r.repair.holes_filled) + " hole(s) filled");
@@ -226,7 +227,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   {
     Stage t(r, progress, "simplify");
     StageUsage u;
-    simplify_once(&u, t.heartbeat());
+    simplify_once(&u, t.heartbeat(), limits);
     t.set_usage(u);
     t.done(std::to_string(r.simplify.input_faces) + " -> " +
            std::to_string(r.simplify.output_faces) + " faces");
@@ -237,6 +238,14 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     to.limits = limits;
     to.cell_size *= s;
     to.wrapped_surface = r.repair.wrap_cause != 0;
+    const bool retry_possible =
+        o.repair.wrap == RepairOptions::Wrap::fallback && r.repair.wrap_cause == 0;
+    if (!(o.wrap_retry_first_share > 0.0 && o.wrap_retry_first_share <= 1.0))
+      throw ParameterError("preprocess: wrap_retry_first_share must be in (0, 1]");
+    // One CPU budget for the stage: the first attempt leaves the rest of it
+    // to the wrap retry (a pass that would run past the share fails as it
+    // would at the limit).
+    if (retry_possible) to.cpu_budget = o.wrap_retry_first_share * limits.cpu_seconds;
     TetrahedralizeResult tet;
     // The passes run in child processes: a failed attempt's CPU time is the
     // children's, which the retry adds to this stage's.
@@ -259,7 +268,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       // the alpha wrap of the input once instead (it closes gaps narrower
       // than alpha), repeating repair and simplification, all counted in this
       // stage; the summary's repair section and notes say so.
-      if (o.repair.wrap != RepairOptions::Wrap::fallback || r.repair.wrap_cause != 0) throw;
+      if (!retry_possible) throw;
       std::string first = e.what();
       first = first.substr(0, first.find(". Options that change this"));  // the retry is the option
       const double first_cpu = children_cpu() - cpu0;
@@ -273,9 +282,26 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       ro.wrap = RepairOptions::Wrap::always;
       StageUsage ru, su;
       try {
-        repair_once(ro, &ru, beat);
-        simplify_once(&su, beat);
+        // What is left of the stage's CPU limit bounds the retry's repair and
+        // simplification, then its passes together.
+        const auto left = [&] {
+          return limits.cpu_seconds - (children_cpu() - cpu0);
+        };
+        const auto require = [&](double seconds) {
+          if (seconds < 0.5)
+            throw InputError("the stage's CPU-time limit of " + fmt(limits.cpu_seconds) +
+                             " s (--time-limit) is used up");
+        };
+        StageLimits rl = limits;
+        rl.cpu_seconds = left();
+        require(rl.cpu_seconds);
+        repair_once(ro, &ru, beat, rl);
+        rl.cpu_seconds = left();
+        require(rl.cpu_seconds);
+        simplify_once(&su, beat, rl);
         to.wrapped_surface = true;
+        to.cpu_budget = left();
+        require(to.cpu_budget);
         tet = tetrahedralize_surface(simplified, to, beat);
       } catch (const ParameterError&) {
         throw;
@@ -292,8 +318,8 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       r.notes.push_back("tetrahedralize: the mesher failed on the repaired surface at every "
                         "size (" + first + "; " + fmt(first_cpu) + " s CPU); the surface was "
                         "rebuilt by alpha wrapping and meshed once more (both attempts, with "
-                        "the second repair and simplification, in this stage's time; --wrap "
-                        "never refuses instead)");
+                        "the second repair and simplification, in this stage's time and its "
+                        "one CPU limit; --wrap never refuses instead)");
     }
     t.set_usage(tet.usage);
     b.coarse = std::move(tet.mesh);
@@ -308,9 +334,11 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
                     "tetrahedralize: stable-step post-pass collapsed %d node(s) (node estimate of "
                     "the step ratio %.3f -> %.3f, volume %+.2f %%, %d node(s) left above the "
                     "target; --step-target); dihedral phase: %d collapse(s), %d flip(s), %d "
-                    "surface sliver(s) dropped, %d relocation(s), smallest angle %.2f -> %.2f deg",
+                    "surface sliver(s) dropped, %d relocation(s), %d off the surface, smallest "
+                    "angle %.2f -> %.2f deg",
                     c.collapses, c.ratio_before, c.ratio_after, 100.0 * c.volume_change, c.stuck,
-                    c.dihedral_collapses, c.flips, c.drops, c.relocations, c.min_dihedral_before,
+                    c.dihedral_collapses, c.flips, c.drops, c.relocations, c.off_surface,
+                    c.min_dihedral_before,
                     c.min_dihedral_after);
       r.notes.push_back(buf);
     }

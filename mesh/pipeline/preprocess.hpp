@@ -76,6 +76,13 @@ struct PreprocessOptions {
   /// CPU-time and memory limits of every stage (each runs in a child
   /// process, bounded.hpp); tetrahedralize.limits is set from it.
   StageLimits limits;
+  /// The tetrahedralize stage has one CPU budget, limits.cpu_seconds, for
+  /// both attempts of the automatic wrap retry: the first attempt (on the
+  /// repaired surface, when a retry may follow) may use this share of it, the
+  /// retry (the wrap's repair, simplification and meshing) what is left.
+  /// Each mesher pass keeps its own bound (TetrahedralizeOptions::pass_share
+  /// of the limit). In (0, 1].
+  double wrap_retry_first_share = 0.5;
   PreprocessOptions() {
     spheres.time_limit = 1e9;
     apply_sphere_fit(SphereFit::light, spheres);
@@ -141,7 +148,8 @@ using ProgressFn = std::function<void(const std::string& stage, const std::strin
 /// RepairOptions::Wrap::fallback, a repaired (not wrapped) surface on which
 /// the mesher fails at every size is rebuilt by alpha wrapping and meshed
 /// once more (the automatic wrap retry; repair.wrap_cause 4, a note, its CPU
-/// in the tetrahedralize stage). Every stage runs bounded by
+/// in the tetrahedralize stage, both attempts within the stage's one CPU
+/// limit: wrap_retry_first_share). Every stage runs bounded by
 /// options.limits. Deterministic for identical input and options unless the
 /// sphere builder hits its time limit (reported). Throws what the stages
 /// throw: InputError for unusable input (StageError for a stage beyond its

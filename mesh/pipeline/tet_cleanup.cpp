@@ -136,10 +136,10 @@ double ideal_omega(double mean_volume, double poisson) {
 StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) {
   if (!(o.target_ratio >= 0) || !(o.max_shift >= 0) || !(o.max_volume_change >= 0) ||
       o.max_collapses < 0 || o.max_relocation_sweeps < 0 || !(o.poisson > -1 && o.poisson < 0.5) ||
-      !(o.dihedral_volume_change >= 0))
+      !(o.dihedral_volume_change >= 0) || !(o.max_off_surface >= 0))
     throw ParameterError("raise_stable_step: need target_ratio, max_shift, max_volume_change, "
-                         "dihedral_volume_change, max_collapses, max_relocation_sweeps >= 0 and "
-                         "poisson in (-1, 0.5)");
+                         "dihedral_volume_change, max_off_surface, max_collapses, "
+                         "max_relocation_sweeps >= 0 and poisson in (-1, 0.5)");
   StepCleanupReport rep;
   const int n = static_cast<int>(mesh.V.rows());
   if (mesh.T.rows() == 0 || o.target_ratio == 0) return rep;
@@ -764,6 +764,132 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     if (rep.relocations > 0) w = node_frequencies(mesh.V, T, o.poisson);
   }
   if (rep.relocations > 0) topological_phase();
+  // Last phase, only when tets below the target remain: their nodes move
+  // again, a surface node now also off the boundary (within max_off_surface
+  // of the diagonal of the boundary as it was before this phase), along the
+  // gradient of the sliver's smallest angle or along the boundary's normal;
+  // accepted as the relocations are (the smallest angle of the node's tets
+  // rises, positive tets, the node-frequency cap, the volume bound).
+  const auto below_target = [&] {
+    for (const Tet& t : T)
+      if (min_dihedral(mesh.V, t) < o.dihedral_target_deg) return true;
+    return false;
+  };
+  if (o.dihedral_target_deg > 0 && o.max_off_surface > 0 && o.max_relocation_sweeps > 0 &&
+      below_target()) {
+    const Local L = local();
+    MatX4i Tm(static_cast<Eigen::Index>(T.size()), 4);
+    for (size_t e = 0; e < T.size(); ++e)
+      for (int k = 0; k < 4; ++k) Tm(static_cast<Eigen::Index>(e), k) = T[e][k];
+    const MatX3i Fb = boundary_faces(Tm);
+    const MatX3d V1 = mesh.V;
+    const double budget = o.max_off_surface * diagonal;
+    const auto off_boundary = [&](const Eigen::Vector3d& p) {  // distance to the boundary before
+      double d2 = INFINITY;
+      for (Eigen::Index f = 0; f < Fb.rows(); ++f)
+        d2 = std::min(d2, (closest_point_on_triangle(p, V1.row(Fb(f, 0)).transpose(),
+                                                     V1.row(Fb(f, 1)).transpose(),
+                                                     V1.row(Fb(f, 2)).transpose()) -
+                           p).squaredNorm());
+      return std::sqrt(d2);
+    };
+    const auto star_min = [&](int i, const Eigen::Vector3d& x) {
+      const Eigen::RowVector3d keep = mesh.V.row(i);
+      mesh.V.row(i) = x.transpose();
+      double d = 180;
+      for (int e : L.around[static_cast<size_t>(i)]) {
+        if (!(tet_volume(mesh.V, T[static_cast<size_t>(e)]) > 0)) {
+          d = -1;
+          break;
+        }
+        d = std::min(d, min_dihedral(mesh.V, T[static_cast<size_t>(e)]));
+      }
+      mesh.V.row(i) = keep;
+      return d;
+    };
+    const double cap = std::max(threshold, w.maxCoeff());
+    for (int sweep = 0; sweep < 2 * o.max_relocation_sweeps; ++sweep) {
+      std::vector<std::pair<double, int>> bad;
+      for (size_t e = 0; e < T.size(); ++e) {
+        const double d = min_dihedral(mesh.V, T[e]);
+        if (d < o.dihedral_target_deg) bad.emplace_back(d, static_cast<int>(e));
+      }
+      std::sort(bad.begin(), bad.end());
+      int moved_now = 0;
+      for (const auto& [d0, e] : bad) {
+        const Tet& t = T[static_cast<size_t>(e)];
+        if (min_dihedral(mesh.V, t) >= o.dihedral_target_deg) continue;
+        int best_i = -1;
+        double best_gain = 0, best_dv = 0;
+        Eigen::Vector3d best_to = Eigen::Vector3d::Zero();
+        for (int i : t) {
+          const bool surf = L.surface[static_cast<size_t>(i)] != 0;
+          const Eigen::Vector3d x = mesh.V.row(i).transpose();
+          const double now = star_min(i, x);
+          double mean_edge = 0;
+          const std::set<int> nbrs = neighbours(L, i);
+          for (int v : nbrs) mean_edge += (mesh.V.row(v) - mesh.V.row(i)).norm();
+          if (nbrs.empty()) continue;
+          mean_edge /= static_cast<double>(nbrs.size());
+          std::vector<Eigen::Vector3d> cand;
+          Eigen::Vector3d g = Eigen::Vector3d::Zero();
+          const double h = 1e-4 * mean_edge;
+          for (int k = 0; k < 3; ++k) {
+            const Eigen::RowVector3d keep = mesh.V.row(i);
+            mesh.V(i, k) += h;
+            const double up = min_dihedral(mesh.V, t);
+            mesh.V(i, k) -= 2 * h;
+            const double down = min_dihedral(mesh.V, t);
+            mesh.V.row(i) = keep;
+            g[k] = (up - down) / (2 * h);
+          }
+          if (g.norm() > 0)
+            for (double s : {0.01, 0.02, 0.04, 0.08, 0.16})
+              cand.push_back(x + s * mean_edge * g.normalized());
+          if (surf) {  // along the normal of the boundary around i, both ways
+            Eigen::Vector3d nrm = Eigen::Vector3d::Zero();
+            for (Eigen::Index f = 0; f < Fb.rows(); ++f)
+              if (Fb(f, 0) == i || Fb(f, 1) == i || Fb(f, 2) == i) {
+                const Eigen::Vector3d a = V1.row(Fb(f, 0)), b = V1.row(Fb(f, 1)), c = V1.row(Fb(f, 2));
+                nrm += (b - a).cross(c - a);
+              }
+            if (nrm.norm() > 0)
+              for (double s : {0.25, 0.5, 1.0}) {
+                cand.push_back(x + s * budget * nrm.normalized());
+                cand.push_back(x - s * budget * nrm.normalized());
+              }
+          }
+          for (const Eigen::Vector3d& p : cand) {
+            if (surf && off_boundary(p) > budget) continue;
+            const double d = star_min(i, p);
+            if (!(d > now + 1e-9) || d - now <= best_gain) continue;
+            const Eigen::RowVector3d keep = mesh.V.row(i);
+            double dv = 0;
+            for (int k : L.around[static_cast<size_t>(i)]) dv -= tet_volume(mesh.V, T[static_cast<size_t>(k)]);
+            mesh.V.row(i) = p.transpose();
+            for (int k : L.around[static_cast<size_t>(i)]) dv += tet_volume(mesh.V, T[static_cast<size_t>(k)]);
+            const Eigen::VectorXd wc = node_frequencies(mesh.V, T, o.poisson);
+            mesh.V.row(i) = keep;
+            if (wc.maxCoeff() > cap || !volume_ok(volume + dv)) continue;
+            best_i = i;
+            best_gain = d - now;
+            best_to = p;
+            best_dv = dv;
+          }
+        }
+        if (best_i < 0) continue;
+        mesh.V.row(best_i) = best_to.transpose();
+        volume += best_dv;
+        ++rep.off_surface;
+        ++moved_now;
+      }
+      if (moved_now == 0) break;
+    }
+    if (rep.off_surface > 0) {
+      w = node_frequencies(mesh.V, T, o.poisson);
+      topological_phase();
+    }
+  }
   rep.min_dihedral_after = 180;
   for (const Tet& t : T) rep.min_dihedral_after = std::min(rep.min_dihedral_after, min_dihedral(mesh.V, t));
   for (int v = 0; v < n; ++v)

@@ -58,6 +58,17 @@ struct StepCleanupOptions {
   /// little volume, and the step phase used up the whole 1 % on 6 of the 7
   /// corpus meshes left below 12 deg.
   double dihedral_volume_change = 0.005;
+  /// Last, and only when tets below dihedral_target_deg remain after all the
+  /// phases above (a mesh that meets the target is left as they left it):
+  /// the nodes of those tets are moved once more, a surface node now also off
+  /// the boundary, by at most this fraction of the bounding-box diagonal from
+  /// the boundary as it was before this phase (the coarse surface's distance
+  /// to the dense one grows by at most as much), under the same acceptance
+  /// rule as the relocations, in up to 2 x max_relocation_sweeps sweeps
+  /// (off with them); then flips once more. For parts one tet thick (knots,
+  /// tubes): their last slivers have all four nodes on the surface, which the
+  /// tangential relocation cannot lift. 0: off.
+  double max_off_surface = 0.005;
 };
 
 /// What raise_stable_step() did.
@@ -73,6 +84,7 @@ struct StepCleanupReport {
   int relocations = 0;             ///< node moves of the relocation phase
   int flips = 0;                   ///< flips of the dihedral phases (2-3, 3-2, 4-4, ...)
   int drops = 0;                   ///< surface slivers dropped by the dihedral phases
+  int off_surface = 0;             ///< node moves of the last phase (max_off_surface)
 };
 
 /// Collapses the nodes that limit the stable step, then those of the tets

@@ -192,12 +192,12 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       !(o.limits.cpu_seconds > 0.0) || !(o.limits.memory_mb > 0.0) ||
       !(o.step_cleanup.target_ratio >= 0.0) ||
       !(o.interior_size_factor > 0.0 && o.interior_size_factor <= 1.0) ||
-      !(o.over_refinement_factor >= 0.0) || o.min_vertex_cap < 0)
+      !(o.over_refinement_factor >= 0.0) || o.min_vertex_cap < 0 || !(o.cpu_budget >= 0.0))
     throw ParameterError(
         "tetrahedralize_surface: need target_tets >= 1 or cell_size > 0, facet_angle_deg in (0, "
         "30], radius_edge_bound >= 2, sliver_bound_deg in [0, 70), positive factors, "
         "max_size_iterations >= 1, pass_share in (0, 1], max_retries >= 0, positive limits, step_cleanup.target_ratio >= 0, interior_size_factor in (0, 1], "
-        "over_refinement_factor and min_vertex_cap >= 0");
+        "over_refinement_factor, min_vertex_cap and cpu_budget >= 0");
   CgalMesh sm;
   if (!detail::to_cgal(surface, sm) || !CGAL::is_closed(sm))
     throw InputError("tetrahedralize_surface: the surface is not a closed manifold triangle mesh");
@@ -231,6 +231,7 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     res.feature_curves = static_cast<int>(curves.size());
   }
   double spent = 0.0;  // CPU seconds of all passes
+  const double budget = o.cpu_budget > 0.0 ? o.cpu_budget : o.limits.cpu_seconds;
   int retries_left = o.max_retries;
   std::string last_cause;
   bool last_over_refined = false;
@@ -240,10 +241,13 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     res.step_cleanup = {};
     last_over_refined = false;
     StageLimits pl = o.limits;
-    pl.cpu_seconds = std::min(o.limits.cpu_seconds - spent, o.pass_share * o.limits.cpu_seconds);
+    pl.cpu_seconds = std::min(budget - spent, o.pass_share * o.limits.cpu_seconds);
     if (pl.cpu_seconds < 0.5) {
-      last_cause = "the stage's CPU-time limit of " + fmt(o.limits.cpu_seconds) +
-                   " s (--time-limit) is used up";
+      last_cause = budget < o.limits.cpu_seconds
+                       ? "its share of " + fmt(budget) + " s of the stage's CPU-time limit of " +
+                             fmt(o.limits.cpu_seconds) + " s (--time-limit) is used up"
+                       : "the stage's CPU-time limit of " + fmt(o.limits.cpu_seconds) +
+                             " s (--time-limit) is used up";
       return false;
     }
     ++res.passes;
@@ -319,7 +323,7 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
         out = std::move(m);
         return true;
       }
-      if (o.limits.cpu_seconds - spent < 0.5) return false;
+      if (budget - spent < 0.5) return false;
     }
     return false;
   };

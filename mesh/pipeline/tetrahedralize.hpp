@@ -52,6 +52,11 @@ struct TetrahedralizeOptions {
   /// pass that stalls leaves time for the retries.
   StageLimits limits;
   double pass_share = 0.34;  ///< in (0, 1]
+  /// CPU seconds all passes of this call may use together (0: limits.cpu_seconds).
+  /// Each pass still gets at most pass_share x limits.cpu_seconds. The
+  /// preprocessing's automatic wrap retry splits one --time-limit between the
+  /// first attempt and the retry with it.
+  double cpu_budget = 0.0;
   /// Passes that fail (no tet, a non-manifold boundary, a CGAL failure, a pass
   /// limit) are retried at nearby cell sizes (x 0.85, 1.15, 0.7, 1.3, ...) up
   /// to this many times in all; each retry is reported in the result's notes.

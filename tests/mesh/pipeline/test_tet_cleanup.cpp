@@ -14,6 +14,7 @@
 
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/core/triangle_geometry.hpp>
 #include <icd/mesh/pipeline/fem_step.hpp>
 #include <icd/mesh/pipeline/tet_quality.hpp>
 
@@ -249,6 +250,76 @@ TEST(TetCleanup, BoundarySliverIsDropped) {
   EXPECT_EQ(off.T.rows(), block.T.rows() + 1);
 }
 
+TEST(TetCleanup, SliverOfASlabOneTetThickIsLiftedOffTheSurface) {
+  // A slab one cell thick (Kuhn tets of 3 x 3 x 1 cells: every node on the
+  // surface, as on the corpus' knots) with the top node at (1/3, 1/3) pushed
+  // down until one of its tets falls below 11 deg: a sliver whose four nodes
+  // lie on the surface. With collapses and flips off and surface nodes held
+  // on their place along the boundary (max_shift 0: here sliding the node
+  // along the dent would also do, on the knots it did not), only the last
+  // phase can lift it (checked: with max_off_surface 0 it stays): it moves
+  // a surface node off the boundary, by at most max_off_surface of the
+  // diagonal, until every tet is at 12 deg or more; the connectivity stays.
+  BoxMeshOptions bo;
+  bo.size = {1, 1, 0.3};
+  bo.nx = bo.ny = 3;
+  bo.nz = 1;
+  TetMesh m = make_box_tet_mesh(bo);
+  const int c = 1 + 4 * (1 + 4 * 1);  // vertex (1, 1, 1): index i + (nx+1)(j + (ny+1)k)
+  ASSERT_NEAR(m.V(c, 2), 0.3, 1e-12);
+  double push = 0;
+  while (tet_quality(m).min_dihedral_deg >= 11.0 && push < 0.3) {
+    push += 0.002;
+    m.V(c, 2) = 0.3 - push;
+  }
+  m.F = boundary_faces(m.T);
+  ASSERT_TRUE(closed_manifold(m));
+  ASSERT_GT(signed_tet_volumes(m.V, m.T).minCoeff(), 0.0);
+  const TetQuality q0 = tet_quality(m);
+  ASSERT_LT(q0.min_dihedral_deg, 11.0);
+  const TetMesh before = m;
+  const double diagonal = (m.V.colwise().maxCoeff() - m.V.colwise().minCoeff()).norm();
+
+  StepCleanupOptions o;
+  o.max_collapses = 0;
+  o.flips = false;
+  o.max_shift = 0;
+  o.max_volume_change = 0.05;
+  o.max_off_surface = push / diagonal;  // enough to lift the node back
+  TetMesh off = m;
+  const StepCleanupReport r = raise_stable_step(m, o);
+  EXPECT_GE(r.off_surface, 1);
+  EXPECT_EQ(r.collapses + r.dihedral_collapses + r.flips + r.drops + r.relocations, 0);
+  EXPECT_EQ(m.T, before.T);
+  EXPECT_EQ(m.F, before.F);
+  const TetQuality q = tet_quality(m);
+  EXPECT_GE(q.min_dihedral_deg, 12.0);
+  EXPECT_NEAR(r.min_dihedral_after, q.min_dihedral_deg, 1e-9);
+  EXPECT_GT(q.min_volume, 0.0);
+  // Every node (all on the surface here) within the budget of the boundary
+  // as it was (brute force over its faces).
+  int moved = 0;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    if (m.V.row(i) == before.V.row(i)) continue;
+    ++moved;
+    const Eigen::Vector3d p = m.V.row(i).transpose();
+    double d = INFINITY;
+    for (Eigen::Index f = 0; f < before.F.rows(); ++f)
+      d = std::min(d, (closest_point_on_triangle(p, before.V.row(before.F(f, 0)).transpose(),
+                                                 before.V.row(before.F(f, 1)).transpose(),
+                                                 before.V.row(before.F(f, 2)).transpose()) -
+                       p).norm());
+    EXPECT_LE(d, o.max_off_surface * diagonal * (1 + 1e-9)) << "node " << i;
+  }
+  EXPECT_GE(moved, 1);
+  // Off: nothing moves, the sliver stays.
+  o.max_off_surface = 0;
+  const StepCleanupReport r_off = raise_stable_step(off, o);
+  EXPECT_EQ(r_off.off_surface + r_off.relocations, 0);
+  EXPECT_EQ(off.V, before.V);
+  EXPECT_LT(tet_quality(off).min_dihedral_deg, 11.0);
+}
+
 TEST(TetCleanup, BadOptionsAreRefused) {
   TetMesh m = bcc_block(2, 1.0);
   StepCleanupOptions o;
@@ -262,6 +333,9 @@ TEST(TetCleanup, BadOptionsAreRefused) {
   EXPECT_THROW(raise_stable_step(m, o), ParameterError);
   o = {};
   o.dihedral_volume_change = -0.01;
+  EXPECT_THROW(raise_stable_step(m, o), ParameterError);
+  o = {};
+  o.max_off_surface = -0.001;
   EXPECT_THROW(raise_stable_step(m, o), ParameterError);
 }
 

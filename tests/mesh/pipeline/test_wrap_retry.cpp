@@ -89,6 +89,26 @@ TEST(Tetrahedralize, RefusalOfAWrappedSurfaceNamesTheWrapAlphaNotWrapAlways) {
   }
 }
 
+TEST(Tetrahedralize, PassesStopWithinTheirCpuBudget) {
+  // The wrap retry splits one --time-limit between two calls through
+  // cpu_budget: a call whose budget cannot hold a pass refuses at once,
+  // naming the budget, the stage's limit and --time-limit, without a pass.
+  TetrahedralizeOptions o = small_options();
+  o.cpu_budget = 0.4;  // below the half second a pass needs at least
+  try {
+    tetrahedralize_surface(two_boxes(0.3), o);
+    FAIL() << "meshed within a budget of 0.4 s";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("failed in all 0 pass(es)"), std::string::npos) << m;
+    EXPECT_NE(m.find("its share of 0.4 s of the stage's CPU-time limit of 120 s (--time-limit)"),
+              std::string::npos)
+        << m;
+  }
+  o.cpu_budget = -1;
+  EXPECT_THROW(tetrahedralize_surface(two_boxes(0.3), o), ParameterError);
+}
+
 TEST(Preprocess, MesherFailureIsRetriedOnTheAlphaWrap) {
   PreprocessOptions o;
   o.sphere_builder = SphereBuilder::none;
