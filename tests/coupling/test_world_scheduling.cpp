@@ -396,6 +396,63 @@ TEST(WorldScheduling, PredictedFirstContactSkipsTheRolledBackTrial) {
   EXPECT_NEAR(ahead.contact_frames, trial.contact_frames, 1);
 }
 
+// The pair bound of the motion cycles counts how far each object can close
+// on the other over the frame (World::closing_motion), not its fastest
+// sphere's speed: a ball vibrating in its breathing mode (radial node
+// velocities up to 4 m/s, no net motion) 8 cm from a ball approaching at
+// 0.6 m/s. Reference by hand from the node velocities at each frame's
+// start: the old rule (fastest node of each ball times the frame, over
+// cycle_motion leaf radii) and the approach alone. The count lies between
+// the two, under half the old rule over the run; the contact is still found,
+// holds (no pair deeper than a leaf radius) and pushes the vibrating ball away.
+TEST(WorldScheduling, VibrationWithoutApproachAsksFewMotionCycles) {
+  std::vector<WorldObject> v;
+  v.push_back(ball("vibrating", {-0.14, 0, 0}, {0, 0, 0}));
+  v.push_back(ball("approaching", {0.14, 0, 0}, {-0.6, 0, 0}));
+  WorldSettings s = deterministic();
+  s.gravity.setZero();
+  World w(std::move(v), s);
+  {
+    RuntimeObject& o = w.objects()[0];
+    const Eigen::RowVector3d c = o.positions.colwise().mean();
+    MatX3d vel = o.positions.rowwise() - c;
+    vel *= 4.0 / vel.rowwise().norm().maxCoeff();  // 4 m/s at the surface, outward
+    o.sim->set_velocities(vel);
+  }
+  const double dt = 1.0 / 60;
+  const double step = s.collision.cycle_motion * std::min(w.objects()[0].leaf_radius, w.objects()[1].leaf_radius);
+  int compared = 0, contact_frames = 0, first_contact = -1, cycles = 0, old_cycles = 0;
+  double depth_ratio = 0;
+  for (int f = 0; f < 24; ++f) {
+    const double fastest0 = w.objects()[0].sim->velocities().rowwise().norm().maxCoeff();
+    const double fastest1 = w.objects()[1].sim->velocities().rowwise().norm().maxCoeff();
+    const FrameMetrics m = w.step();
+    contact_frames += m.active_pairs > 0;
+    if (m.active_pairs > 0 && first_contact < 0) first_contact = f;
+    depth_ratio = std::max(depth_ratio, m.depth_ratio);
+    if (m.cycles <= 1 || f < 2) continue;  // (apart, or the first frames: no frame motion measured)
+    const int old_rule = static_cast<int>(std::ceil((fastest0 + fastest1) * dt / step));
+    const int approach = static_cast<int>(std::ceil(0.6 * dt / step));
+    if (std::getenv("ICD_TEST_VERBOSE"))
+      std::printf("frame %d motion cycles %d (old rule %d, approach %d) active %d depth %g x %g %g\n", f,
+                  m.cycles_motion, old_rule, approach, m.active_pairs, m.max_penetration,
+                  w.objects()[0].positions.col(0).maxCoeff(), w.objects()[1].positions.col(0).minCoeff());
+    ASSERT_GT(old_rule, 3 * approach);  // (the vibration is fast enough to matter)
+    EXPECT_GE(m.cycles_motion, approach);
+    cycles += m.cycles_motion;
+    old_cycles += old_rule;
+    ++compared;
+  }
+  ASSERT_GE(compared, 3);
+  EXPECT_LT(cycles, old_cycles / 2);
+  EXPECT_GE(first_contact, 2);  // (reached by the approach, not by the vibration at once)
+  EXPECT_GE(contact_frames, 2);
+  EXPECT_LT(depth_ratio, 1.0);
+  const RuntimeObject& left = w.objects()[0];
+  const Eigen::VectorXd& mass = left.sim->model().mass();
+  EXPECT_LT((left.sim->velocities().transpose() * mass).x() / mass.sum(), -0.02);  // pushed away
+}
+
 // The pool hands every index to exactly one thread, job after job, whether
 // its workers spin between jobs or block at once (the World's hand-off,
 // thousands of times per second).
