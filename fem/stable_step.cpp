@@ -19,32 +19,32 @@ bool rk4_stable(std::complex<double> z) {
   return std::norm(R) <= (1.0 + 1e-12) * (1.0 + 1e-12);  // |R|^2: no hypot
 }
 
-double rk4_mode_limit(double omega, double c) {
-  // Roots of s^2 + c s + omega^2 = 0.
-  const std::complex<double> disc = std::sqrt(std::complex<double>(c * c - 4 * omega * omega, 0.0));
-  const std::complex<double> s1 = 0.5 * (-c + disc), s2 = 0.5 * (-c - disc);
-  auto stable = [&](double h) { return rk4_stable(h * s1) && rk4_stable(h * s2); };
-  const double scale = std::max(std::abs(s1), std::abs(s2));
-  if (scale == 0) return std::numeric_limits<double>::infinity();
-  double lo = 0, hi = 1.0 / scale;
-  while (stable(hi)) {
-    lo = hi;
-    hi *= 2;
+// A damped mode: the roots of s^2 + c s + omega^2 = 0. RK4 at step h is
+// stable for it when |R(h s)| <= 1 at both roots.
+struct Rk4Mode {
+  std::complex<double> s1, s2;
+  Rk4Mode(double omega, double c) {
+    const std::complex<double> disc = std::sqrt(std::complex<double>(c * c - 4 * omega * omega, 0.0));
+    s1 = 0.5 * (-c + disc);
+    s2 = 0.5 * (-c - disc);
   }
-  for (int i = 0; i < 56; ++i) {  // the bracket [lo, 2 lo] to 2^-55 relative
-    const double mid = 0.5 * (lo + hi);
-    (stable(mid) ? lo : hi) = mid;
+  bool stable(double h) const { return rk4_stable(h * s1) && rk4_stable(h * s2); }
+  // The largest stable step (the stable steps form an interval [0, limit]).
+  double limit() const {
+    const double scale = std::max(std::abs(s1), std::abs(s2));
+    if (scale == 0) return std::numeric_limits<double>::infinity();
+    double lo = 0, hi = 1.0 / scale;
+    while (stable(hi)) {
+      lo = hi;
+      hi *= 2;
+    }
+    for (int i = 0; i < 56; ++i) {  // the bracket [lo, 2 lo] to 2^-55 relative
+      const double mid = 0.5 * (lo + hi);
+      (stable(mid) ? lo : hi) = mid;
+    }
+    return lo;
   }
-  return lo;
-}
-
-// Whether RK4 at step h is stable for the mode (omega, c) (both roots, as
-// rk4_mode_limit tests them).
-bool rk4_step_stable(double omega, double c, double h) {
-  const std::complex<double> disc = std::sqrt(std::complex<double>(c * c - 4 * omega * omega, 0.0));
-  const std::complex<double> s1 = 0.5 * (-c + disc), s2 = 0.5 * (-c - disc);
-  return rk4_stable(h * s1) && rk4_stable(h * s2);
-}
+};
 
 double symplectic_euler_mode_limit(double omega, double c) {
   double h = (std::sqrt(c * c + 4 * omega * omega) - c) / (omega * omega);
@@ -68,7 +68,7 @@ double stable_step_limit(Integrator integrator, double omega_max, const Rayleigh
   const int levels = max_damping_rate > 0 ? 8 : 0;
   // From the top mode down (it usually sets the limit): a mode for which
   // the limit found so far is already stable cannot lower it (the stable
-  // steps of a mode form an interval [0, its limit], as rk4_mode_limit's
+  // steps of a mode form an interval [0, its limit], as Rk4Mode::limit's
   // search assumes), so RK4 skips its bisection (one stability test
   // instead of ~60: the limit was ~20 % of a many_objects contact cycle).
   for (int k = 96; k >= 0; --k) {  // omega_max * 10^(0 .. -6)
@@ -77,8 +77,9 @@ double stable_step_limit(Integrator integrator, double omega_max, const Rayleigh
       const double c = damping.alpha + damping.beta * omega * omega +
                        (levels ? max_damping_rate * j / levels : 0.0);
       if (integrator == Integrator::RK4) {
-        if (std::isfinite(limit) && rk4_step_stable(omega, c, limit)) continue;
-        limit = std::min(limit, rk4_mode_limit(omega, c));
+        const Rk4Mode mode(omega, c);
+        if (std::isfinite(limit) && mode.stable(limit)) continue;
+        limit = std::min(limit, mode.limit());
       } else {
         limit = std::min(limit, symplectic_euler_mode_limit(omega, c));
       }

@@ -342,6 +342,82 @@ TEST(WorldScheduling, SlowContactCyclesAreAsLongAsTheFemStepWithTheRateCap) {
   EXPECT_LT(now.contact_substeps, before.contact_substeps);
 }
 
+// With the rate cap and cycles_at_fem_step, a pair closing faster than the
+// slow-contact rule allows at one cycle per sub-step (3 x its motion cycles
+// above the sub-steps) gets 3 x its motion cycles, not the stiffness rule's
+// count at once (World::contact_cycles): balls head-on at 1.5 m/s each. By
+// hand from each contact frame's figures: penalty cycles = 3 x motion
+// cycles, capped by the stiffness rule (worked out from the node masses);
+// fewer contact sub-steps than with the stiffness rule alone; no cycle
+// softened, the balls bounce back and leave with less kinetic energy than
+// they came, and the contact holds, if deeper: the longer capped cycles are
+// softer (deepest pair 1.12 leaf radii against 0.93 with the stiffness
+// rule; bound here 1.25, and 1.3x the stiffness rule's).
+TEST(WorldScheduling, FasterContactGetsThreeTimesItsMotionCyclesWithTheRateCap) {
+  struct Run {
+    int fast_frames = 0, contact_substeps = 0, mismatches = 0, softened = 0;
+    double left_vx = 0;
+    double depth_ratio = 0, kinetic_before = 0, kinetic_after = 0;
+  };
+  const auto run = [](bool at_step) {
+    std::vector<WorldObject> v;
+    v.push_back(ball("left", {-0.15, 0, 0}, {1.5, 0, 0}));
+    v.push_back(ball("right", {0.15, 0, 0}, {-1.5, 0, 0}));
+    WorldSettings s = deterministic();
+    s.collision.cycles_at_fem_step = at_step;
+    World w(std::move(v), s);
+    const double lightest =
+        std::min(w.objects()[0].node_mass.minCoeff(), w.objects()[1].node_mass.minCoeff());
+    const double dt = 1.0 / 60;
+    const int stiff = std::min(64, static_cast<int>(std::ceil(std::sqrt(2000 / lightest) * dt / 0.25)));
+    const auto kinetic = [&] {
+      double k = 0;
+      for (const RuntimeObject& o : w.objects()) k += o.sim->model().kinetic_energy(o.sim->velocities());
+      return k;
+    };
+    Run r;
+    r.kinetic_before = kinetic();
+    int apart_substeps = 0;
+    for (int f = 0; f < 20; ++f) {
+      const FrameMetrics m = w.step();
+      if (f == 0 && m.cycles == 1) apart_substeps = w.objects()[0].substeps;  // (0: not apart)
+      r.depth_ratio = std::max(r.depth_ratio, m.depth_ratio);
+      r.softened += m.softened;
+      if (m.active_pairs == 0) continue;
+      r.contact_substeps += m.substeps;
+      if (std::getenv("ICD_TEST_VERBOSE"))
+        std::printf("frame %d cycles %d penalty %d motion %d substeps %d (stiff %d, apart %d)\n", f,
+                    m.cycles, m.cycles_penalty, m.cycles_motion, m.substeps, stiff, apart_substeps);
+      if (!at_step || 3 * m.cycles_motion <= apart_substeps + 2) continue;  // (slow: the other test)
+      ++r.fast_frames;
+      // (the stiffness rule takes the node stiffness when above k: at least
+      // the hand value)
+      const int slow = 3 * m.cycles_motion;
+      if (slow <= stiff)
+        r.mismatches += m.cycles_penalty != slow;
+      else
+        r.mismatches += m.cycles_penalty < stiff || m.cycles_penalty > slow;
+    }
+    r.kinetic_after = kinetic();
+    const RuntimeObject& left = w.objects()[0];
+    const Eigen::VectorXd& mass = left.sim->model().mass();
+    r.left_vx = (left.sim->velocities().transpose() * mass).x() / mass.sum();
+    return r;
+  };
+  const Run now = run(true), before = run(false);
+  if (std::getenv("ICD_TEST_VERBOSE"))
+    std::printf("depth ratio %.3f (stiffness rule %.3f), kinetic %.4f -> %.4f J (%.4f)\n", now.depth_ratio,
+                before.depth_ratio, now.kinetic_before, now.kinetic_after, before.kinetic_after);
+  ASSERT_GE(now.fast_frames, 1);
+  EXPECT_EQ(now.mismatches, 0);
+  EXPECT_LT(now.contact_substeps, before.contact_substeps);
+  EXPECT_EQ(now.softened, 0);
+  EXPECT_LT(now.depth_ratio, 1.25);
+  EXPECT_LT(now.depth_ratio, 1.3 * before.depth_ratio);
+  EXPECT_LT(now.kinetic_after, now.kinetic_before);
+  EXPECT_LT(now.left_vx, -0.5);  // bounced back
+}
+
 // A frame that starts apart and ends in contact used to run as one cycle,
 // be rolled back and re-run in cycles (the single-cycle trial): the trial's
 // sub-steps were paid for nothing. With the contact predicted from the node
@@ -394,6 +470,63 @@ TEST(WorldScheduling, PredictedFirstContactSkipsTheRolledBackTrial) {
   EXPECT_NEAR(ahead.vx, trial.vx, 0.02 * std::abs(trial.vx));
   EXPECT_NEAR(ahead.depth, trial.depth, 0.1 * trial.depth);
   EXPECT_NEAR(ahead.contact_frames, trial.contact_frames, 1);
+}
+
+// The pair bound of the motion cycles counts how far each object can close
+// on the other over the frame (World::closing_motion), not its fastest
+// sphere's speed: a ball vibrating in its breathing mode (radial node
+// velocities up to 4 m/s, no net motion) 8 cm from a ball approaching at
+// 0.6 m/s. Reference by hand from the node velocities at each frame's
+// start: the old rule (fastest node of each ball times the frame, over
+// cycle_motion leaf radii) and the approach alone. The count lies between
+// the two, under half the old rule over the run; the contact is still found,
+// holds (no pair deeper than a leaf radius) and pushes the vibrating ball away.
+TEST(WorldScheduling, VibrationWithoutApproachAsksFewMotionCycles) {
+  std::vector<WorldObject> v;
+  v.push_back(ball("vibrating", {-0.14, 0, 0}, {0, 0, 0}));
+  v.push_back(ball("approaching", {0.14, 0, 0}, {-0.6, 0, 0}));
+  WorldSettings s = deterministic();
+  s.gravity.setZero();
+  World w(std::move(v), s);
+  {
+    RuntimeObject& o = w.objects()[0];
+    const Eigen::RowVector3d c = o.positions.colwise().mean();
+    MatX3d vel = o.positions.rowwise() - c;
+    vel *= 4.0 / vel.rowwise().norm().maxCoeff();  // 4 m/s at the surface, outward
+    o.sim->set_velocities(vel);
+  }
+  const double dt = 1.0 / 60;
+  const double step = s.collision.cycle_motion * std::min(w.objects()[0].leaf_radius, w.objects()[1].leaf_radius);
+  int compared = 0, contact_frames = 0, first_contact = -1, cycles = 0, old_cycles = 0;
+  double depth_ratio = 0;
+  for (int f = 0; f < 24; ++f) {
+    const double fastest0 = w.objects()[0].sim->velocities().rowwise().norm().maxCoeff();
+    const double fastest1 = w.objects()[1].sim->velocities().rowwise().norm().maxCoeff();
+    const FrameMetrics m = w.step();
+    contact_frames += m.active_pairs > 0;
+    if (m.active_pairs > 0 && first_contact < 0) first_contact = f;
+    depth_ratio = std::max(depth_ratio, m.depth_ratio);
+    if (m.cycles <= 1 || f < 2) continue;  // (apart, or the first frames: no frame motion measured)
+    const int old_rule = static_cast<int>(std::ceil((fastest0 + fastest1) * dt / step));
+    const int approach = static_cast<int>(std::ceil(0.6 * dt / step));
+    if (std::getenv("ICD_TEST_VERBOSE"))
+      std::printf("frame %d motion cycles %d (old rule %d, approach %d) active %d depth %g x %g %g\n", f,
+                  m.cycles_motion, old_rule, approach, m.active_pairs, m.max_penetration,
+                  w.objects()[0].positions.col(0).maxCoeff(), w.objects()[1].positions.col(0).minCoeff());
+    ASSERT_GT(old_rule, 3 * approach);  // (the vibration is fast enough to matter)
+    EXPECT_GE(m.cycles_motion, approach);
+    cycles += m.cycles_motion;
+    old_cycles += old_rule;
+    ++compared;
+  }
+  ASSERT_GE(compared, 3);
+  EXPECT_LT(cycles, old_cycles / 2);
+  EXPECT_GE(first_contact, 2);  // (reached by the approach, not by the vibration at once)
+  EXPECT_GE(contact_frames, 2);
+  EXPECT_LT(depth_ratio, 1.0);
+  const RuntimeObject& left = w.objects()[0];
+  const Eigen::VectorXd& mass = left.sim->model().mass();
+  EXPECT_LT((left.sim->velocities().transpose() * mass).x() / mass.sum(), -0.02);  // pushed away
 }
 
 // The pool hands every index to exactly one thread, job after job, whether
