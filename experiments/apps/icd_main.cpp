@@ -8,10 +8,13 @@
 #include <string>
 
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/runner/locations.hpp"
 #include "experiments/runner/run.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   std::filesystem::path out = "results/main";
   std::filesystem::path scene_path = icd::runner::scenes_dir() / "bunny_dragon.json";
   std::filesystem::path cache_dir = icd::runner::default_cache_dir();
@@ -33,23 +36,24 @@ int main(int argc, char** argv) {
   if (const auto status = cli.parse(argc, argv)) return *status;
   // --threads is the scene field `threads`, applied after every --set.
   if (threads >= 0) overrides.push_back("threads=" + std::to_string(threads));
-  try {
-    const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
-    std::printf("scene \"%s\" (%s)\n", scene.name.c_str(), scene_path.c_str());
-    for (const std::string& line : icd::runner::describe_plan(scene))
-      std::printf("  %s\n", line.c_str());
-    icd::runner::RunOptions opt;
-    opt.out_dir = out;
-    opt.cache_dir = cache_dir;
-    opt.tool_dir = icd::runner::program_dir();
-    opt.frames = frames;
-    opt.scene_file = scene_path;
-    icd::runner::run_scene(scene, opt);
-    std::printf("results: %s (frames.csv, scene.json, version.txt; vtu/run.pvd for ParaView)\n",
-                std::filesystem::absolute(out).c_str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "icd-main: %s\n", e.what());
-    return 1;
-  }
+  const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
+  std::printf("scene \"%s\" (%s)\n", scene.name.c_str(), scene_path.c_str());
+  for (const std::string& line : icd::runner::describe_plan(scene))
+    std::printf("  %s\n", line.c_str());
+  icd::runner::RunOptions opt;
+  opt.out_dir = out;
+  opt.cache_dir = cache_dir;
+  opt.tool_dir = icd::runner::program_dir();
+  opt.frames = frames;
+  opt.scene_file = scene_path;
+  icd::runner::run_scene(scene, opt);
+  std::printf("results: %s (frames.csv, scene.json, version.txt; vtu/run.pvd for ParaView)\n",
+              std::filesystem::absolute(out).c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("icd-main", run, argc, argv);
 }

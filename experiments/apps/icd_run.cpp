@@ -6,10 +6,13 @@
 #include <vector>
 
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/runner/locations.hpp"
 #include "experiments/runner/run.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   std::filesystem::path scene_path, out, cache_dir = icd::runner::default_cache_dir();
   int frames = -1, threads = -1;
   double target_fps = -1;
@@ -40,39 +43,40 @@ int main(int argc, char** argv) {
   if (const auto status = cli.parse(argc, argv)) return *status;
   // --threads is the scene field `threads`, applied after every --set.
   if (threads >= 0) overrides.push_back("threads=" + std::to_string(threads));
-  try {
-    const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
-    std::printf("scene \"%s\": %zu objects, %d frames at %g Hz\n", scene.name.c_str(),
-                scene.objects.size(), frames >= 0 ? frames : scene.frames, scene.world.frame_rate);
-    for (const std::string& line : icd::runner::describe_plan(scene))
-      std::printf("  %s\n", line.c_str());
-    const double fps = target_fps >= 0 ? target_fps : scene.world.target_fps;
-    if (fps > 0)
-      std::printf(
-          "  real-time mode: %g frames per second; collision detection gets what is left of each "
-          "frame\n",
-          fps);
-    if (dry) {
-      icd::runner::check_scene_inputs(scene);
-      std::printf("  input files: all present and within their size limits\n");
-      return 0;
-    }
-    icd::runner::RunOptions opt;
-    // The scene's name is a label: results/<name as one file name>, never a path.
-    opt.out_dir = out.empty()
-                      ? std::filesystem::path("results") / icd::runner::file_name_from(scene.name)
-                      : std::filesystem::path(out);
-    opt.cache_dir = cache_dir;
-    opt.tool_dir = icd::runner::program_dir();
-    opt.frames = frames;
-    opt.scene_file = scene_path;
-    opt.target_fps = target_fps;
-    opt.progress = !quiet;
-    icd::runner::run_scene(scene, opt);
-    std::printf("results: %s\n", std::filesystem::absolute(opt.out_dir).c_str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "icd-run: %s\n", e.what());
-    return 1;
+  const icd::runner::Scene scene = icd::runner::load_scene(scene_path, overrides);
+  std::printf("scene \"%s\": %zu objects, %d frames at %g Hz\n", scene.name.c_str(),
+              scene.objects.size(), frames >= 0 ? frames : scene.frames, scene.world.frame_rate);
+  for (const std::string& line : icd::runner::describe_plan(scene))
+    std::printf("  %s\n", line.c_str());
+  const double fps = target_fps >= 0 ? target_fps : scene.world.target_fps;
+  if (fps > 0)
+    std::printf(
+        "  real-time mode: %g frames per second; collision detection gets what is left of each "
+        "frame\n",
+        fps);
+  if (dry) {
+    icd::runner::check_scene_inputs(scene);
+    std::printf("  input files: all present and within their size limits\n");
+    return 0;
   }
+  icd::runner::RunOptions opt;
+  // The scene's name is a label: results/<name as one file name>, never a path.
+  opt.out_dir = out.empty()
+                    ? std::filesystem::path("results") / icd::runner::file_name_from(scene.name)
+                    : std::filesystem::path(out);
+  opt.cache_dir = cache_dir;
+  opt.tool_dir = icd::runner::program_dir();
+  opt.frames = frames;
+  opt.scene_file = scene_path;
+  opt.target_fps = target_fps;
+  opt.progress = !quiet;
+  icd::runner::run_scene(scene, opt);
+  std::printf("results: %s\n", std::filesystem::absolute(opt.out_dir).c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("icd-run", run, argc, argv);
 }

@@ -6,6 +6,7 @@
 #include <CGAL/Surface_mesh.h>
 
 #include <cassert>
+#include <cstddef>
 #include <vector>
 
 #include <icd/mesh/core/types.hpp>
@@ -15,6 +16,13 @@ namespace icd::mesh::detail {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using CgalMesh = CGAL::Surface_mesh<Point>;
+
+/// Closes the hole bounded by the border halfedge `h` with a minimal-area
+/// triangulation of its loop, adding no vertex (PMP::triangulate_hole);
+/// returns the number of faces added. Defined in repair.cpp, so that CGAL's
+/// hole filling on this mesh type is compiled once in the library (the
+/// sphere code's close_holes uses it too).
+std::size_t fill_hole(CgalMesh& mesh, CgalMesh::Halfedge_index h);
 
 /// Builds a Surface_mesh from a valid, manifold, consistently oriented
 /// triangle mesh (vertex i of V becomes vertex i). Returns false when a face

@@ -96,6 +96,12 @@ class Wrappable : public InputError {
 
 }  // namespace
 
+std::size_t detail::fill_hole(CgalMesh& mesh, CgalMesh::Halfedge_index h) {
+  std::vector<CgalMesh::Face_index> patch;
+  PMP::triangulate_hole(mesh, h, std::back_inserter(patch));
+  return patch.size();
+}
+
 RepairOptions::Wrap parse_wrap(const std::string& name, const std::string& field) {
   for (auto w : {RepairOptions::Wrap::never, RepairOptions::Wrap::fallback,
                  RepairOptions::Wrap::always})
@@ -356,15 +362,18 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
     for (const Loop& l : boundary_loops(mesh)) {
       if (l.edges > options.max_hole_edges || l.diameter > options.max_hole_diameter * diag) continue;
       rep.largest_hole_filled = std::max(rep.largest_hole_filled, l.diameter / diag);
-      std::vector<CgalMesh::Face_index> patch;
-      std::vector<CgalMesh::Vertex_index> new_vertices;
-      if (options.fair_holes)
+      std::size_t added = 0;
+      if (options.fair_holes) {
+        std::vector<CgalMesh::Face_index> patch;
+        std::vector<CgalMesh::Vertex_index> new_vertices;
         PMP::triangulate_refine_and_fair_hole(mesh, l.h, std::back_inserter(patch),
                                               std::back_inserter(new_vertices));
-      else
-        PMP::triangulate_hole(mesh, l.h, std::back_inserter(patch));
+        added = patch.size();
+      } else {
+        added = detail::fill_hole(mesh, l.h);
+      }
       ++rep.holes_filled;
-      rep.hole_faces_added += static_cast<int>(patch.size());
+      rep.hole_faces_added += static_cast<int>(added);
     }
     {
       const std::vector<Loop> left = boundary_loops(mesh);

@@ -6,20 +6,19 @@
 #include <utility>
 #include <vector>
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Side_of_triangle_mesh.h>
-#include <CGAL/Surface_mesh.h>
 
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/pipeline/cgal_convert.hpp>
 #include <icd/mesh/spheres/triangle_bvh.hpp>
 
 namespace icd::mesh {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using CgalMesh = CGAL::Surface_mesh<Point>;
+// The pipeline's CGAL types: detail::fill_hole (repair.cpp) is compiled for them.
+using detail::CgalMesh;
+using detail::Kernel;
+using detail::Point;
 using Inside = CGAL::Side_of_triangle_mesh<CgalMesh, Kernel>;
 
 void check_indices(const SurfaceMesh& mesh) {
@@ -83,8 +82,7 @@ SurfaceMesh close_holes(const SurfaceMesh& mesh) {
   for (auto h : borders) {
     if (done[h.idx()] || !cm.is_border(h)) continue;
     for (auto g : CGAL::halfedges_around_face(h, cm)) done[g.idx()] = 1;
-    std::vector<CgalMesh::Face_index> patch;
-    CGAL::Polygon_mesh_processing::triangulate_hole(cm, h, std::back_inserter(patch));
+    detail::fill_hole(cm, h);
   }
   SurfaceMesh out;
   out.V = mesh.V;

@@ -11,8 +11,9 @@
 namespace icd::mesh {
 
 /// Returns a copy of `mesh` with every boundary loop (hole) closed by a
-/// minimal-area triangulation (CGAL PMP triangulate_hole), so that inside
-/// tests are well defined. Returns the input unchanged when it is closed.
+/// minimal-area triangulation (CGAL PMP triangulate_hole, compiled once in
+/// the pipeline's repair.cpp as detail::fill_hole), so that inside tests are
+/// well defined. Returns the input unchanged when it is closed.
 /// Throws InputError when the mesh is empty, has out-of-range indices or
 /// is not a valid polygon mesh. The only place where holes are closed in
 /// mesh/spheres (used by both the builder and the evaluation).

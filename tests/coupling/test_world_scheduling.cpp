@@ -45,6 +45,14 @@ WorldSettings deterministic() {
   return s;
 }
 
+/// Balls "left" and "right" at x = -x0 and x0, heading for each other at `speed`.
+std::vector<WorldObject> head_on_pair(double x0, double speed) {
+  std::vector<WorldObject> v;
+  v.push_back(ball("left", {-x0, 0, 0}, {speed, 0, 0}));
+  v.push_back(ball("right", {x0, 0, 0}, {-speed, 0, 0}));
+  return v;
+}
+
 const RuntimeObject& named(const World& w, const std::string& name) {
   for (const RuntimeObject& o : w.objects())
     if (o.setup.name == name) return o;
@@ -93,13 +101,7 @@ TEST(WorldScheduling, FarObjectDoesNotPayForTheCyclesOfAContact) {
 // used the lightest node of all objects, and the light far object cut the
 // pair's frames into more cycles and softened its penalty.)
 TEST(WorldScheduling, ALightObjectFarAwayDoesNotChangeAContact) {
-  const auto pair = [] {
-    std::vector<WorldObject> v;
-    v.push_back(ball("left", {-0.12, 0, 0}, {0.6, 0, 0}));
-    v.push_back(ball("right", {0.12, 0, 0}, {-0.6, 0, 0}));
-    return v;
-  };
-  std::vector<WorldObject> with_light = pair();
+  std::vector<WorldObject> with_light = head_on_pair(0.12, 0.6);
   PrimitiveSpec fine;
   fine.radius = 0.05;
   fine.subdivisions = 2;
@@ -110,7 +112,7 @@ TEST(WorldScheduling, ALightObjectFarAwayDoesNotChangeAContact) {
   light.asset = make_primitive_asset(fine, 3);
   place_asset(light.asset, {0, {0, 3, 0}, {0, 0, 0}});
   with_light.push_back(std::move(light));
-  World alone(pair(), deterministic());
+  World alone(head_on_pair(0.12, 0.6), deterministic());
   World crowd(std::move(with_light), deterministic());
   // The light object's nodes are lighter than the pair's (else this tests nothing).
   ASSERT_LT(crowd.objects()[2].node_mass.minCoeff(), 0.5 * alone.objects()[0].node_mass.minCoeff());
@@ -283,12 +285,9 @@ struct ContactRun {
 // Two balls head-on at 0.2 m/s, 1 cm apart (a slow contact, see
 // World::contact_cycles): the frames in contact, with the cycle rule given.
 ContactRun head_on_contact(bool cycles_at_fem_step) {
-  std::vector<WorldObject> v;
-  v.push_back(ball("left", {-0.105, 0, 0}, {0.2, 0, 0}));
-  v.push_back(ball("right", {0.105, 0, 0}, {-0.2, 0, 0}));
   WorldSettings s = deterministic();
   s.collision.cycles_at_fem_step = cycles_at_fem_step;
-  World w(std::move(v), s);
+  World w(head_on_pair(0.105, 0.2), s);
   ContactRun r;
   r.lightest = std::min(w.objects()[0].node_mass.minCoeff(), w.objects()[1].node_mass.minCoeff());
   std::vector<FrameMetrics> contact;
@@ -432,12 +431,9 @@ TEST(WorldScheduling, PredictedFirstContactSkipsTheRolledBackTrial) {
     double depth = 0, vx = 0;
   };
   const auto run = [](bool predict) {
-    std::vector<WorldObject> v;
-    v.push_back(ball("left", {-0.15, 0, 0}, {0.6, 0, 0}));
-    v.push_back(ball("right", {0.15, 0, 0}, {-0.6, 0, 0}));
     WorldSettings s = deterministic();
     s.collision.predict_contact = predict;
-    World w(std::move(v), s);
+    World w(head_on_pair(0.15, 0.6), s);
     Run r;
     bool entered = false;
     for (int f = 0; f < 40; ++f) {

@@ -32,13 +32,14 @@
 #include <vector>
 
 #include <icd/collision/aabb_tree.hpp>
-#include <icd/coupling/contact_response.hpp>
-#include "experiments/common/cli.hpp"
-#include "experiments/studies/paper/contact_moment.hpp"
 #include <icd/config.hpp>
-#include <icd/mesh/io/atomic_write.hpp>
+#include <icd/coupling/contact_response.hpp>
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/core/triangle_geometry.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/studies/paper/contact_moment.hpp"
 
 namespace fs = std::filesystem;
 using namespace icd;
@@ -192,9 +193,7 @@ class Evaluator {
   double m_volume_full = 0;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   fs::path out = "results/contact_error";
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
   std::string budgets_text = "1e-6,3e-6,1e-5,3e-5,1e-4,3e-4,1e-3,3e-3,1e-2";
@@ -213,105 +212,104 @@ int main(int argc, char** argv) {
       .integer("--max-frames", max_frames, "N", "frames searched for contact (default 200)", 1);
   cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
-  try {
-    const std::vector<double> budgets = experiments::parse_list(budgets_text, "--budgets");
-    const std::vector<double> test_budgets = experiments::parse_list(tests_text, "--test-budgets");
-    Scene scene = load_scene(scene_path, overrides);
-    scene.output = OutputSpec{};
-    scene.world.target_fps = 0;
-    scene.world.collision.query.budget_tests = -1;
-    scene.world.collision.query.budget_seconds = std::numeric_limits<double>::infinity();
-    World world = make_world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
-                fs::canonical("/proc/self/exe").parent_path());
-    if (world.plan().pairs.empty()) throw InputError(scene_path.string() + ": no collision pair");
-    const experiments::ContactMoment cm = experiments::run_to_contact(world, max_frames, after);
-    if (cm.contact_frame < 0)
-      throw InputError(scene_path.string() + ": no contact within --max-frames");
-    const auto [ia, ib] = world.plan().pairs[0];
-    const RuntimeObject& oa = world.objects()[ia];
-    const RuntimeObject& ob = world.objects()[ib];
-    const MatX3d da = experiments::dense_positions(oa), db = experiments::dense_positions(ob);
-    const collision::AabbTree ta(da, oa.asset.dense.F), tb(db, ob.asset.dense.F);
-    const auto exact =
-        collision::intersecting_triangle_pairs(ta, da, oa.asset.dense.F, tb, db, ob.asset.dense.F);
-    std::vector<Tri> tri_a, tri_b;
-    for (const auto& [f, g] : exact) {
-      tri_a.push_back(make_tri(da, oa.asset.dense.F, f));
-      tri_b.push_back(make_tri(db, ob.asset.dense.F, g));
-    }
-    const Evaluator ev(oa.asset.spheres, ob.asset.spheres, scene.world.collision.contact,
-                       static_cast<int>(oa.positions.rows()), static_cast<int>(ob.positions.rows()),
-                       tri_a, tri_b);
-    const Metrics full = ev.evaluate(ev.full());
-    std::printf(
-        "%s: frame %d (contact at %d): %zu exact triangle pairs, full traversal %zu leaf pairs, "
-        "%lld tests, |F_full| = %.4g N, exact recall of the full traversal %.3f\n",
-        scene.name.c_str(), cm.last_frame, cm.contact_frame, exact.size(),
-        ev.full().colliding.size(), static_cast<long long>(ev.full().tests), ev.force_full().norm(),
-        full.recall_exact);
-
-    std::vector<Mode> modes;
-    const CollisionSpec& cs = scene.world.collision;
-    auto base = [&] {
-      CollisionRequest r;
-      r.clock_check_interval = cs.query.clock_check_interval;
-      return r;
-    };
-    modes.push_back({"fifo", base()});
-    modes.push_back({"fifo_paper_literal", CollisionRequest::paper_reference(1)});
-    CollisionRequest pr = base();
-    pr.mode = collision::TraversalMode::Priority;
-    pr.max_list_size = cs.query.max_list_size;
-    modes.push_back({"priority", pr});
-    pr.max_list_size = 256;
-    modes.push_back({"priority_cap256", pr});
-    CollisionRequest df = base();
-    df.mode = collision::TraversalMode::DepthFirst;
-    modes.push_back({"depth_first", df});
-
-    std::ostringstream csv;
-    csv << "scene,frame,mode,budget_kind,budget,seconds,response_seconds,tests,reported_pairs,"
-           "colliding_pairs,completed_level,interrupted,force_rel_error,force_angle_deg,recall_"
-           "full,"
-           "recall_exact,false_positive,volume_ratio,exact_pairs,full_leaf_pairs,full_seconds\n";
-    for (const Mode& mode : modes)
-      for (int kind = 0; kind < 2; ++kind)
-        for (double budget : kind == 0 ? budgets : test_budgets) {
-          CollisionRequest req = mode.request;
-          req.budget_seconds = kind == 0 ? budget : std::numeric_limits<double>::infinity();
-          req.budget_tests = kind == 0 ? -1 : static_cast<int64_t>(budget);
-          // Time every repetition; evaluate the median-time one (evaluation is costly).
-          std::vector<CollisionResult> runs(reps);
-          for (CollisionResult& run : runs) {
-            // The first call sizes the result's vectors, so the timed one does not reallocate.
-            collision::collide(oa.asset.spheres, ob.asset.spheres, req, run);
-            collision::collide(oa.asset.spheres, ob.asset.spheres, req, run);
-          }
-          std::sort(runs.begin(), runs.end(),
-                    [](const CollisionResult& x, const CollisionResult& y) {
-                      return x.seconds < y.seconds;
-                    });
-          const Metrics m = ev.evaluate(runs[runs.size() / 2]);
-          csv << scene.name << ',' << cm.last_frame << ',' << mode.name << ','
-              << (kind == 0 ? "seconds" : "tests") << ',' << budget << ',' << m.seconds << ','
-              << m.response_seconds << ',' << m.tests << ',' << m.reported << ',' << m.colliding
-              << ',' << m.completed_level << ',' << m.interrupted << ',' << m.force_rel_error << ','
-              << m.force_angle_deg << ',' << m.recall_full << ',' << m.recall_exact << ','
-              << m.false_positive << ',' << m.volume_ratio << ',' << exact.size() << ','
-              << ev.full().colliding.size() << ',' << full.seconds << '\n';
-          std::printf(
-              "%-18s %-7s %-8g: %9.2e s, %7lld tests, force err %.3f, recall full %.3f exact %.3f, "
-              "false pos %.3f\n",
-              mode.name.c_str(), kind == 0 ? "seconds" : "tests", budget, m.seconds,
-              static_cast<long long>(m.tests), m.force_rel_error, m.recall_full, m.recall_exact,
-              m.false_positive);
-        }
-    fs::create_directories(out);
-    write_file_atomically(out / "contact_error.csv", csv.str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "contact_error: %s\n", e.what());
-    return 1;
+  const std::vector<double> budgets = experiments::parse_list(budgets_text, "--budgets");
+  const std::vector<double> test_budgets = experiments::parse_list(tests_text, "--test-budgets");
+  Scene scene = load_scene(scene_path, overrides);
+  scene.output = OutputSpec{};
+  scene.world.target_fps = 0;
+  scene.world.collision.query.budget_tests = -1;
+  scene.world.collision.query.budget_seconds = std::numeric_limits<double>::infinity();
+  World world = make_world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
+                           fs::canonical("/proc/self/exe").parent_path());
+  if (world.plan().pairs.empty()) throw InputError(scene_path.string() + ": no collision pair");
+  const experiments::ContactMoment cm = experiments::run_to_contact(world, max_frames, after);
+  if (cm.contact_frame < 0)
+    throw InputError(scene_path.string() + ": no contact within --max-frames");
+  const auto [ia, ib] = world.plan().pairs[0];
+  const RuntimeObject& oa = world.objects()[ia];
+  const RuntimeObject& ob = world.objects()[ib];
+  const MatX3d da = experiments::dense_positions(oa), db = experiments::dense_positions(ob);
+  const collision::AabbTree ta(da, oa.asset.dense.F), tb(db, ob.asset.dense.F);
+  const auto exact =
+      collision::intersecting_triangle_pairs(ta, da, oa.asset.dense.F, tb, db, ob.asset.dense.F);
+  std::vector<Tri> tri_a, tri_b;
+  for (const auto& [f, g] : exact) {
+    tri_a.push_back(make_tri(da, oa.asset.dense.F, f));
+    tri_b.push_back(make_tri(db, ob.asset.dense.F, g));
   }
+  const Evaluator ev(oa.asset.spheres, ob.asset.spheres, scene.world.collision.contact,
+                     static_cast<int>(oa.positions.rows()), static_cast<int>(ob.positions.rows()),
+                     tri_a, tri_b);
+  const Metrics full = ev.evaluate(ev.full());
+  std::printf(
+      "%s: frame %d (contact at %d): %zu exact triangle pairs, full traversal %zu leaf pairs, "
+      "%lld tests, |F_full| = %.4g N, exact recall of the full traversal %.3f\n",
+      scene.name.c_str(), cm.last_frame, cm.contact_frame, exact.size(), ev.full().colliding.size(),
+      static_cast<long long>(ev.full().tests), ev.force_full().norm(), full.recall_exact);
+
+  std::vector<Mode> modes;
+  const CollisionSpec& cs = scene.world.collision;
+  auto base = [&] {
+    CollisionRequest r;
+    r.clock_check_interval = cs.query.clock_check_interval;
+    return r;
+  };
+  modes.push_back({"fifo", base()});
+  modes.push_back({"fifo_paper_literal", CollisionRequest::paper_reference(1)});
+  CollisionRequest pr = base();
+  pr.mode = collision::TraversalMode::Priority;
+  pr.max_list_size = cs.query.max_list_size;
+  modes.push_back({"priority", pr});
+  pr.max_list_size = 256;
+  modes.push_back({"priority_cap256", pr});
+  CollisionRequest df = base();
+  df.mode = collision::TraversalMode::DepthFirst;
+  modes.push_back({"depth_first", df});
+
+  std::ostringstream csv;
+  csv << "scene,frame,mode,budget_kind,budget,seconds,response_seconds,tests,reported_pairs,"
+         "colliding_pairs,completed_level,interrupted,force_rel_error,force_angle_deg,recall_"
+         "full,"
+         "recall_exact,false_positive,volume_ratio,exact_pairs,full_leaf_pairs,full_seconds\n";
+  for (const Mode& mode : modes)
+    for (int kind = 0; kind < 2; ++kind)
+      for (double budget : kind == 0 ? budgets : test_budgets) {
+        CollisionRequest req = mode.request;
+        req.budget_seconds = kind == 0 ? budget : std::numeric_limits<double>::infinity();
+        req.budget_tests = kind == 0 ? -1 : static_cast<int64_t>(budget);
+        // Time every repetition; evaluate the median-time one (evaluation is costly).
+        std::vector<CollisionResult> runs(reps);
+        for (CollisionResult& run : runs) {
+          // The first call sizes the result's vectors, so the timed one does not reallocate.
+          collision::collide(oa.asset.spheres, ob.asset.spheres, req, run);
+          collision::collide(oa.asset.spheres, ob.asset.spheres, req, run);
+        }
+        std::sort(runs.begin(), runs.end(), [](const CollisionResult& x, const CollisionResult& y) {
+          return x.seconds < y.seconds;
+        });
+        const Metrics m = ev.evaluate(runs[runs.size() / 2]);
+        csv << scene.name << ',' << cm.last_frame << ',' << mode.name << ','
+            << (kind == 0 ? "seconds" : "tests") << ',' << budget << ',' << m.seconds << ','
+            << m.response_seconds << ',' << m.tests << ',' << m.reported << ',' << m.colliding
+            << ',' << m.completed_level << ',' << m.interrupted << ',' << m.force_rel_error << ','
+            << m.force_angle_deg << ',' << m.recall_full << ',' << m.recall_exact << ','
+            << m.false_positive << ',' << m.volume_ratio << ',' << exact.size() << ','
+            << ev.full().colliding.size() << ',' << full.seconds << '\n';
+        std::printf(
+            "%-18s %-7s %-8g: %9.2e s, %7lld tests, force err %.3f, recall full %.3f exact %.3f, "
+            "false pos %.3f\n",
+            mode.name.c_str(), kind == 0 ? "seconds" : "tests", budget, m.seconds,
+            static_cast<long long>(m.tests), m.force_rel_error, m.recall_full, m.recall_exact,
+            m.false_positive);
+      }
+  fs::create_directories(out);
+  write_file_atomically(out / "contact_error.csv", csv.str());
   std::printf("results: %s\n", fs::absolute(out / "contact_error.csv").c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("contact_error", run, argc, argv);
 }

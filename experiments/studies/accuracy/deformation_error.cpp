@@ -20,13 +20,14 @@
 #include <string>
 #include <vector>
 
+#include <icd/config.hpp>
 #include <icd/coupling/barycentric_embedding.hpp>
 #include <icd/coupling/rigid_links.hpp>
-#include "experiments/common/cli.hpp"
-#include "experiments/studies/paper/contact_moment.hpp"
-#include <icd/config.hpp>
-#include <icd/mesh/io/atomic_write.hpp>
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/studies/paper/contact_moment.hpp"
 
 namespace fs = std::filesystem;
 using namespace icd;
@@ -117,9 +118,7 @@ Run run_resolution(Scene scene, int cells, int frames) {
   return run;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   fs::path out = "results/deformation_error";
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/bunny_dragon.json";
   fs::path res_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
@@ -139,54 +138,55 @@ int main(int argc, char** argv) {
       .integer("--fine", fine, "N", "reference resolution (cells per side)", 1);
   cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
-  try {
-    const std::vector<double> cells = experiments::parse_list(cells_text, "--cells");
-    auto prepare = [&overrides](const fs::path& p) {
-      Scene s = load_scene(p, overrides);
-      s.output = OutputSpec{};
-      s.world.target_fps = 0;
-      return s;
-    };
-    std::ostringstream links;
-    links << "scene,frame,object,dense_vertices,coarse_nodes,outside_vertices,links_seconds,"
-             "barycentric_seconds,rms_error,max_error,rms_error_pct_bbox,max_error_pct_bbox,active_"
-             "pairs\n";
-    links_vs_barycentric(prepare(scene_path), frames, reps, links);
+  const std::vector<double> cells = experiments::parse_list(cells_text, "--cells");
+  auto prepare = [&overrides](const fs::path& p) {
+    Scene s = load_scene(p, overrides);
+    s.output = OutputSpec{};
+    s.world.target_fps = 0;
+    return s;
+  };
+  std::ostringstream links;
+  links << "scene,frame,object,dense_vertices,coarse_nodes,outside_vertices,links_seconds,"
+           "barycentric_seconds,rms_error,max_error,rms_error_pct_bbox,max_error_pct_bbox,active_"
+           "pairs\n";
+  links_vs_barycentric(prepare(scene_path), frames, reps, links);
 
-    const Scene res_scene = prepare(res_path);
-    const Run ref = run_resolution(res_scene, fine, frames);
-    const double diag = bbox_diagonal(ref.dense[0]);
-    std::ostringstream res;
-    res << "scene,cells,coarse_nodes,coarse_tets,frame_seconds,rms_error,max_error,rms_error_pct_"
-           "bbox,"
-           "max_error_pct_bbox,fine_cells,fine_coarse_tets,fine_frame_seconds\n";
-    for (double c : cells) {
-      const Run run = run_resolution(res_scene, static_cast<int>(c), frames);
-      double rms = 0, mx = 0;
-      for (int f = 0; f < frames; ++f) {
-        const Error e = compare(run.dense[f], ref.dense[f]);
-        rms += e.rms * e.rms / frames;
-        mx = std::max(mx, e.max);
-      }
-      rms = std::sqrt(rms);
-      res << res_scene.name << ',' << c << ',' << run.nodes << ',' << run.tets << ','
-          << run.frame_seconds << ',' << rms << ',' << mx << ',' << 100 * rms / diag << ','
-          << 100 * mx / diag << ',' << fine << ',' << ref.tets << ',' << ref.frame_seconds << '\n';
-      std::printf(
-          "cells %2g (%5d tets): %.3g ms/frame, RMS error %.3g%% of bbox, max %.3g%% (fine %d: %d "
-          "tets, "
-          "%.3g ms/frame)\n",
-          c, run.tets, 1e3 * run.frame_seconds, 100 * rms / diag, 100 * mx / diag, fine, ref.tets,
-          1e3 * ref.frame_seconds);
-      std::fflush(stdout);
+  const Scene res_scene = prepare(res_path);
+  const Run ref = run_resolution(res_scene, fine, frames);
+  const double diag = bbox_diagonal(ref.dense[0]);
+  std::ostringstream res;
+  res << "scene,cells,coarse_nodes,coarse_tets,frame_seconds,rms_error,max_error,rms_error_pct_"
+         "bbox,"
+         "max_error_pct_bbox,fine_cells,fine_coarse_tets,fine_frame_seconds\n";
+  for (double c : cells) {
+    const Run run = run_resolution(res_scene, static_cast<int>(c), frames);
+    double rms = 0, mx = 0;
+    for (int f = 0; f < frames; ++f) {
+      const Error e = compare(run.dense[f], ref.dense[f]);
+      rms += e.rms * e.rms / frames;
+      mx = std::max(mx, e.max);
     }
-    fs::create_directories(out);
-    write_file_atomically(out / "links.csv", links.str());
-    write_file_atomically(out / "resolution.csv", res.str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "deformation_error: %s\n", e.what());
-    return 1;
+    rms = std::sqrt(rms);
+    res << res_scene.name << ',' << c << ',' << run.nodes << ',' << run.tets << ','
+        << run.frame_seconds << ',' << rms << ',' << mx << ',' << 100 * rms / diag << ','
+        << 100 * mx / diag << ',' << fine << ',' << ref.tets << ',' << ref.frame_seconds << '\n';
+    std::printf(
+        "cells %2g (%5d tets): %.3g ms/frame, RMS error %.3g%% of bbox, max %.3g%% (fine %d: %d "
+        "tets, "
+        "%.3g ms/frame)\n",
+        c, run.tets, 1e3 * run.frame_seconds, 100 * rms / diag, 100 * mx / diag, fine, ref.tets,
+        1e3 * ref.frame_seconds);
+    std::fflush(stdout);
   }
+  fs::create_directories(out);
+  write_file_atomically(out / "links.csv", links.str());
+  write_file_atomically(out / "resolution.csv", res.str());
   std::printf("results: %s\n", fs::absolute(out).c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("deformation_error", run, argc, argv);
 }

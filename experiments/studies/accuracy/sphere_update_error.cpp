@@ -24,11 +24,12 @@
 #include <icd/collision/coverage.hpp>
 #include <icd/collision/octree_tree.hpp>
 #include <icd/collision/sphere_update.hpp>
-#include "experiments/common/cli.hpp"
-#include "experiments/studies/paper/contact_moment.hpp"
 #include <icd/config.hpp>
-#include <icd/mesh/io/atomic_write.hpp>
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/studies/paper/contact_moment.hpp"
 
 namespace fs = std::filesystem;
 using namespace icd;
@@ -53,9 +54,7 @@ double leaf_volume(const collision::SphereTree& t) {
   return v;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   fs::path out = "results/sphere_update";
   fs::path scene_path = fs::path(ICD_SOURCE_DIR) / "experiments/scenes/two_spheres.json";
   int frames = 60, every = 1, reps = 5;
@@ -74,65 +73,66 @@ int main(int argc, char** argv) {
   std::ostringstream csv;
   csv << "scene,frame,object,method,seconds,uncovered_fraction,max_gap,tightness,leaf_spheres,"
          "max_displacement\n";
-  try {
-    Scene scene = load_scene(scene_path, overrides);
-    scene.output = OutputSpec{};
-    scene.world.target_fps = 0;
-    World world = make_world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
-                fs::canonical("/proc/self/exe").parent_path());
-    for (int f = 0; f < frames; ++f) {
-      world.step();
-      if (f % every) continue;
-      for (const RuntimeObject& o : world.objects()) {
-        if (!o.sim) continue;
-        const MatX3d dense = experiments::dense_positions(o);
-        const MatX3i& F = o.asset.dense.F;
-        const double volume = enclosed_volume(dense, F);
-        // Displacement relative to the rigid motion is what the update must follow;
-        // report the largest node displacement from rest minus the mean (deformation + rotation).
-        const MatX3d u = o.positions - o.rest;
-        const double max_disp = (u.rowwise() - u.colwise().mean()).rowwise().norm().maxCoeff();
-        auto row = [&](const char* method, double secs, const collision::SphereTree& t) {
-          const collision::CoverageReport cov = collision::measure_coverage(t, dense, -1);
-          int leaves = 0;
-          for (int i = 0; i < t.num_nodes(); ++i) leaves += t.is_leaf(i);
-          csv << scene.name << ',' << f << ',' << o.setup.name << ',' << method << ',' << secs << ','
-              << cov.uncovered_fraction << ',' << cov.max_gap << ',' << leaf_volume(t) / volume
-              << ',' << leaves << ',' << max_disp << '\n';
-        };
-        for (const auto& [name, mode] :
-             {std::pair{"update_paper_ratio", collision::SphereUpdateMode::PaperRatio},
-              std::pair{"update_displacement_bound",
-                        collision::SphereUpdateMode::DisplacementBound}}) {
-          collision::SphereTree t = o.asset.spheres;
-          collision::SphereUpdateOptions opt;
-          opt.mode = mode;
-          std::vector<double> ts;
-          for (int r = 0; r < reps; ++r) {
-            const auto t0 = std::chrono::steady_clock::now();
-            collision::update_spheres(t, o.rest, o.positions, opt);
-            ts.push_back(seconds_since(t0));
-          }
-          row(name, median(ts), t);
-        }
-        collision::OctreeTreeOptions oo;
-        oo.levels = o.asset.spheres.num_levels();
-        collision::SphereTree rebuilt;
+  Scene scene = load_scene(scene_path, overrides);
+  scene.output = OutputSpec{};
+  scene.world.target_fps = 0;
+  World world = make_world(scene, fs::path(ICD_SOURCE_DIR) / "assets",
+                           fs::canonical("/proc/self/exe").parent_path());
+  for (int f = 0; f < frames; ++f) {
+    world.step();
+    if (f % every) continue;
+    for (const RuntimeObject& o : world.objects()) {
+      if (!o.sim) continue;
+      const MatX3d dense = experiments::dense_positions(o);
+      const MatX3i& F = o.asset.dense.F;
+      const double volume = enclosed_volume(dense, F);
+      // Displacement relative to the rigid motion is what the update must follow;
+      // report the largest node displacement from rest minus the mean (deformation + rotation).
+      const MatX3d u = o.positions - o.rest;
+      const double max_disp = (u.rowwise() - u.colwise().mean()).rowwise().norm().maxCoeff();
+      auto row = [&](const char* method, double secs, const collision::SphereTree& t) {
+        const collision::CoverageReport cov = collision::measure_coverage(t, dense, -1);
+        int leaves = 0;
+        for (int i = 0; i < t.num_nodes(); ++i) leaves += t.is_leaf(i);
+        csv << scene.name << ',' << f << ',' << o.setup.name << ',' << method << ',' << secs << ','
+            << cov.uncovered_fraction << ',' << cov.max_gap << ',' << leaf_volume(t) / volume << ','
+            << leaves << ',' << max_disp << '\n';
+      };
+      for (const auto& [name, mode] :
+           {std::pair{"update_paper_ratio", collision::SphereUpdateMode::PaperRatio},
+            std::pair{"update_displacement_bound",
+                      collision::SphereUpdateMode::DisplacementBound}}) {
+        collision::SphereTree t = o.asset.spheres;
+        collision::SphereUpdateOptions opt;
+        opt.mode = mode;
         std::vector<double> ts;
-        for (int r = 0; r < std::min(reps, 3); ++r) {
+        for (int r = 0; r < reps; ++r) {
           const auto t0 = std::chrono::steady_clock::now();
-          rebuilt = collision::build_octree_tree(dense, F, oo);
+          collision::update_spheres(t, o.rest, o.positions, opt);
           ts.push_back(seconds_since(t0));
         }
-        row("rebuild_octree", median(ts), rebuilt);
+        row(name, median(ts), t);
       }
+      collision::OctreeTreeOptions oo;
+      oo.levels = o.asset.spheres.num_levels();
+      collision::SphereTree rebuilt;
+      std::vector<double> ts;
+      for (int r = 0; r < std::min(reps, 3); ++r) {
+        const auto t0 = std::chrono::steady_clock::now();
+        rebuilt = collision::build_octree_tree(dense, F, oo);
+        ts.push_back(seconds_since(t0));
+      }
+      row("rebuild_octree", median(ts), rebuilt);
     }
-    fs::create_directories(out);
-    write_file_atomically(out / "sphere_update.csv", csv.str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "sphere_update_error: %s\n", e.what());
-    return 1;
   }
+  fs::create_directories(out);
+  write_file_atomically(out / "sphere_update.csv", csv.str());
   std::printf("results: %s\n", fs::absolute(out / "sphere_update.csv").c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("sphere_update_error", run, argc, argv);
 }

@@ -19,8 +19,9 @@
 #include <icd/collision/coverage.hpp>
 #include <icd/collision/sphere_update.hpp>
 #include <icd/collision/traversal.hpp>
-#include "experiments/studies/collision/workloads.hpp"
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/studies/collision/workloads.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -186,22 +187,21 @@ void coherence_experiment(int levels) {
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   int levels = 6;
   icd::experiments::Cli cli("icd_collision_accuracy");
   cli.integer("--levels", levels, "L", "sphere-tree levels (default 6)", 1);
   if (const auto status = cli.parse(argc, argv)) return *status;
-  try {
-    coverage_experiment("ChineseDragon-10kv.off", 4);
-    coverage_experiment("ChineseDragon-10kv.off", 6);
-    coverage_experiment("bunny00.off", 6);
-    modes_experiment(levels);
-    coherence_experiment(levels);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  coverage_experiment("ChineseDragon-10kv.off", 4);
+  coverage_experiment("ChineseDragon-10kv.off", 6);
+  coverage_experiment("bunny00.off", 6);
+  modes_experiment(levels);
+  coherence_experiment(levels);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("icd_collision_accuracy", run, argc, argv);
 }

@@ -43,10 +43,11 @@
 #include <fcl/fcl.h>
 
 #include <icd/collision/sphere_update.hpp>
+#include <icd/collision/traversal.hpp>
 #include <icd/coupling/asset_bundle.hpp>
 #include <icd/mesh/core/error.hpp>
-#include <icd/collision/traversal.hpp>
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/studies/collision/near_limit.hpp"
 #include "experiments/studies/collision/workloads.hpp"
 
@@ -314,13 +315,13 @@ int run_scene(const std::string& label, const std::string& file, const std::stri
   return mismatches;
 }
 
-}  // namespace
+constexpr const char* kProgram = "icd_collision_vs_fcl";
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   int frames = 10, rounds = 3;
   std::string levels_text = "4,5,6", mesh = "both";
   std::filesystem::path dragon_bundle, bunny_bundle;
-  icd::experiments::Cli cli("icd_collision_vs_fcl");
+  icd::experiments::Cli cli(kProgram);
   cli.integer("--frames", frames, "N", "frames (default 10)", 1)
       .integer("--rounds", rounds, "R", "timed rounds per frame (default 3)", 1)
       .text("--levels", levels_text, "L,..",
@@ -340,37 +341,38 @@ int main(int argc, char** argv) {
       char* end = nullptr;
       const long v = std::strtol(item.c_str(), &end, 10);
       if (item.empty() || *end != '\0' || v < 1 || v > 9) {
-        std::fprintf(stderr, "error: --levels: '%s' is not a level in 1..9\n", item.c_str());
-        return 2;
+        return icd::experiments::Cli::fail(kProgram,
+                                           "--levels: '" + item + "' is not a level in 1..9");
       }
       levels.push_back(static_cast<int>(v));
     }
     if (levels.empty()) {
-      std::fprintf(stderr, "error: --levels: no level given\n");
-      return 2;
+      return icd::experiments::Cli::fail(kProgram, "--levels: no level given");
     }
   }
   if (mesh != "dragon" && mesh != "bunny" && mesh != "both") {
-    std::fprintf(stderr, "error: --mesh: '%s' is not dragon, bunny or both\n", mesh.c_str());
-    return 2;
+    return icd::experiments::Cli::fail(kProgram,
+                                       "--mesh: '" + mesh + "' is not dragon, bunny or both");
   }
   std::printf("icd_collision_vs_fcl: load average at start %s (/proc/loadavg, 2 cores shared)\n",
               icd::experiments::load_average().c_str());
   int bad = 0;
-  try {
-    if (mesh != "bunny")
-      bad += run_scene("dragon", "ChineseDragon-10kv.off", dragon_bundle.string(), frames, rounds,
-                       levels);
-    if (mesh != "dragon")
-      bad += run_scene("bunny", "bunny00.off", bunny_bundle.string(), frames, rounds, levels);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  if (mesh != "bunny")
+    bad += run_scene("dragon", "ChineseDragon-10kv.off", dragon_bundle.string(), frames, rounds,
+                     levels);
+  if (mesh != "dragon")
+    bad += run_scene("bunny", "bunny00.off", bunny_bundle.string(), frames, rounds, levels);
   std::printf("\nload average at end %s\n", icd::experiments::load_average().c_str());
   if (bad > 0) {
-    std::fprintf(stderr, "error: near-limit loops disagree with the library on %d frames\n", bad);
+    std::fprintf(stderr, "%s: near-limit loops disagree with the library on %d frames\n", kProgram,
+                 bad);
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main(kProgram, run, argc, argv);
 }

@@ -17,11 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/cli.hpp"
 #include <icd/fem/simulator.hpp>
 #include <icd/fem/static_solver.hpp>
-#include <icd/mesh/io/atomic_write.hpp>
 #include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 
 namespace {
 
@@ -73,9 +74,7 @@ double static_tip(int r, MaterialModel mm) {
   return tip(model, x);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   using icd::experiments::Cli;
   std::filesystem::path out = "fem_error_vs_time.csv";
   bool quick = false;
@@ -150,12 +149,13 @@ int main(int argc, char** argv) {
       }
     }
   }
-  try {
-    icd::write_file_atomically(out, csv.str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "fem_error_vs_time: %s\n", e.what());
-    return 1;
-  }
+  icd::write_file_atomically(out, csv.str());
   std::printf("wrote %s\n", out.string().c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("fem_error_vs_time", run, argc, argv);
 }

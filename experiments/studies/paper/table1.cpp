@@ -14,10 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/cli.hpp"
-#include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/runner/run.hpp"
 
 namespace fs = std::filesystem;
 using namespace icd::runner;
@@ -73,9 +74,7 @@ struct Row {
   double collision_ms = 0;  // mean collision time per frame in the window
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   fs::path out = "results/table1";
   std::vector<fs::path> scenes;
   std::vector<double> budgets = {1e-4, 1e-3, 1e-2, 1e-1, 1.0};
@@ -127,65 +126,61 @@ int main(int argc, char** argv) {
   const fs::path cache = fs::path(ICD_SOURCE_DIR) / "assets";
   const fs::path tools = fs::canonical("/proc/self/exe").parent_path();
   std::vector<Row> rows;
-  try {
-    for (const fs::path& sp : scenes) {
-      Scene scene = load_scene(sp, overrides);
-      scene.output = OutputSpec{};
-      scene.output.csv = false;
-      scene.world.target_fps = 0;
-      for (const auto& [tests, budget] : all) {
-        scene.world.collision.query.budget_tests = tests ? static_cast<int64_t>(budget) : -1;
-        scene.world.collision.query.budget_seconds =
-            tests ? std::numeric_limits<double>::infinity() : budget;
-        World world = make_world(scene, cache, tools);
-        Row row;
-        row.scene = scene.name;
-        row.budget = budget;
-        row.tests = tests;
-        std::vector<FrameMetrics> frames;
-        try {
-          for (int f = 0; f < max_frames; ++f) {
-            frames.push_back(world.step());
-            // Contact: some sphere pair produced a force.
-            if (row.contact_frame < 0 && frames.back().active_pairs > 0) row.contact_frame = f;
-            if (row.contact_frame >= 0 && f == row.contact_frame + after) break;
-          }
-        } catch (const std::exception& e) {
-          // A run that fails is a result (recorded, marked), not the end of the table.
-          row.failure = e.what();
-          row.failed_frame = static_cast<int>(frames.size());
-          std::fprintf(stderr, "table1: %s at %g%s: failed in frame %d: %s\n", scene.name.c_str(),
-                       budget, tests ? " tests" : " s", row.failed_frame, e.what());
-          rows.push_back(row);
-          continue;
+  for (const fs::path& sp : scenes) {
+    Scene scene = load_scene(sp, overrides);
+    scene.output = OutputSpec{};
+    scene.output.csv = false;
+    scene.world.target_fps = 0;
+    for (const auto& [tests, budget] : all) {
+      scene.world.collision.query.budget_tests = tests ? static_cast<int64_t>(budget) : -1;
+      scene.world.collision.query.budget_seconds =
+          tests ? std::numeric_limits<double>::infinity() : budget;
+      World world = make_world(scene, cache, tools);
+      Row row;
+      row.scene = scene.name;
+      row.budget = budget;
+      row.tests = tests;
+      std::vector<FrameMetrics> frames;
+      try {
+        for (int f = 0; f < max_frames; ++f) {
+          frames.push_back(world.step());
+          // Contact: some sphere pair produced a force.
+          if (row.contact_frame < 0 && frames.back().active_pairs > 0) row.contact_frame = f;
+          if (row.contact_frame >= 0 && f == row.contact_frame + after) break;
         }
-        if (row.contact_frame < 0) {
-          std::fprintf(stderr, "table1: %s at %g s: no contact within %d frames\n",
-                       scene.name.c_str(), budget, max_frames);
-          row.at = frames.back();
-        } else {
-          row.measure_frame = static_cast<int>(frames.size()) - 1;
-          row.at = frames.back();
-          double wall = 0, coll = 0;
-          for (int f = row.contact_frame; f <= row.measure_frame; ++f) {
-            wall += frames[f].wall;
-            coll += frames[f].times.collision;
-          }
-          const int n = row.measure_frame - row.contact_frame + 1;
-          row.fps = n / wall;
-          row.collision_ms = 1e3 * coll / n;
-        }
-        std::printf(
-            "%-14s budget %-7g%s contact frame %3d: PAIRLIST %6lld COLLISIONLIST %5lld fps %6.1f\n",
-            row.scene.c_str(), budget, tests ? " tests" : " s", row.contact_frame, static_cast<long long>(row.at.pair_list),
-            static_cast<long long>(row.at.collision_list), row.fps);
-        std::fflush(stdout);
+      } catch (const std::exception& e) {
+        // A run that fails is a result (recorded, marked), not the end of the table.
+        row.failure = e.what();
+        row.failed_frame = static_cast<int>(frames.size());
+        std::fprintf(stderr, "table1: %s at %g%s: failed in frame %d: %s\n", scene.name.c_str(),
+                     budget, tests ? " tests" : " s", row.failed_frame, e.what());
         rows.push_back(row);
+        continue;
       }
+      if (row.contact_frame < 0) {
+        std::fprintf(stderr, "table1: %s at %g s: no contact within %d frames\n",
+                     scene.name.c_str(), budget, max_frames);
+        row.at = frames.back();
+      } else {
+        row.measure_frame = static_cast<int>(frames.size()) - 1;
+        row.at = frames.back();
+        double wall = 0, coll = 0;
+        for (int f = row.contact_frame; f <= row.measure_frame; ++f) {
+          wall += frames[f].wall;
+          coll += frames[f].times.collision;
+        }
+        const int n = row.measure_frame - row.contact_frame + 1;
+        row.fps = n / wall;
+        row.collision_ms = 1e3 * coll / n;
+      }
+      std::printf(
+          "%-14s budget %-7g%s contact frame %3d: PAIRLIST %6lld COLLISIONLIST %5lld fps %6.1f\n",
+          row.scene.c_str(), budget, tests ? " tests" : " s", row.contact_frame,
+          static_cast<long long>(row.at.pair_list), static_cast<long long>(row.at.collision_list),
+          row.fps);
+      std::fflush(stdout);
+      rows.push_back(row);
     }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "table1: %s\n", e.what());
-    return 1;
   }
 
   std::ostringstream csv, md;
@@ -227,4 +222,10 @@ int main(int argc, char** argv) {
   icd::write_file_atomically(out / "table1.md", md.str());
   std::printf("\n%s\nresults: %s\n", md.str().c_str(), fs::absolute(out).c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("table1", run, argc, argv);
 }

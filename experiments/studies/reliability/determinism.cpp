@@ -21,10 +21,11 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/cli.hpp"
-#include "experiments/studies/reliability/soak_scene.hpp"
-#include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/runner/run.hpp"
+#include "experiments/studies/reliability/soak_scene.hpp"
 
 namespace {
 
@@ -97,9 +98,7 @@ std::vector<std::string> world_trace(const runner::Scene& scene, int threads, in
   return trace;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::string scene_path = std::string(ICD_SOURCE_DIR) + "/experiments/scenes/two_spheres.json";
   int frames = 60, vtu_every = 10;
   long long budget = 2000;
@@ -115,51 +114,52 @@ int main(int argc, char** argv) {
       .path("--out", out, "DIR", "scratch folder");
   cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
-  try {
-    runner::Scene scene = runner::load_scene(scene_path, overrides);
-    reliability::use_test_budget(scene, budget);
-    scene.frames = frames;
-    scene.output.csv = true;
-    scene.output.vtu_every = vtu_every;
+  runner::Scene scene = runner::load_scene(scene_path, overrides);
+  reliability::use_test_budget(scene, budget);
+  scene.frames = frames;
+  scene.output.csv = true;
+  scene.output.vtu_every = vtu_every;
 
-    bool ok = true;
-    runner::RunOptions ro;
-    ro.cache_dir = fs::path(ICD_SOURCE_DIR) / "assets";
-    ro.tool_dir = ICD_TOOL_DIR;
-    ro.progress = false;
-    ro.log = nullptr;
-    fs::remove_all(out);
-    for (const char* run : {"run1", "run2"}) {
-      ro.out_dir = out / run;
-      runner::run_scene(scene, ro);
-    }
-    int files = 0;
-    const std::string diff = compare_runs(out / "run1", out / "run2", files);
-    std::printf("determinism: %s, %d frames, budget %lld tests: two runs %s (%d files compared)\n",
-                scene.name.c_str(), frames, budget, diff.empty() ? "identical" : "DIFFER", files);
-    if (!diff.empty()) {
-      std::printf("  first difference: %s\n", diff.c_str());
-      ok = false;
-    }
-
-    int contacts1 = 0, contacts2 = 0;
-    const std::vector<std::string> t1 = world_trace(scene, 1, contacts1);
-    const std::vector<std::string> t2 = world_trace(scene, 2, contacts2);
-    int first = -1;
-    for (size_t f = 0; f < t1.size() && first < 0; ++f)
-      if (f >= t2.size() || t1[f] != t2[f]) first = static_cast<int>(f);
-    std::printf("determinism: 1 vs 2 FEM threads: %s", first < 0 ? "identical" : "DIFFER");
-    if (first >= 0) std::printf(" from frame %d", first);
-    std::printf(" (%zu frames of metrics and positions compared, %d with contact)\n", t1.size(),
-                contacts1);
-    ok = ok && first < 0;
-    if (contacts1 == 0) {  // without contact the check proves little
-      std::printf("determinism: no frame had contact; use more frames\n");
-      ok = false;
-    }
-    return ok ? 0 : 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "determinism: %s\n", e.what());
-    return 1;
+  bool ok = true;
+  runner::RunOptions ro;
+  ro.cache_dir = fs::path(ICD_SOURCE_DIR) / "assets";
+  ro.tool_dir = ICD_TOOL_DIR;
+  ro.progress = false;
+  ro.log = nullptr;
+  fs::remove_all(out);
+  for (const char* run : {"run1", "run2"}) {
+    ro.out_dir = out / run;
+    runner::run_scene(scene, ro);
   }
+  int files = 0;
+  const std::string diff = compare_runs(out / "run1", out / "run2", files);
+  std::printf("determinism: %s, %d frames, budget %lld tests: two runs %s (%d files compared)\n",
+              scene.name.c_str(), frames, budget, diff.empty() ? "identical" : "DIFFER", files);
+  if (!diff.empty()) {
+    std::printf("  first difference: %s\n", diff.c_str());
+    ok = false;
+  }
+
+  int contacts1 = 0, contacts2 = 0;
+  const std::vector<std::string> t1 = world_trace(scene, 1, contacts1);
+  const std::vector<std::string> t2 = world_trace(scene, 2, contacts2);
+  int first = -1;
+  for (size_t f = 0; f < t1.size() && first < 0; ++f)
+    if (f >= t2.size() || t1[f] != t2[f]) first = static_cast<int>(f);
+  std::printf("determinism: 1 vs 2 FEM threads: %s", first < 0 ? "identical" : "DIFFER");
+  if (first >= 0) std::printf(" from frame %d", first);
+  std::printf(" (%zu frames of metrics and positions compared, %d with contact)\n", t1.size(),
+              contacts1);
+  ok = ok && first < 0;
+  if (contacts1 == 0) {  // without contact the check proves little
+    std::printf("determinism: no frame had contact; use more frames\n");
+    ok = false;
+  }
+  return ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("determinism", run, argc, argv);
 }

@@ -36,10 +36,11 @@
 #include <fstream>
 #include <string>
 
-#include "experiments/common/cli.hpp"
-#include "experiments/studies/reliability/soak_scene.hpp"
-#include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/runner/run.hpp"
+#include "experiments/studies/reliability/soak_scene.hpp"
 
 namespace {
 
@@ -106,9 +107,7 @@ double relaunch(icd::runner::World& world) {
   return change;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   using namespace icd;
   Args a;
   std::vector<std::string> overrides;  // --set
@@ -116,109 +115,109 @@ int main(int argc, char** argv) {
   add_options(cli, a);
   cli.scene_overrides(overrides);
   if (const auto status = cli.parse(argc, argv)) return *status;
-  try {
-    runner::Scene scene;
-    if (a.scene.empty()) {
-      reliability::ContactBoxOptions o;
-      o.budget_tests = a.budget_tests;
-      o.speed = a.speed;
-      scene = reliability::make_contact_box_scene(o);
-    } else {
-      scene = runner::load_scene(a.scene, overrides);
-      if (a.budget_given) reliability::use_test_budget(scene, a.budget_tests);
-    }
-    runner::World world = runner::make_world(scene, std::filesystem::path(ICD_SOURCE_DIR) / "assets", ICD_TOOL_DIR);
-    std::FILE* csv = a.csv.empty() ? nullptr : std::fopen(a.csv.c_str(), "w");
-    const char* header =
-        "frame,fps,rss_mb,energy,penalty_energy,max_energy_ratio,max_object_energy_ratio,"
-        "max_launch_gain,contact_frames,tests,interrupted\n";
-    if (csv) std::fputs(header, csv);
-    std::printf("%s", header);
-
-    double e0 = -1, max_ratio = 0, max_object_ratio = 0, rss_first = -1, rss_max = 0;
-    // Energy just after the current launch, the largest energy since, and the
-    // largest ratio of the two over all launches (the bound checked).
-    double e_launch = -1, e_prev = 0, max_gain = 0;
-    int worst_launch_frame = 0;
-    long long contact_frames = 0, tests = 0, interrupted = 0;
-    bool failed = false;
-    auto t_window = std::chrono::steady_clock::now();
-    const auto t_start = t_window;
-    for (int f = 0; f < a.frames; ++f) {
-      if (a.relaunch > 0 && f > 0 && f % a.relaunch == 0) e_launch = e_prev + relaunch(world);
-      const runner::FrameMetrics m = world.step();
-      if (e0 < 0) e0 = m.energy;
-      if (e_launch < 0) e_launch = e0;
-      const double e_objects = m.energy - m.penalty_energy;
-      e_prev = e_objects;
-      max_object_ratio = std::max(max_object_ratio, e0 > 0 ? e_objects / e0 : 0.0);
-      if (e_launch > 0 && e_objects / e_launch > max_gain) {
-        max_gain = e_objects / e_launch;
-        worst_launch_frame = a.relaunch > 0 ? f - f % a.relaunch : 0;
-      }
-      bool finite = std::isfinite(m.energy);
-      for (runner::RuntimeObject& o : world.objects()) finite = finite && o.positions.allFinite();
-      if (!finite) {
-        std::fprintf(stderr, "soak: FAIL frame %d: non-finite position or energy\n", f);
-        failed = true;
-        break;
-      }
-      max_ratio = std::max(max_ratio, e0 > 0 ? m.energy / e0 : 0.0);
-      contact_frames += m.active_pairs > 0;
-      tests += m.tests;
-      interrupted += m.interrupted;
-      if ((f + 1) % a.every == 0 || f + 1 == a.frames) {
-        const auto now = std::chrono::steady_clock::now();
-        const double dt = std::chrono::duration<double>(now - t_window).count();
-        const int n = (f + 1) % a.every == 0 ? a.every : (f + 1) % a.every;
-        t_window = now;
-        const double rss = resident_mb();
-        if (rss_first < 0) rss_first = rss;
-        rss_max = std::max(rss_max, rss);
-        char row[256];
-        std::snprintf(row, sizeof row, "%d,%.1f,%.1f,%.6g,%.6g,%.4f,%.4f,%.4f,%lld,%lld,%lld\n",
-                      f + 1, n / dt, rss, m.energy, m.penalty_energy, max_ratio, max_object_ratio,
-                      max_gain, contact_frames, tests, interrupted);
-        std::fputs(row, stdout);
-        std::fflush(stdout);
-        if (csv) {
-          std::fputs(row, csv);
-          std::fflush(csv);  // a stopped run keeps its windows
-        }
-      }
-    }
-    if (csv) std::fclose(csv);
-    const double total =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-    std::printf(
-        "soak: %d frames in %.1f s (%.1f fps), initial energy %.6g J, max energy ratio "
-        "%.4f (objects %.4f, with the penalty springs %.4f), %lld frames with contact, "
-        "%lld interrupted queries, RSS first window %.1f MB, max %.1f MB\n",
-        a.frames, total, a.frames / total, e0, max_object_ratio, max_object_ratio, max_ratio,
-        contact_frames, interrupted, rss_first, rss_max);
-    if (a.relaunch > 0)
-      std::printf(
-          "soak: largest object energy within a launch / energy at its start: %.4f "
-          "(launch at frame %d)\n",
-          max_gain, worst_launch_frame);
-    if (max_gain > a.energy_factor) {
-      std::fprintf(stderr, "soak: FAIL energy grew to %.4f x the energy at %s (limit %.4f)\n",
-                   max_gain, a.relaunch > 0 ? "the start of its launch" : "the start",
-                   a.energy_factor);
-      failed = true;
-    }
-    if (rss_max - rss_first > a.max_growth_mb) {
-      std::fprintf(stderr, "soak: FAIL resident memory grew by %.1f MB (limit %.1f MB)\n",
-                   rss_max - rss_first, a.max_growth_mb);
-      failed = true;
-    }
-    if (contact_frames == 0) {
-      std::fprintf(stderr, "soak: FAIL no contact happened: the scene does not test contact\n");
-      failed = true;
-    }
-    return failed ? 1 : 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "soak: %s\n", e.what());
-    return 1;
+  runner::Scene scene;
+  if (a.scene.empty()) {
+    reliability::ContactBoxOptions o;
+    o.budget_tests = a.budget_tests;
+    o.speed = a.speed;
+    scene = reliability::make_contact_box_scene(o);
+  } else {
+    scene = runner::load_scene(a.scene, overrides);
+    if (a.budget_given) reliability::use_test_budget(scene, a.budget_tests);
   }
+  runner::World world =
+      runner::make_world(scene, std::filesystem::path(ICD_SOURCE_DIR) / "assets", ICD_TOOL_DIR);
+  std::FILE* csv = a.csv.empty() ? nullptr : std::fopen(a.csv.c_str(), "w");
+  const char* header =
+      "frame,fps,rss_mb,energy,penalty_energy,max_energy_ratio,max_object_energy_ratio,"
+      "max_launch_gain,contact_frames,tests,interrupted\n";
+  if (csv) std::fputs(header, csv);
+  std::printf("%s", header);
+
+  double e0 = -1, max_ratio = 0, max_object_ratio = 0, rss_first = -1, rss_max = 0;
+  // Energy just after the current launch, the largest energy since, and the
+  // largest ratio of the two over all launches (the bound checked).
+  double e_launch = -1, e_prev = 0, max_gain = 0;
+  int worst_launch_frame = 0;
+  long long contact_frames = 0, tests = 0, interrupted = 0;
+  bool failed = false;
+  auto t_window = std::chrono::steady_clock::now();
+  const auto t_start = t_window;
+  for (int f = 0; f < a.frames; ++f) {
+    if (a.relaunch > 0 && f > 0 && f % a.relaunch == 0) e_launch = e_prev + relaunch(world);
+    const runner::FrameMetrics m = world.step();
+    if (e0 < 0) e0 = m.energy;
+    if (e_launch < 0) e_launch = e0;
+    const double e_objects = m.energy - m.penalty_energy;
+    e_prev = e_objects;
+    max_object_ratio = std::max(max_object_ratio, e0 > 0 ? e_objects / e0 : 0.0);
+    if (e_launch > 0 && e_objects / e_launch > max_gain) {
+      max_gain = e_objects / e_launch;
+      worst_launch_frame = a.relaunch > 0 ? f - f % a.relaunch : 0;
+    }
+    bool finite = std::isfinite(m.energy);
+    for (runner::RuntimeObject& o : world.objects()) finite = finite && o.positions.allFinite();
+    if (!finite) {
+      std::fprintf(stderr, "soak: FAIL frame %d: non-finite position or energy\n", f);
+      failed = true;
+      break;
+    }
+    max_ratio = std::max(max_ratio, e0 > 0 ? m.energy / e0 : 0.0);
+    contact_frames += m.active_pairs > 0;
+    tests += m.tests;
+    interrupted += m.interrupted;
+    if ((f + 1) % a.every == 0 || f + 1 == a.frames) {
+      const auto now = std::chrono::steady_clock::now();
+      const double dt = std::chrono::duration<double>(now - t_window).count();
+      const int n = (f + 1) % a.every == 0 ? a.every : (f + 1) % a.every;
+      t_window = now;
+      const double rss = resident_mb();
+      if (rss_first < 0) rss_first = rss;
+      rss_max = std::max(rss_max, rss);
+      char row[256];
+      std::snprintf(row, sizeof row, "%d,%.1f,%.1f,%.6g,%.6g,%.4f,%.4f,%.4f,%lld,%lld,%lld\n",
+                    f + 1, n / dt, rss, m.energy, m.penalty_energy, max_ratio, max_object_ratio,
+                    max_gain, contact_frames, tests, interrupted);
+      std::fputs(row, stdout);
+      std::fflush(stdout);
+      if (csv) {
+        std::fputs(row, csv);
+        std::fflush(csv);  // a stopped run keeps its windows
+      }
+    }
+  }
+  if (csv) std::fclose(csv);
+  const double total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  std::printf(
+      "soak: %d frames in %.1f s (%.1f fps), initial energy %.6g J, max energy ratio "
+      "%.4f (objects %.4f, with the penalty springs %.4f), %lld frames with contact, "
+      "%lld interrupted queries, RSS first window %.1f MB, max %.1f MB\n",
+      a.frames, total, a.frames / total, e0, max_object_ratio, max_object_ratio, max_ratio,
+      contact_frames, interrupted, rss_first, rss_max);
+  if (a.relaunch > 0)
+    std::printf(
+        "soak: largest object energy within a launch / energy at its start: %.4f "
+        "(launch at frame %d)\n",
+        max_gain, worst_launch_frame);
+  if (max_gain > a.energy_factor) {
+    std::fprintf(stderr, "soak: FAIL energy grew to %.4f x the energy at %s (limit %.4f)\n",
+                 max_gain, a.relaunch > 0 ? "the start of its launch" : "the start",
+                 a.energy_factor);
+    failed = true;
+  }
+  if (rss_max - rss_first > a.max_growth_mb) {
+    std::fprintf(stderr, "soak: FAIL resident memory grew by %.1f MB (limit %.1f MB)\n",
+                 rss_max - rss_first, a.max_growth_mb);
+    failed = true;
+  }
+  if (contact_frames == 0) {
+    std::fprintf(stderr, "soak: FAIL no contact happened: the scene does not test contact\n");
+    failed = true;
+  }
+  return failed ? 1 : 0;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return icd::experiments::guarded_main("soak", run, argc, argv); }

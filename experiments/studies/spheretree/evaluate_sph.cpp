@@ -24,6 +24,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <stdexcept>
 #include <string>
 
 #include "experiments/common/cli.hpp"
@@ -36,6 +38,18 @@
 
 namespace {
 
+using icd::experiments::Cli;
+
+/// Reads an option's value into `target`: a finite number > 0, else the
+/// command-line error (status 2).
+std::function<void(const std::string&)> positive(double& target) {
+  return [&target](const std::string& v) {
+    const double x = Cli::parse_real(v);
+    if (!(x > 0)) throw std::invalid_argument("must be > 0, got '" + v + "'");
+    target = x;
+  };
+}
+
 int run(int argc, char** argv) {
   std::filesystem::path mesh_path, tree_path;
   std::string name = "tree";
@@ -44,13 +58,13 @@ int run(int argc, char** argv) {
   std::filesystem::path cover_path, leaf_table, sample_table, shrink_path, other_path;
   bool other_centred = false;
   double sample_spacing = 4.0;
-  icd::experiments::Cli cli(
+  Cli cli(
       "evaluate_sph", "  Evaluates a .sph sphere tree against its surface mesh (issue 5 metrics).");
   cli.argument("MESH", mesh_path, "surface mesh (OFF, OBJ, PLY, STL) the tree was built for", true)
       .argument("TREE", tree_path, ".sph sphere tree in the mesh's coordinates", true);
   cli.text("--name", name, "NAME", "label of the rows")
-      .real("--coverage-spacing", evaluation.coverage_spacing, "UNITS",
-            "dense coverage spacing (normalized units)")
+      .custom("--coverage-spacing", "UNITS", "dense coverage spacing (normalized units, > 0)",
+              positive(evaluation.coverage_spacing))
       .integer("--shell-samples", evaluation.shell_samples, "N", "shell points per sphere", 0)
       .integer("--rotations", evaluation.probe_rotations, "N",
                "random orientations of the 42 probes per sphere", 0)
@@ -62,18 +76,20 @@ int run(int argc, char** argv) {
       .path("--leaf-table", leaf_table, "FILE", "per-leaf CSV (centre, radius, depth, errors)")
       .path("--sample-table", sample_table, "FILE",
             "per-coverage-sample CSV (leaves containing it, reach along the normal)")
-      .real("--sample-spacing", sample_spacing, "UNITS", "spacing of --sample-table's samples")
+      .custom("--sample-spacing", "UNITS", "spacing of --sample-table's samples (> 0)",
+              positive(sample_spacing))
       .path("--cover-only-as", other_path, "OTHER.sph",
             "shrink the leaves to cover only what OTHER's leaves cover (with --shrunk)")
       .boolean("--other-centred", other_centred, "OTHER is centred (as --centred)")
       .path("--shrunk", shrink_path, "FILE",
             "write the tree shrunk by --cover-only-as to FILE and evaluate it");
   if (const auto status = cli.parse(argc, argv)) return *status;
+  if (other_path.empty() != shrink_path.empty())
+    return Cli::fail("evaluate_sph", "--cover-only-as and --shrunk go together");
 
   const icd::SurfaceMesh mesh = icd::read_surface_mesh(mesh_path);
   icd::collision::SphereTree tree =
       icd::experiments::read_sph_for_mesh(tree_path.string(), mesh, centred);
-  if (!(sample_spacing > 0)) throw icd::ParameterError("--sample-spacing must be > 0");
   if (!cover_path.empty()) {
     icd::experiments::GrownLeaves grown =
         icd::experiments::grow_leaves_to_cover(mesh, tree, evaluation.coverage_spacing);
@@ -84,8 +100,6 @@ int run(int argc, char** argv) {
     icd::collision::write_sph(cover_path.string(), grown.tree);
     tree = std::move(grown.tree);
   }
-  if (other_path.empty() != shrink_path.empty())
-    throw icd::ParameterError("--cover-only-as and --shrunk go together");
   if (!other_path.empty()) {
     const icd::collision::SphereTree other =
         icd::experiments::read_sph_for_mesh(other_path.string(), mesh, other_centred);

@@ -20,10 +20,11 @@
 #include <string>
 #include <vector>
 
-#include "experiments/common/cli.hpp"
-#include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
+#include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
+#include "experiments/runner/run.hpp"
 
 namespace fs = std::filesystem;
 using namespace icd;
@@ -217,9 +218,7 @@ std::string md_escape(std::string s) {
   return s;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   fs::path out = "results/stability";
   int frames = 30;
   double max_seconds = 30;
@@ -263,15 +262,16 @@ int main(int argc, char** argv) {
         o.drift, o.max_gain, o.max_penetration, o.fps, md_escape(o.message).c_str());
     md << row;
   }
-  try {
-    fs::create_directories(out);
-    write_file_atomically(out / "stability.csv", csv.str());
-    write_file_atomically(out / "stability.md", md.str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "stability_sweep: %s\n", e.what());
-    return 1;
-  }
+  fs::create_directories(out);
+  write_file_atomically(out / "stability.csv", csv.str());
+  write_file_atomically(out / "stability.md", md.str());
   std::printf("%d of the cases not stable (see the table); results: %s\n", failures,
               fs::absolute(out).c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("stability_sweep", run, argc, argv);
 }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <stdexcept>
 
 #include <icd/mesh/core/error.hpp>
 #include <icd/mesh/core/primitives.hpp>
@@ -33,6 +34,24 @@ bool closed_manifold(const TetMesh& m) {
     if (n != 1 || rev == directed.end() || rev->second != 1) return false;
   }
   return true;
+}
+
+/// The centre sliver (test::bcc_block_with_centre_sliver): the mesh to clean,
+/// a copy as made, its volume, and cleanup options with collapses off.
+struct CentreSliver {
+  TetMesh m, before;
+  double volume0 = 0;
+  StepCleanupOptions o;
+};
+
+CentreSliver centre_sliver_without_collapses() {
+  CentreSliver c;
+  if (!test::bcc_block_with_centre_sliver(c.m))
+    throw std::runtime_error("bcc_block_with_centre_sliver: no sliver made");
+  c.before = c.m;
+  c.volume0 = signed_tet_volumes(c.m.V, c.m.T).sum();
+  c.o.max_collapses = 0;
+  return c;
 }
 
 TEST(TetCleanup, NearRegularBlockIsLeftAlone) {
@@ -122,12 +141,7 @@ TEST(TetCleanup, SliverIsRelocatedAwayWhenNoCollapseIsAllowed) {
   // The same centre sliver with collapses off (max_collapses 0): the
   // relocation phase moves a node of the sliver instead; the connectivity,
   // every other node and the volume (the moved node is interior) stay.
-  TetMesh m;
-  ASSERT_TRUE(test::bcc_block_with_centre_sliver(m));
-  const TetMesh before = m;
-  const double volume0 = signed_tet_volumes(m.V, m.T).sum();
-  StepCleanupOptions o;
-  o.max_collapses = 0;
+  auto [m, before, volume0, o] = centre_sliver_without_collapses();
   o.flips = false;  // this test is about the relocation phase (flips: the next test)
   const StepCleanupReport r = raise_stable_step(m, o);
   EXPECT_EQ(r.collapses + r.dihedral_collapses + r.flips + r.drops, 0);
@@ -165,12 +179,7 @@ TEST(TetCleanup, SliverIsFlippedAwayWhenNoCollapseOrRelocationIsAllowed) {
   // The centre sliver with collapses and relocations off: the flips replace
   // it and its neighbours by tets of the same nodes filling the same region
   // (every node where it was, the same boundary and volume, positive tets).
-  TetMesh m;
-  ASSERT_TRUE(test::bcc_block_with_centre_sliver(m));
-  const TetMesh before = m;
-  const double volume0 = signed_tet_volumes(m.V, m.T).sum();
-  StepCleanupOptions o;
-  o.max_collapses = 0;
+  auto [m, before, volume0, o] = centre_sliver_without_collapses();
   o.max_relocation_sweeps = 0;
   TetMesh off = m;
   o.flips = false;

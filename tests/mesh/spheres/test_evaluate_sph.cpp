@@ -173,6 +173,21 @@ TEST(EvaluateSphProgram, EvaluatesAToolkitFileInBothFramesAndRefusesBadInput) {
   const ProgramRun usage = run_program((dir / "cube.off").string(), dir);
   EXPECT_EQ(usage.status, 2);
   EXPECT_NE(usage.output.find("TREE"), std::string::npos) << usage.output;
+  // Bad option values are command-line errors (status 2, the option named,
+  // nothing written), before any file is read.
+  const std::string trees = mesh_arg + (dir / "cube.sph").string() + common;
+  const std::pair<std::string, std::string> bad_options[] = {
+      {" --sample-spacing 0 --sample-table " + (dir / "samples.csv").string(),
+       "evaluate_sph: --sample-spacing must be > 0, got '0' (see --help)"},
+      {" --coverage-spacing -1", "evaluate_sph: --coverage-spacing must be > 0, got '-1' (see --help)"},
+      {" --cover-only-as " + (dir / "cube.sph").string(),
+       "evaluate_sph: --cover-only-as and --shrunk go together (see --help)"}};
+  for (const auto& [options, message] : bad_options) {
+    const ProgramRun refused = run_program(trees + options, dir);
+    EXPECT_EQ(refused.status, 2) << options << ": " << refused.output;
+    EXPECT_NE(refused.output.find(message), std::string::npos) << refused.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "samples.csv"));
   fs::remove_all(dir);
 #endif
 }
