@@ -278,18 +278,15 @@ DeepContactStats deep_contact_velocity_step(const SphereTree& a, const SphereTre
       !(mass_a.minCoeff() > 0.0) || !(mass_b.minCoeff() > 0.0))
     throw ParameterError("deep contact step: one positive mass per node and object needed");
   DeepContactStats stats;
-  // Mass-weighted mean velocity and total mass of a sphere's nodes.
-  auto mean = [](const SphereTree& t, int s, const Eigen::VectorXd& m, const auto& v,
-                 double& total) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    total = 0;
-    for (int32_t j = t.assoc_offset[s]; j < t.assoc_offset[s + 1]; ++j) {
-      const int32_t n = t.assoc_nodes[j];
-      p += m[n] * v.row(n).transpose();
-      total += m[n];
-    }
-    return Eigen::Vector3d(p / std::max(total, 1e-300));
+  // The deep pairs, their normals and their spheres' node masses.
+  struct Deep {
+    NodePair p;
+    Eigen::Vector3d n;
+    double ma, mb;
+    bool active;   // approaching in this sweep
+    bool stepped;  // its velocities changed in some sweep
   };
+  std::vector<Deep> deep;
   for (const NodePair& p : result.colliding) {
     const collision::Sphere& sa = a.spheres[p.a];
     const collision::Sphere& sb = b.spheres[p.b];
@@ -300,21 +297,120 @@ DeepContactStats deep_contact_velocity_step(const SphereTree& a, const SphereTre
     if (a.assoc_offset[p.a] == a.assoc_offset[p.a + 1] ||
         b.assoc_offset[p.b] == b.assoc_offset[p.b + 1])
       continue;
-    ++stats.pairs;
-    const Eigen::Vector3d n = d / dist;
     double ma = 0, mb = 0;
-    const Eigen::Vector3d va = mean(a, p.a, mass_a, vel_a, ma);
-    const Eigen::Vector3d vb = mean(b, p.b, mass_b, vel_b, mb);
-    const double vn = (vb - va).dot(n);  // < 0: approaching
-    if (!(vn < 0.0)) continue;
-    ++stats.approaching;
-    const double mu = ma * mb / (ma + mb);
-    const double j = -vn * mu;  // impulse on b along n, -j on a
-    const Eigen::RowVector3d da = (-j / ma) * n.transpose(), db = (j / mb) * n.transpose();
-    for (int32_t k = a.assoc_offset[p.a]; k < a.assoc_offset[p.a + 1]; ++k) vel_a.row(a.assoc_nodes[k]) += da;
-    for (int32_t k = b.assoc_offset[p.b]; k < b.assoc_offset[p.b + 1]; ++k) vel_b.row(b.assoc_nodes[k]) += db;
-    stats.removed_energy += 0.5 * mu * vn * vn;
+    for (int32_t k = a.assoc_offset[p.a]; k < a.assoc_offset[p.a + 1]; ++k) ma += mass_a[a.assoc_nodes[k]];
+    for (int32_t k = b.assoc_offset[p.b]; k < b.assoc_offset[p.b + 1]; ++k) mb += mass_b[b.assoc_nodes[k]];
+    deep.push_back({p, d / dist, ma, mb, false, false});
   }
+  stats.pairs = static_cast<int>(deep.size());
+  if (deep.empty()) return stats;
+  // Mass-weighted mean velocity of a sphere's nodes.
+  auto mean = [](const SphereTree& t, int s, const Eigen::VectorXd& m, const auto& v, double total) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int32_t j = t.assoc_offset[s]; j < t.assoc_offset[s + 1]; ++j)
+      p += m[t.assoc_nodes[j]] * v.row(t.assoc_nodes[j]).transpose();
+    return Eigen::Vector3d(p / total);
+  };
+  const auto na = static_cast<int32_t>(vel_a.rows()), nb = static_cast<int32_t>(vel_b.rows());
+  MatX3d impulse(na + nb, 3);  // per node of a, then of b
+  std::vector<int32_t> parent(static_cast<size_t>(na + nb)), patch_of(parent.size());
+  struct Patch {
+    double g = 0, h = 0, scale = 0;
+  };
+  std::vector<Patch> patches;
+  auto find = [&](int32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  auto join = [&](int32_t x, int32_t y) {
+    if (parent[x] < 0) parent[x] = x;
+    if (parent[y] < 0) parent[y] = y;
+    x = find(x);
+    y = find(y);
+    if (x != y) parent[std::max(x, y)] = std::min(x, y);
+  };
+  auto node_mass = [&](int32_t x) { return x < na ? mass_a[x] : mass_b[x - na]; };
+  auto node_vel = [&](int32_t x) {
+    return x < na ? Eigen::RowVector3d(vel_a.row(x)) : Eigen::RowVector3d(vel_b.row(x - na));
+  };
+  // Sweeps, each judging every deep pair on the same velocities (no order):
+  // each pair still approaching gets the impulse j n (on b; -j n on a,
+  // j = mu v_n) that would stop it alone, spread over its spheres' nodes in
+  // proportion to their masses (each node of a sphere shifted by the same
+  // velocity). Pairs that share a coarse node (of either object) form a
+  // patch; overlapping on its nodes, its pairs' impulses all at once would
+  // overshoot, so they are applied together scaled by s = min(1, -G / H),
+  // G = sum impulse . v and H = sum |impulse|^2 / m over the patch's nodes:
+  // the kinetic energy changes by s G + s^2 H / 2 <= 0 (at s = -G / H the
+  // most the scaled impulses can remove); a lone pair gets s = 1, its
+  // approach stopped. Patches share no node. Repeated until no deep pair
+  // approaches (up to kSweeps; the first sweep nearly always settles a lone
+  // pair, overlapping ones converge like a Jacobi iteration).
+  constexpr int kSweeps = 32;
+  const double tiny = 1e-12;
+  for (int sweep = 0; sweep < kSweeps; ++sweep) {
+    impulse.setZero();
+    std::fill(parent.begin(), parent.end(), -1);
+    std::fill(patch_of.begin(), patch_of.end(), -1);
+    bool any = false;
+    for (Deep& q : deep) {
+      q.active = false;
+      const Eigen::Vector3d va = mean(a, q.p.a, mass_a, vel_a, q.ma);
+      const Eigen::Vector3d vb = mean(b, q.p.b, mass_b, vel_b, q.mb);
+      const double vn = (vb - va).dot(q.n);  // < 0: approaching
+      // (a relative bound: rounding leaves pairs stopped by the last sweep
+      // at |v_n| ~ 1e-16 |v|)
+      if (!(vn < -tiny * (va.norm() + vb.norm()))) continue;
+      any = q.active = true;
+      const double j = -vn * q.ma * q.mb / (q.ma + q.mb);
+      const int32_t first = a.assoc_nodes[a.assoc_offset[q.p.a]];
+      for (int32_t k = a.assoc_offset[q.p.a]; k < a.assoc_offset[q.p.a + 1]; ++k) {
+        const int32_t node = a.assoc_nodes[k];
+        impulse.row(node) -= (mass_a[node] / q.ma * j) * q.n.transpose();
+        join(first, node);
+      }
+      for (int32_t k = b.assoc_offset[q.p.b]; k < b.assoc_offset[q.p.b + 1]; ++k) {
+        const int32_t node = b.assoc_nodes[k];
+        impulse.row(na + node) += (mass_b[node] / q.mb * j) * q.n.transpose();
+        join(first, na + node);
+      }
+    }
+    if (!any) break;
+    patches.clear();
+    for (int32_t x = 0; x < na + nb; ++x) {
+      if (parent[x] < 0) continue;
+      const int32_t root = find(x);
+      if (patch_of[root] < 0) {
+        patch_of[root] = static_cast<int32_t>(patches.size());
+        patches.emplace_back();
+      }
+      patch_of[x] = patch_of[root];
+      Patch& pt = patches[patch_of[x]];
+      pt.g += impulse.row(x).dot(node_vel(x));
+      pt.h += impulse.row(x).squaredNorm() / node_mass(x);
+    }
+    bool moved = false;
+    for (Patch& pt : patches) {
+      pt.scale = 0;
+      if (!(pt.g < 0.0) || !(pt.h > 0.0)) continue;  // together they do not oppose the motion
+      pt.scale = std::min(1.0, -pt.g / pt.h);
+      stats.removed_energy -= pt.scale * pt.g + 0.5 * pt.scale * pt.scale * pt.h;
+      moved = true;
+    }
+    if (!moved) break;
+    for (Deep& q : deep)
+      if (q.active && patches[patch_of[a.assoc_nodes[a.assoc_offset[q.p.a]]]].scale > 0)
+        q.stepped = true;
+    for (int32_t x = 0; x < na + nb; ++x) {
+      if (patch_of[x] < 0 || patches[patch_of[x]].scale == 0.0) continue;
+      const Eigen::RowVector3d dv = (patches[patch_of[x]].scale / node_mass(x)) * impulse.row(x);
+      if (x < na)
+        vel_a.row(x) += dv;
+      else
+        vel_b.row(x - na) += dv;
+    }
+  }
+  for (const Deep& q : deep) stats.approaching += q.stepped;
   return stats;
 }
 

@@ -195,6 +195,8 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
   m_pair_tests.assign(m_plan.pairs.size(), 0);
   m_pair_depth.assign(m_plan.pairs.size(), 0.0);
   m_pair_weight.assign(m_plan.pairs.size(), 1.0);
+  m_pair_cost_tests.assign(m_plan.pairs.size(), std::numeric_limits<double>::infinity());
+  m_pair_cost_seconds.assign(m_plan.pairs.size(), std::numeric_limits<double>::infinity());
   for (const RuntimeObject& o : m_objects)
     if (!(o.setup.collision_weight > 0) || !std::isfinite(o.setup.collision_weight))
       throw ParameterError("object \"" + o.setup.name + "\": collision_weight must be > 0 and finite, got " +
@@ -311,6 +313,13 @@ void World::share_budget() {
   const CollisionSpec& cs = m_settings.collision;
   const size_t n = m_query_pairs.size();
   for (size_t p : m_query_pairs) m_pair_weight[p] = 1;
+  if (cs.budget_split == BudgetSplit::Cheapest && n > 1) {
+    // Cheapest complete answer first (ties in pair order: deterministic).
+    std::stable_sort(m_query_pairs.begin(), m_query_pairs.end(), [&](size_t x, size_t y) {
+      return m_pair_cost_tests[x] < m_pair_cost_tests[y];
+    });
+    return;
+  }
   if (cs.budget_split != BudgetSplit::Priority || n < 2) return;
   const double dt = 1.0 / m_settings.frame_rate;
   const auto centre_velocity = [](const RuntimeObject& o) -> Eigen::Vector3d {
@@ -336,6 +345,13 @@ void World::share_budget() {
   // pairs after it (ties in pair order: deterministic).
   std::stable_sort(m_query_pairs.begin(), m_query_pairs.end(),
                    [&](size_t x, size_t y) { return m_pair_weight[x] < m_pair_weight[y]; });
+}
+
+double World::cheapest_budget(double pool, double left, double floor, double cost) {
+  const double spare = pool - (left - 1) * floor;  // what the later pairs' floors leave
+  const double even = pool / left;
+  if (cost <= spare) return std::min(spare, std::max(2 * cost, even));
+  return std::min(spare, even);
 }
 
 int World::motion_cycles(double dt, bool pairs_only) const {
@@ -889,6 +905,8 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
   share_budget();
   // The pool of the cycle: the even budget of every pair that needs a query.
   const bool priority = cs.budget_split == BudgetSplit::Priority && m_query_pairs.size() > 1;
+  const bool cheapest = cs.budget_split == BudgetSplit::Cheapest && m_query_pairs.size() > 1;
+  double pairs_left = static_cast<double>(m_query_pairs.size());
   const double pairs_queried = static_cast<double>(m_query_pairs.size());
   double pool_seconds = budget * pairs_queried, pool_weight = 0;
   double pool_tests = static_cast<double>(cs.query.budget_tests) * pairs_queried;
@@ -905,6 +923,16 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
       if (cs.query.budget_tests >= 0)
         m_pair_tests[p] = std::max<int64_t>(1, static_cast<int64_t>(std::floor(pool_tests * fraction)));
     }
+    if (cheapest) {  // in cost order: complete answers while the pool lasts
+      if (std::isfinite(budget))
+        m_pair_budget[p] = std::max(cheapest_budget(pool_seconds, pairs_left,
+                                                    m_settings.min_query_budget, m_pair_cost_seconds[p]),
+                                    m_settings.min_query_budget);
+      if (cs.query.budget_tests >= 0)
+        m_pair_tests[p] = std::max<int64_t>(
+            1, static_cast<int64_t>(std::floor(cheapest_budget(pool_tests, pairs_left, 1, m_pair_cost_tests[p]))));
+      pairs_left -= 1;
+    }
     req.budget_seconds = m_pair_budget[p];
     if (cs.query.budget_tests >= 0) req.budget_tests = m_pair_tests[p];
     const Clock::time_point q0 = Clock::now();
@@ -915,10 +943,22 @@ void World::cycle(double h, double t_end, double budget, bool last, bool start_f
     const RuntimeObject& oa = m_objects[i];
     const RuntimeObject& ob = m_objects[j];
     collision::collide(oa.asset.spheres, ob.asset.spheres, req, r);
-    if (priority) {
-      pool_seconds -= seconds_since(q0);
+    const double query_seconds = seconds_since(q0);
+    if (priority || cheapest) {
+      pool_seconds -= query_seconds;
       pool_tests -= static_cast<double>(r.tests);
       pool_weight -= m_pair_weight[p];
+    }
+    // The estimate of the pair's complete cost (Cheapest): its last complete
+    // query; an interrupted one needed more than it used (a lower bound,
+    // also for a pair never complete: so it is tried with more next time).
+    if (!r.interrupted) {
+      m_pair_cost_tests[p] = static_cast<double>(r.tests);
+      m_pair_cost_seconds[p] = query_seconds;
+    } else {
+      const auto known = [](double x) { return std::isfinite(x) ? x : 0.0; };
+      m_pair_cost_tests[p] = std::max(known(m_pair_cost_tests[p]), static_cast<double>(r.tests) + 1);
+      m_pair_cost_seconds[p] = std::max(known(m_pair_cost_seconds[p]), query_seconds);
     }
     if (cs.swept && start_free && r.colliding.empty() && r.untested.empty() &&
         oa.motion + ob.motion > cs.cycle_motion * m_pair_leaf[p]) {

@@ -336,8 +336,22 @@ class World {
   void plan_islands(double dt);
   /// collision.budget_split = Priority: each pair's priority weight
   /// (m_pair_weight) and m_query_pairs in the order they share the pool
-  /// (lowest priority first); Even: weights 1, order unchanged.
+  /// (lowest priority first); Cheapest: m_query_pairs by their estimated
+  /// complete cost (m_pair_cost_tests, cheapest first, unknown last); Even:
+  /// weights 1, order unchanged.
   void share_budget();
+  /// Budget of a query of BudgetSplit::Cheapest (tests or seconds): `pool`
+  /// is what is left of the cycle's pool, `left` the pairs still to query
+  /// (this one included), `floor` what each later pair keeps at least, `cost`
+  /// the pair's estimated complete cost. A pair whose estimate fits, with the
+  /// later pairs' floors set aside, gets what is left of the pool but at most
+  /// twice its estimate (or the even share of what is left, if more); else
+  /// the even share of what is left. Never more than pool - (left - 1) floor.
+  static double cheapest_budget(double pool, double left, double floor, double cost);
+  /// Each pair's cost of its last complete query, in tests and seconds, or
+  /// after an interrupted one at least what it used (+ 1 test); inf: never
+  /// queried. The estimate of BudgetSplit::Cheapest.
+  std::vector<double> m_pair_cost_tests, m_pair_cost_seconds;
   std::vector<double> m_pair_weight;   ///< priority weight of each pair this cycle
   std::vector<size_t> m_query_pairs;   ///< pairs that need a traversal this cycle
   std::vector<double> m_pair_budget;   ///< their time budgets this cycle, s

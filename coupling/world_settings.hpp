@@ -95,6 +95,19 @@ enum class BudgetSplit {
   /// what resting pairs do not use goes to deep or fast-closing ones; each
   /// gets at least one test (min_query_budget in seconds).
   Priority,
+  /// Level of detail by cost: the same total, n pairs x the even budget,
+  /// handed whole to the cheapest pairs first. Each pair's complete cost is
+  /// estimated from its last complete query (tests, or seconds measured;
+  /// after an interrupted query: at least what it used; never queried:
+  /// last); in that order each pair whose estimate fits in what is
+  /// left (one test, or min_query_budget, set aside for each later pair)
+  /// gets what is left, up to twice its estimate, so it is answered
+  /// completely; once one does not fit, it and the later pairs share what
+  /// is left evenly. The total of a cycle's queries never exceeds the pool
+  /// (in tests). A weight split moves a part of the tests and so moves the
+  /// cut within a level (three_pairs: no better than even); this completes
+  /// as many pairs as the pool can pay for.
+  Cheapest,
 };
 
 /// The collision request of every pair query of a simulation: 1 ms per
@@ -172,30 +185,29 @@ struct CollisionSpec {
   /// FEM sub-step of the objects that run them (the shortest of theirs):
   /// the cap keeps every node's penalty rate under the explicit limit at any
   /// cycle length, so each cycle may cost each object one sub-step
-  /// (World::contact_cycles). The count is the fewer of that and the rule
-  /// below, for slow contacts only (each pair closing by at most a third of
-  /// collision.cycle_motion per cycle at that count: with the cap, longer
+  /// (World::contact_cycles). Slow contacts (each pair closing by at most a
+  /// third of collision.cycle_motion per cycle at that count) get the fewer
+  /// of that and the rule below; faster ones get 3x their motion cycles (at
+  /// least the sub-steps), at most the rule below: with the cap, longer
   /// cycles mean a softer penalty, and balls thrown head-on at 5 m/s sank
-  /// 2.6 leaf radii deep). Off by default: at 0.6 m/s head-on the spheres
-  /// of HeadOn.SoftSpheresBounceApartSymmetrically leave with 2.07 % sideways
-  /// drift (its bound: 2 %; 1.95 % with the rule below). Not the cap (it
-  /// caps no pair there, in either rule): the drift is the lateral part of
-  /// forces and impulses along the centre lines of leaf pairs of two trees
-  /// that are not mirror images, and the deep-contact velocity steps
-  /// (deep_step_ratio) give ~0.8 points of it: without them 1.16 % with
-  /// this option, 1.20 % without; with them the 15 cycles of 1.1 ms take 43
-  /// larger steps (pairs 0.75 leaf radii deep) where 41-64 cycles take 145
-  /// (0.69). On the main job it changed neither the deepest pair (0.54 vs
-  /// 0.53 leaf radii) nor the energy.
+  /// 2.6 leaf radii deep at one cycle per sub-step. On by default since the deep-contact velocity
+  /// step is order-free (deep_contact_velocity_step): the 0.6 m/s head-on
+  /// bounce of HeadOn.SoftSpheresBounceApartSymmetrically leaves with 1.52 %
+  /// sideways drift with it, 1.18 % with the rule below (bound 2 %; with
+  /// the earlier pair-by-pair step 2.07 % and 1.95 %; without deep steps
+  /// 1.16 %: the rest is the penalty between two trees that are not mirror
+  /// images). Main job: contact frames 128 -> 74-76 sub-steps, every frame
+  /// within a 60 Hz deadline.
   /// false, or without the cap: as many cycles as the full stiffness
   /// (at least contact.stiffness) on the lightest node needs for omega h <=
   /// 0.25 (on the main job's light nodes its maximum, 64: two cycles per
   /// sub-step, 128 sub-steps per contact frame instead of ~70).
-  bool cycles_at_fem_step = false;
+  bool cycles_at_fem_step = true;
   /// A colliding leaf pair deeper than this fraction of its smaller radius
   /// that still approaches gets an inelastic velocity step on its coarse
   /// nodes (deep_contact_velocity_step: momentum kept, kinetic energy only
-  /// removed), so it stops sinking deeper. 0: off (the penalty alone).
+  /// removed, no order among the pairs), so it stops sinking deeper. 0: off
+  /// (the penalty alone).
   double deep_step_ratio = 0.5;
   collision::SphereUpdateOptions update;
   ContactOptions contact;

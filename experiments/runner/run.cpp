@@ -319,7 +319,7 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
          "contact_force,cycles,substeps,min_step,energy,exact_contacts,rollback,reused,softened,"
          "limited,subdivided,deep_pairs,depth_ratio,obstacle_vertices,obstacle_depth,deadline,"
          "deadline_met,lateness,min_budget_queries,fem_over_deadline,capped_pairs,deep_steps,"
-         "deep_step_energy\n";
+         "deep_step_energy,predicted\n";
   for (const FrameMetrics& m : frames)
     csv << m.frame << ',' << m.time << ',' << m.wall << ',' << m.times.fem << ',' << m.times.links
         << ',' << m.times.sphere_update << ',' << m.times.collision << ',' << m.times.response
@@ -331,7 +331,7 @@ std::string metrics_csv(const std::vector<FrameMetrics>& frames) {
         << m.deep_pairs << ',' << m.depth_ratio << ',' << m.obstacle_vertices << ','
         << m.obstacle_depth << ',' << m.deadline << ',' << m.deadline_met << ',' << m.lateness
         << ',' << m.min_budget_queries << ',' << m.fem_over_deadline << ',' << m.capped_pairs
-        << ',' << m.deep_steps << ',' << m.deep_step_energy << '\n';
+        << ',' << m.deep_steps << ',' << m.deep_step_energy << ',' << m.predicted << '\n';
   return csv.str();
 }
 

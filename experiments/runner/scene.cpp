@@ -583,12 +583,17 @@ CollisionSpec parse_collision(const Json& j, const std::string& source) {
            "filter; use \"fifo\"");
   c.layered = f.boolean("layered", c.layered);
   c.single_cycle_when_apart = f.boolean("single_cycle_when_apart", c.single_cycle_when_apart);
+  c.predict_contact = f.boolean("predict_contact", c.predict_contact);
   c.swept = f.boolean("swept", c.swept);
-  c.budget_split =
-      f.string("budget_split", c.budget_split == BudgetSplit::Priority ? "priority" : "even",
-               {"even", "priority"}) == "priority"
-          ? BudgetSplit::Priority
-          : BudgetSplit::Even;
+  const std::string split = f.string(
+      "budget_split",
+      c.budget_split == BudgetSplit::Priority   ? "priority"
+      : c.budget_split == BudgetSplit::Cheapest ? "cheapest"
+                                                : "even",
+      {"even", "priority", "cheapest"});
+  c.budget_split = split == "priority"   ? BudgetSplit::Priority
+                   : split == "cheapest" ? BudgetSplit::Cheapest
+                                         : BudgetSplit::Even;
   c.cycle_motion = f.number("cycle_motion", c.cycle_motion, 0, 1e3, true);
   c.midpoint = f.boolean("midpoint", c.midpoint);
   c.passive = f.boolean("passive", c.passive);

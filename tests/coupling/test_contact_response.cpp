@@ -404,5 +404,113 @@ TEST(ContactResponse, DeepContactStepStopsTheApproachAndOnlyRemovesEnergy) {
   EXPECT_THROW(deep_contact_velocity_step(a, b, r, short_mass, mb, va, vb), ParameterError);
 }
 
+// Mirror symmetry of the deep-contact step: tree b is tree a reflected in
+// the plane x = 0 (sphere i of b is the mirror of sphere i of a, tied to the
+// same node numbers, nodes sharing spheres), with mirrored node masses and
+// velocities; the deep pairs (i, j) and (j, i) are mirror images of each
+// other. The step must give mirror-image velocities (so no sideways impulse
+// on either object), whatever the order of the pairs and whichever object
+// is a, keep the momentum and never add kinetic energy. Reference: the
+// reflection itself and the sums before the step. (A pair-by-pair sweep
+// treats (i, j) before (j, i) and fails the mirror.)
+TEST(ContactResponse, DeepContactStepIsMirrorSymmetricAndOrderFree) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Eigen::Vector3d mirror(-1, 1, 1);
+  int stepped = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int leaves = 5, nodes = leaves + 1;
+    std::vector<Sphere> la, lb;
+    std::vector<std::vector<int>> assoc{{0, 1, 2, 3, 4, 5}};  // the root
+    for (int i = 0; i < leaves; ++i) {
+      const Eigen::Vector3d c(-0.08 + 0.03 * u(rng), 0.12 * u(rng), 0.12 * u(rng));
+      const double r = 0.3 + 0.05 * u(rng);
+      la.push_back({c.x(), c.y(), c.z(), r});
+      lb.push_back({-c.x(), c.y(), c.z(), r});
+      assoc.push_back({i, i + 1});  // neighbouring spheres share a node
+    }
+    const SphereTree a = make_tree(la, assoc), b = make_tree(lb, assoc);
+    CollisionResult r;
+    for (int i = 1; i <= leaves; ++i)
+      for (int j = 1; j <= leaves; ++j) r.colliding.push_back({i, j});
+    Eigen::VectorXd ma(nodes);
+    MatX3d va(nodes, 3);
+    for (int n = 0; n < nodes; ++n) {
+      ma[n] = 1.0 + 0.9 * u(rng);
+      va.row(n) << 0.5 + u(rng), u(rng), u(rng);  // a moves towards +x, b towards -x
+    }
+    const Eigen::VectorXd mb = ma;
+    MatX3d vb = va.array().rowwise() * mirror.transpose().array();
+    const MatX3d va0 = va, vb0 = vb;
+    const DeepContactStats s = deep_contact_velocity_step(a, b, r, ma, mb, va, vb, 0.5);
+    ASSERT_GT(s.pairs, 0) << "trial " << trial;
+    stepped += s.approaching > 0;
+    // Mirror images.
+    const MatX3d va_mirrored = va.array().rowwise() * mirror.transpose().array();
+    EXPECT_LT((vb - va_mirrored).cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial;
+    // Momentum kept, kinetic energy not gained; no sideways momentum moved.
+    const Eigen::Vector3d p0a = va0.transpose() * ma, p0b = vb0.transpose() * mb;
+    const Eigen::Vector3d p1a = va.transpose() * ma, p1b = vb.transpose() * mb;
+    EXPECT_LT((p1a + p1b - p0a - p0b).norm(), 1e-12);
+    EXPECT_LT((p1a - p0a).tail<2>().norm(), 1e-12);
+    const double e0 = kinetic(va0, ma) + kinetic(vb0, mb), e1 = kinetic(va, ma) + kinetic(vb, mb);
+    EXPECT_LE(e1, e0 + 1e-12);
+    EXPECT_NEAR(e0 - e1, s.removed_energy, 1e-12);
+    // The pairs in reverse order, and b as object a: the same velocities.
+    CollisionResult reversed, swapped;
+    reversed.colliding.assign(r.colliding.rbegin(), r.colliding.rend());
+    for (const NodePair& p : r.colliding) swapped.colliding.push_back({p.b, p.a});
+    MatX3d va2 = va0, vb2 = vb0, va3 = va0, vb3 = vb0;
+    deep_contact_velocity_step(a, b, reversed, ma, mb, va2, vb2, 0.5);
+    deep_contact_velocity_step(b, a, swapped, mb, ma, vb3, va3, 0.5);
+    EXPECT_LT((va2 - va).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((vb2 - vb).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((va3 - va).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((vb3 - vb).cwiseAbs().maxCoeff(), 1e-12);
+  }
+  EXPECT_GT(stepped, 10);
+}
+
+// Kinetic energy is never gained and momentum is kept, on random
+// non-symmetric pairs of trees (several patches, random velocities), and
+// every patch that stepped no longer approaches along its normal.
+TEST(ContactResponse, DeepContactStepNeverGainsEnergyOnRandomTrees) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int leaves = 8, nodes = 12;
+    std::uniform_int_distribution<int> pick(0, nodes - 1);
+    std::vector<Sphere> la, lb;
+    std::vector<std::vector<int>> aa{{0}}, ab{{0}};
+    for (int i = 0; i < leaves; ++i) {
+      la.push_back({-0.1 + 0.1 * u(rng), 0.3 * u(rng), 0.3 * u(rng), 0.3});
+      lb.push_back({0.1 + 0.1 * u(rng), 0.3 * u(rng), 0.3 * u(rng), 0.3});
+      aa.push_back({pick(rng), pick(rng)});
+      ab.push_back({pick(rng)});
+    }
+    const SphereTree a = make_tree(la, aa), b = make_tree(lb, ab);
+    CollisionResult r;
+    for (int i = 1; i <= leaves; ++i)
+      for (int j = 1; j <= leaves; ++j) r.colliding.push_back({i, j});
+    Eigen::VectorXd ma(nodes), mb(nodes);
+    MatX3d va(nodes, 3), vb(nodes, 3);
+    for (int n = 0; n < nodes; ++n) {
+      ma[n] = 1.0 + 0.9 * u(rng);
+      mb[n] = 1.0 + 0.9 * u(rng);
+      va.row(n) << u(rng), u(rng), u(rng);
+      vb.row(n) << u(rng), u(rng), u(rng);
+    }
+    const MatX3d va0 = va, vb0 = vb;
+    const DeepContactStats s = deep_contact_velocity_step(a, b, r, ma, mb, va, vb, 0.3);
+    const Eigen::Vector3d p0 = va0.transpose() * ma + vb0.transpose() * mb;
+    const Eigen::Vector3d p1 = va.transpose() * ma + vb.transpose() * mb;
+    EXPECT_LT((p1 - p0).norm(), 1e-12) << "trial " << trial;
+    const double e0 = kinetic(va0, ma) + kinetic(vb0, mb), e1 = kinetic(va, ma) + kinetic(vb, mb);
+    EXPECT_LE(e1, e0 + 1e-12) << "trial " << trial;
+    EXPECT_NEAR(e0 - e1, s.removed_energy, 1e-12);
+    EXPECT_GE(s.removed_energy, 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace icd::coupling

@@ -222,6 +222,115 @@ TEST(WorldScheduling, PrioritySplitFindsTheCriticalPairWhereTheEvenSplitDoesNot)
   }
 }
 
+// Level of detail by cost (BudgetSplit::Cheapest). Three still pairs
+// (scripted balls) overlapping 2 mm, 2 cm and 6 cm, whose complete queries
+// cost c1 < c2 < c3 tests (oracle: an unlimited query of the same scene, its
+// answers checked against every leaf pair by brute force). A budget per query
+// B with 3 B enough for the two cheapest complete answers but not the third,
+// and B < c2: the even split completes at most one pair, the cheapest-first
+// split two (after learning the costs: at first none is known),
+// each exactly the brute-force answer; in every cycle the queries together
+// use at most 3 B tests.
+TEST(WorldScheduling, CheapestSplitAnswersAsManyPairsExactlyAsThePoolPaysFor) {
+  const double overlap[3] = {0.002, 0.02, 0.06};
+  const auto scene = [&] {
+    std::vector<WorldObject> v;
+    const auto still = [&v](const std::string& name, const Eigen::Vector3d& x) {
+      WorldObject o = ball(name, x, {0, 0, 0});
+      o.setup.kind = ObjectKind::Rigid;
+      o.setup.motion = [](double) { return RigidPose{}; };  // rest = placed pose
+      v.push_back(std::move(o));
+    };
+    for (int k = 0; k < 3; ++k) {
+      still("p" + std::to_string(k) + "a", {-0.1 + overlap[k] / 2, 1.0 * k, 0});
+      still("p" + std::to_string(k) + "b", {0.1 - overlap[k] / 2, 1.0 * k, 0});
+    }
+    v.push_back(ball("soft", {0, -5, 0}, {0, 0, 0}));  // a deformable object: response on
+    return v;
+  };
+  WorldSettings oracle_settings = deterministic();
+  oracle_settings.collision.query.budget_tests = -1;
+  World oracle(scene(), oracle_settings);
+  oracle.step();
+  const auto& pairs = oracle.plan().pairs;
+  const auto pair_of = [&](int k) {
+    const std::string a = "p" + std::to_string(k) + "a", b = "p" + std::to_string(k) + "b";
+    for (size_t p = 0; p < pairs.size(); ++p)
+      if (oracle.objects()[pairs[p].first].setup.name == a &&
+          oracle.objects()[pairs[p].second].setup.name == b)
+        return p;
+    throw std::runtime_error("no pair " + a + " - " + b);
+  };
+  auto sorted = [](std::vector<collision::NodePair> v) {
+    std::sort(v.begin(), v.end(), [](const collision::NodePair& x, const collision::NodePair& y) {
+      return std::pair(x.a, x.b) < std::pair(y.a, y.b);
+    });
+    return v;
+  };
+  // Brute force: every overlapping leaf pair of the pair's current spheres.
+  const auto brute = [&](const World& w, size_t p) {
+    const collision::SphereTree& ta = w.objects()[pairs[p].first].asset.spheres;
+    const collision::SphereTree& tb = w.objects()[pairs[p].second].asset.spheres;
+    std::vector<collision::NodePair> out;
+    for (int i = 0; i < ta.num_nodes(); ++i)
+      for (int j = 0; j < tb.num_nodes(); ++j)
+        if (ta.is_leaf(i) && tb.is_leaf(j) && collision::overlap(ta.spheres[i], tb.spheres[j]))
+          out.push_back({i, j});
+    return sorted(out);
+  };
+  int64_t cost[3];
+  for (int k = 0; k < 3; ++k) {
+    const collision::CollisionResult& truth = oracle.results()[pair_of(k)];
+    ASSERT_FALSE(truth.interrupted);
+    ASSERT_EQ(sorted(truth.colliding), brute(oracle, pair_of(k))) << "pair " << k;
+    ASSERT_FALSE(truth.colliding.empty());
+    cost[k] = truth.tests;
+  }
+  std::printf("complete costs %lld %lld %lld tests\n", static_cast<long long>(cost[0]),
+              static_cast<long long>(cost[1]), static_cast<long long>(cost[2]));
+  ASSERT_LT(cost[0], cost[1]);
+  ASSERT_LT(cost[1], cost[2]);
+  // 3 B pays for the two cheapest complete answers (and one test for the
+  // third), not for all three; one pair alone cannot take c2 from B.
+  const int64_t budget = (cost[0] + cost[1] + 1 + 2) / 3 + 1;
+  ASSERT_LT(budget, cost[1]);
+  ASSERT_LT(3 * budget, cost[0] + cost[1] + cost[2]);
+  const auto run = [&](BudgetSplit split, int& cycles_over) {
+    WorldSettings s = deterministic();
+    s.collision.query.budget_tests = budget;
+    s.collision.budget_split = split;
+    auto w = std::make_unique<World>(scene(), s);
+    w->set_cycle_observer([&](const World& world) {
+      int64_t used = 0, queried = 0;
+      for (size_t p = 0; p < pairs.size(); ++p)
+        if (world.pair_test_budgets()[p] > 0) {
+          used += world.results()[p].tests;
+          ++queried;
+        }
+      cycles_over += used > queried * budget;
+    });
+    for (int f = 0; f < 3; ++f) w->step();
+    return w;
+  };
+  int over_even = 0, over_cheapest = 0;
+  const std::unique_ptr<World> even = run(BudgetSplit::Even, over_even);
+  const std::unique_ptr<World> cheapest = run(BudgetSplit::Cheapest, over_cheapest);
+  EXPECT_EQ(over_even, 0);
+  EXPECT_EQ(over_cheapest, 0);
+  // Even: at most the cheapest pair fits in B.
+  EXPECT_EQ(even->results()[pair_of(0)].interrupted, cost[0] > budget);
+  EXPECT_TRUE(even->results()[pair_of(1)].interrupted);
+  EXPECT_TRUE(even->results()[pair_of(2)].interrupted);
+  // Cheapest first: the two cheapest answered exactly, the third cut.
+  for (int k = 0; k < 2; ++k) {
+    const collision::CollisionResult& r = cheapest->results()[pair_of(k)];
+    EXPECT_FALSE(r.interrupted) << "pair " << k;
+    EXPECT_EQ(sorted(r.colliding), brute(*cheapest, pair_of(k))) << "pair " << k;
+  }
+  EXPECT_TRUE(cheapest->results()[pair_of(2)].interrupted);
+  EXPECT_GT(cheapest->pair_test_budgets()[pair_of(2)], 0);
+}
+
 // Cycles fitted to the objects' sub-steps. Each cycle advances an object in
 // ceil(h / step) equal sub-steps: 64 cycles of a 60 Hz frame (0.260 ms) cost
 // an object whose sub-step is 0.256 ms two sub-steps each. Worked by hand:

@@ -1,5 +1,6 @@
 // Real-time mode through the runner: frames.csv records each frame's
-// deadline, whether it was met and the lateness; an impossible deadline
+// deadline, whether it was met and the lateness (and whether it was cycled
+// on a predicted contact); an impossible deadline
 // (FEM alone exceeds it) is said once on stderr, with the figure, and again
 // in the run summary.
 #include <gtest/gtest.h>
@@ -73,6 +74,11 @@ TEST(RealTimeRunner, ImpossibleDeadlineIsSaidOnceAndEveryFrameIsRecorded) {
   const size_t n = static_cast<size_t>(
       std::find(names.begin(), names.end(), "fem_over_deadline") - names.begin() + 1);
   ASSERT_LE(n, names.size());
+  // Whether the frame was cycled at once on a predicted contact: the
+  // `predicted` column holds FrameMetrics::predicted of each frame.
+  const size_t pc =
+      static_cast<size_t>(std::find(names.begin(), names.end(), "predicted") - names.begin());
+  ASSERT_LT(pc, names.size()) << header;
   int rows = 0;
   while (std::getline(csv, line)) {
     ++rows;
@@ -84,6 +90,8 @@ TEST(RealTimeRunner, ImpossibleDeadlineIsSaidOnceAndEveryFrameIsRecorded) {
     EXPECT_EQ(cells[n - 4], "0");                      // missed
     EXPECT_GT(std::stod(cells[n - 3]), 0);             // late
     EXPECT_EQ(cells[n - 1], "1");                      // FEM alone over it
+    ASSERT_LT(static_cast<size_t>(rows), frames.size() + 1);
+    EXPECT_EQ(cells[pc], std::to_string(frames[static_cast<size_t>(rows - 1)].predicted));
   }
   EXPECT_EQ(rows, 6);
   EXPECT_EQ(frames.size(), 6u);

@@ -160,16 +160,22 @@ TEST(Scene, EachBadFieldGetsAClearError) {
 }
 
 // Level of detail: collision.budget_split and each object's collision_weight
-// reach the World's settings and objects; left out, the library defaults.
+// reach the World's settings and objects, as do collision.cycles_at_fem_step
+// and collision.predict_contact; left out, the library defaults.
 TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
   const Scene s = parse(with_objects(
       R"({"name": "a", "primitive": {"type": "sphere", "radius": 0.1, "cells": 3},
           "position": [-0.3, 0, 0], "collision_weight": 2.5},
          {"name": "b", "primitive": {"type": "sphere", "radius": 0.1, "cells": 3},
           "position": [0.3, 0, 0]})",
-      R"("collision": {"budget_split": "priority", "cycles_at_fem_step": true})"));
+      R"("collision": {"budget_split": "priority", "cycles_at_fem_step": false,
+          "predict_contact": false})"));
   EXPECT_EQ(s.world.collision.budget_split, coupling::BudgetSplit::Priority);
-  EXPECT_TRUE(s.world.collision.cycles_at_fem_step);
+  // (both on by default: the keys turn them off)
+  ASSERT_TRUE(coupling::CollisionSpec{}.cycles_at_fem_step);
+  ASSERT_TRUE(coupling::CollisionSpec{}.predict_contact);
+  EXPECT_FALSE(s.world.collision.cycles_at_fem_step);
+  EXPECT_FALSE(s.world.collision.predict_contact);
   EXPECT_EQ(s.objects[0].collision_weight, 2.5);
   EXPECT_EQ(s.objects[1].collision_weight, coupling::ObjectSetup{}.collision_weight);
   const World world = make_world(s, "", "");
@@ -179,9 +185,12 @@ TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
 
   const Scene even = parse(with_objects(kSphere, R"("collision": {"budget_split": "even"})"));
   EXPECT_EQ(even.world.collision.budget_split, coupling::BudgetSplit::Even);
+  const Scene cheap = parse(with_objects(kSphere, R"("collision": {"budget_split": "cheapest"})"));
+  EXPECT_EQ(cheap.world.collision.budget_split, coupling::BudgetSplit::Cheapest);
   const Scene plain = parse(with_objects(kSphere));
   EXPECT_EQ(plain.world.collision.budget_split, coupling::CollisionSpec{}.budget_split);
   EXPECT_EQ(plain.world.collision.cycles_at_fem_step, coupling::CollisionSpec{}.cycles_at_fem_step);
+  EXPECT_EQ(plain.world.collision.predict_contact, coupling::CollisionSpec{}.predict_contact);
   EXPECT_EQ(plain.objects[0].collision_weight, coupling::ObjectSetup{}.collision_weight);
 
   // Bad values: an InputError naming the file and the field.
@@ -192,6 +201,8 @@ TEST(Scene, BudgetSplitAndCollisionWeightReachTheWorld) {
        "string"},
       {with_objects(kSphere, R"("collision": {"cycles_at_fem_step": "yes"})"),
        "collision.cycles_at_fem_step", "true or false"},
+      {with_objects(kSphere, R"("collision": {"predict_contact": 1})"),
+       "collision.predict_contact", "true or false"},
       {with_objects(R"({"primitive": {}, "collision_weight": 0})"), "objects[0].collision_weight",
        "must be in (0"},
       {with_objects(R"({"primitive": {}, "collision_weight": -2})"), "objects[0].collision_weight",

@@ -289,7 +289,7 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
     return r;
   };
   const bool at_step = scene.world.collision.cycles_at_fem_step;  // (the scene's or the default)
-  const Rt s3 = run_rt(!at_step, true, at_step ? "default cycle rule" : "cycles_at_fem_step");
+  const Rt s3 = run_rt(!at_step, true, at_step ? "stiffness cycle rule" : "cycles_at_fem_step");
   const Rt s4 = run_rt(at_step, true, at_step ? "cycles_at_fem_step (the scene's)" : "the scene's cycle rule");
   const Rt s5 = run_rt(at_step, false, "the scene's cycle rule, always the trial");
   scene.world.collision.predict_contact = true;
@@ -308,7 +308,7 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
   row("1 thread (old path)", s1);
   row("2 threads", s2);
   row("2 threads, workers spin", s2b);
-  row(at_step ? "2 thr, 60 Hz RT, old rule" : "2 thr, 60 Hz RT, at step", s3.s);
+  row(at_step ? "2 thr, 60 Hz RT, stiff rule" : "2 thr, 60 Hz RT, at step", s3.s);
   row("2 threads, 60 Hz RT", s4.s);
   row("2 thr, 60 Hz RT, trial", s5.s);
   std::printf("speed-up 2 vs 1 thread (median wall per frame): %.2fx (workers that spin 100 us: %.2fx)\n",
@@ -318,7 +318,7 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
   print_breakdown("1 thread", s1, one);
   print_breakdown("2 threads", s2, two);
   const std::pair<const char*, const Rt*> rts[] = {
-      {at_step ? " (default cycle rule)" : " (cycles_at_fem_step)", &s3},
+      {at_step ? " (stiffness cycle rule: cycles_at_fem_step off)" : " (cycles_at_fem_step)", &s3},
       {"", &s4},
       {" (always the single-cycle trial)", &s5}};
   for (const auto& [label, r] : rts) {
@@ -337,7 +337,8 @@ void run_scene(const std::filesystem::path& path, const std::vector<std::string>
 }
 
 // Level of detail for many pairs (--lod): the scene with its own query
-// budget, shared among the pairs evenly and by priority (two runs). After
+// budget, shared among the pairs evenly, by priority and cheapest first
+// (three runs). After
 // every detection/response cycle (World::set_cycle_observer, rolled-back
 // cycles included) each pair's query answer is compared with an unlimited
 // query on the same spheres (the oracle): the penalty force (Eq. 11, the
@@ -356,14 +357,26 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
               "p90 err", "max err", "missed", "coll ms/fr", "wall ms/fr", "interrupt");
   struct PairErrors {
     std::vector<double> even, priority;
-    // Same state (the priority run's cycles): the World's priority answer
+    // Same state (the priority or cheapest run's cycles): the World's answer
     // and the even split's answer of the same spheres, with the tests each used.
     std::vector<double> same_even, same_priority, tests_even, tests_priority;
   };
   std::vector<PairErrors> per_pair;
   for (const icd::coupling::BudgetSplit split :
-       {icd::coupling::BudgetSplit::Even, icd::coupling::BudgetSplit::Priority}) {
+       {icd::coupling::BudgetSplit::Even, icd::coupling::BudgetSplit::Priority,
+        icd::coupling::BudgetSplit::Cheapest}) {
     const bool even = split == icd::coupling::BudgetSplit::Even;
+    const char* split_name = even ? "even"
+                             : split == icd::coupling::BudgetSplit::Priority ? "priority"
+                                                                             : "cheapest";
+    if (!even)  // the even run's per-pair errors stay; the same-state ones are per run
+      for (PairErrors& pe : per_pair) {
+        pe.priority.clear();
+        pe.same_even.clear();
+        pe.same_priority.clear();
+        pe.tests_even.clear();
+        pe.tests_priority.clear();
+      }
     scene.world.collision.budget_split = split;
     scene.world.target_fps = 0;
     World w = icd::runner::make_world(scene, cache, tools);
@@ -430,13 +443,14 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
     std::vector<double> sorted = err;
     std::sort(sorted.begin(), sorted.end());
     const double p90 = sorted.empty() ? 0 : sorted[static_cast<size_t>(0.9 * (sorted.size() - 1))];
-    std::printf("%-10s %8zu %12.3f %12.3f %12.3f %8d %12.3f %12.2f %10d\n", even ? "even" : "priority",
+    std::printf("%-10s %8zu %12.3f %12.3f %12.3f %8d %12.3f %12.2f %10d\n", split_name,
                 err.size(), median(err), p90, sorted.empty() ? 0 : sorted.back(), missed,
                 1e3 * std::accumulate(coll.begin(), coll.end(), 0.0) / frames, 1e3 * median(wall),
                 interrupted);
     std::fflush(stdout);
     if (!even) {
-      std::printf("per pair (samples: cycles the oracle found the pair in contact): median error even / priority\n");
+      std::printf("per pair (samples: cycles the oracle found the pair in contact): median error even / %s\n",
+                  split_name);
       for (size_t p = 0; p < per_pair.size(); ++p) {
         if (per_pair[p].even.empty() && per_pair[p].priority.empty()) continue;
         const auto& pr = w.plan().pairs[p];
@@ -444,9 +458,10 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
                     w.objects()[pr.second].setup.name.c_str(), per_pair[p].even.size(),
                     median(per_pair[p].even), per_pair[p].priority.size(), median(per_pair[p].priority));
       }
-      std::printf("same state (the priority run's cycles; each pair's answer with its priority "
+      std::printf("same state (the %s run's cycles; each pair's answer with its %s "
                   "budget and with the even budget of the same spheres): samples, median error "
-                  "even / priority, mean error even / priority, median tests even / priority\n");
+                  "even / %s, mean error even / %s, median tests even / %s\n",
+                  split_name, split_name, split_name, split_name, split_name);
       std::vector<double> all_even, all_prio;
       for (size_t p = 0; p < per_pair.size(); ++p) {
         const PairErrors& pe = per_pair[p];
@@ -463,8 +478,8 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
         all_prio.insert(all_prio.end(), pe.same_priority.begin(), pe.same_priority.end());
       }
       if (!all_even.empty())
-        std::printf("  all pairs    %6zu samples: median error even %.3f, priority %.3f; mean %.3f, %.3f\n",
-                    all_even.size(), median(all_even), median(all_prio),
+        std::printf("  all pairs    %6zu samples: median error even %.3f, %s %.3f; mean %.3f, %.3f\n",
+                    all_even.size(), median(all_even), split_name, median(all_prio),
                     std::accumulate(all_even.begin(), all_even.end(), 0.0) / all_even.size(),
                     std::accumulate(all_prio.begin(), all_prio.end(), 0.0) / all_prio.size());
     }
@@ -487,8 +502,8 @@ int main(int argc, char** argv) {
   cli.arguments("SCENE", scenes, "scene files (JSON)", false)
       .integer("--frames", frames, "N", "frames per configuration (default 120)", 1, 100000)
       .flag("--lod", lod,
-            "level of detail for many pairs instead: the scene's query budget shared evenly and "
-            "by priority, per-pair contact force error against an unlimited query of the same "
+            "level of detail for many pairs instead: the scene's query budget shared evenly, "
+            "by priority and cheapest pairs first, per-pair contact force error against an unlimited query of the same "
             "spheres, and collision time")
       .flag("--trace", trace,
             "print one line per frame of the real-time runs: wall, FEM and collision ms, cycles and "
