@@ -386,62 +386,14 @@ int World::motion_cycles(double dt, bool pairs_only) const {
     speed[i] = m_objects[i].setup.motion && m_objects[i].plan.kinematic
                    ? std::max(m_objects[i].speed, scripted_motion(m_objects[i], dt) / dt)
                    : m_objects[i].speed;
-  // Per deformable object its centre velocity and its motion apart from the
-  // centre (closing_motion): a pair closes by at most their relative centre
-  // motion plus both, and gravity's relative part (one may rest on a floor).
-  // The fewer of that and the last cycles' sphere speeds over the frame.
-  const double fall = 0.5 * m_settings.gravity.norm() * dt * dt;
-  std::vector<double> own(m_objects.size(), std::numeric_limits<double>::infinity());
-  std::vector<Eigen::Vector3d> centre(m_objects.size(), Eigen::Vector3d::Zero());
-  for (size_t i = 0; i < m_objects.size(); ++i)
-    if (m_objects[i].sim) own[i] = closing_motion(m_objects[i], dt, centre[i]);
   for (size_t p = 0; p < m_plan.pairs.size(); ++p) {
     if (!m_pair_close[p]) continue;  // queried once, at the frame's end (plan_islands)
     const auto [i, j] = m_plan.pairs[p];
-    double motion = (speed[i] + speed[j]) * dt;
-    // (a static or kinematic side: its own speed, centre still)
-    const auto part = [&](size_t k) { return m_objects[k].sim ? own[k] : speed[k] * dt; };
-    const double closing = (centre[i] - centre[j]).norm() * dt + part(i) + part(j) + fall;
-    if (closing < motion) motion = closing;  // (NaN, infinity: the speeds)
+    const double motion = (speed[i] + speed[j]) * dt;
     const double step = m_settings.collision.cycle_motion * m_pair_leaf[p];
     if (step > 0) cycles = std::max(cycles, std::ceil(motion / step));
   }
   return static_cast<int>(std::min<double>(cycles, kMaxMotionCycles));
-}
-
-double World::closing_motion(const RuntimeObject& o, double dt, Eigen::Vector3d& centre_velocity) const {
-  centre_velocity.setZero();
-  const double unknown = std::numeric_limits<double>::infinity();
-  if (!o.sim || o.asset.spheres.spheres.empty()) return unknown;
-  const MatX3d& x = o.positions;
-  const MatX3d& v = o.sim->velocities();
-  const Eigen::VectorXd& m = o.node_mass;
-  const double mass = m.sum();
-  if (!(mass > 0)) return unknown;
-  const Eigen::Vector3d c = (x.transpose() * m) / mass;
-  centre_velocity = (v.transpose() * m) / mass;
-  if (!std::isfinite(o.frame_motion)) return unknown;
-  // Angular velocity of the best-fit rigid motion: I^-1 L about the centre.
-  Eigen::Vector3d l = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
-  for (Eigen::Index k = 0; k < x.rows(); ++k) {
-    const Eigen::Vector3d r = x.row(k).transpose() - c;
-    l += m[k] * r.cross(v.row(k).transpose() - centre_velocity);
-    inertia += m[k] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
-  }
-  const Eigen::Vector3d w = inertia.ldlt().solve(l);
-  if (!w.allFinite()) return unknown;
-  // The leaf spheres' farthest reach from the centre (contacts are their
-  // overlaps; a parent grows with its children).
-  const collision::SphereTree& tree = o.asset.spheres;
-  double arm = 0;
-  for (int k = 0; k < tree.num_nodes(); ++k)
-    if (tree.is_leaf(k)) {
-      const collision::Sphere& sk = tree.spheres[static_cast<size_t>(k)];
-      arm = std::max(arm, (sk.center() - c).norm() + sk.r);
-    }
-  const double motion = std::max(w.norm() * arm * dt, o.frame_motion);
-  return std::isfinite(motion) ? motion : unknown;
 }
 
 double World::obstacle_approach(const RuntimeObject& o, double dt) const {
@@ -626,12 +578,9 @@ int World::contact_cycles(double dt) const {
   // each pair must close by at most cycle_motion / kSlowContact leaf radii
   // per cycle at this count (the main job: ~0.05 leaf radii per cycle).
   // (the pairs' motion only: the obstacles' cycles bound the projection
-  // step, not how fast a pair closes) Where the pairs close faster, as many
-  // cycles as keep that closing per cycle, if fewer than the stiffness
-  // rule's: the same criterion at a higher count (many_objects: its spinning
-  // bunnies ask 12-23 pair cycles, 3x that is 36-69 against the rule's 64).
-  const int slow = kSlowContact * motion_cycles(dt, /*pairs_only=*/true);
-  return std::clamp(std::max(at_step, slow), 1, stiff);
+  // step, not how fast a pair closes)
+  if (kSlowContact * motion_cycles(dt, /*pairs_only=*/true) > at_step) return stiff;
+  return std::clamp(at_step, 1, stiff);
 }
 
 void World::update_spheres(RuntimeObject& o) const {
@@ -1553,14 +1502,7 @@ FrameMetrics World::advance(std::optional<double> budget) {
   m.frame = m_frame;
   m.min_step = std::numeric_limits<double>::infinity();
   m.budget = budget ? *budget : m_settings.collision.query.budget_seconds;
-  for (RuntimeObject& o : m_objects) {
-    o.substeps = 0;
-    // (the start of the frame's sweep: the spheres at the actual positions)
-    if (o.sim && m_settings.collision.swept) {
-      o.frame_start_spheres = o.start_spheres;
-      o.frame_start_centre = (o.positions.transpose() * o.node_mass) / o.node_mass.sum();
-    }
-  }
+  for (RuntimeObject& o : m_objects) o.substeps = 0;
 
   // Real-time mode: collision detection gets what is left of the frame (of
   // the first `fraction` of it), shared between the pairs, but never less
@@ -1694,21 +1636,6 @@ void World::run_cycles(double t0, double length, int n, int depth, bool ends_fra
 
 FrameMetrics World::finish_frame(FrameMetrics& m, Clock::time_point frame_start) {
   m.energy = m_penalty_energy;
-  // Each object's net sphere motion over the frame apart from its centre's
-  // (closing_motion).
-  for (RuntimeObject& o : m_objects) {
-    if (!o.sim) continue;
-    o.frame_motion = std::numeric_limits<double>::infinity();
-    const std::vector<collision::Sphere>& a = o.frame_start_spheres;
-    const std::vector<collision::Sphere>& b = o.start_spheres;
-    if (a.empty() || a.size() != b.size()) continue;
-    const Eigen::Vector3d shift =
-        (o.positions.transpose() * o.node_mass) / o.node_mass.sum() - o.frame_start_centre;
-    double d = 0;
-    for (size_t k = 0; k < a.size(); ++k)
-      d = std::max(d, (b[k].center() - a[k].center() - shift).norm() + std::abs(b[k].r - a[k].r));
-    o.frame_motion = d;
-  }
   // (an element pass per object: on the workers, summed in object order)
   m_object_energy.assign(m_objects.size(), 0.0);
   for_each_object([&](int k) {

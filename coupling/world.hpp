@@ -6,7 +6,6 @@
 #include <chrono>
 #include <functional>
 #include <memory>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -148,16 +147,6 @@ struct RuntimeObject {
   std::vector<collision::SweptSphere> swept;
   double motion = 0;       ///< largest sphere motion in the last cycle, m
   double speed = 0;        ///< motion / cycle length of the last cycle, m/s
-  /// collision.swept: the spheres and the centre of mass at the start of
-  /// the frame (actual positions), and the largest sphere displacement from
-  /// them to the end of the last frame apart from the centre's, m (infinity:
-  /// not measured yet): its rotation and deformation over the frame.
-  /// Vibration moves a sphere back and forth within a frame: its net motion
-  /// over the frame is far less than its speed times the frame
-  /// (World::closing_motion).
-  std::vector<collision::Sphere> frame_start_spheres;
-  Eigen::Vector3d frame_start_centre = Eigen::Vector3d::Zero();
-  double frame_motion = std::numeric_limits<double>::infinity();
   double leaf_radius = 0;  ///< median rest leaf radius, m (scale of the motion per cycle)
   /// Obstacles: the longest rigid link (m), the object's motion scale (its
   /// median leaf radius, m), and scratch dense positions.
@@ -369,20 +358,6 @@ class World {
   /// kObstacleStep per cycle (obstacle_approach). pairs_only: the pairs'
   /// bound alone.
   int motion_cycles(double dt, bool pairs_only = false) const;
-  /// How far deformable object o may move toward another over the coming
-  /// frame of dt apart from its centre of mass, m, as motion_cycles counts
-  /// it for a pair (whose centres close at their relative velocity): the
-  /// larger of its rotation at the current angular velocity (times its leaf
-  /// spheres' farthest reach from the centre) and its net sphere motion apart from the
-  /// centre's over the last frame (RuntimeObject::frame_motion). Not its
-  /// fastest sphere's speed times dt: a vibrating node moving at 7 m/s moves
-  /// a few mm over a frame, and two objects falling side by side do not
-  /// close. A prediction, not a bound: a cycle that starts apart and first
-  /// meets a pair deeper than a leaf after more motion than the cycle allows
-  /// is re-run shorter (the split), and the sweep misses no contact whatever
-  /// the count. infinity when unknown; `centre_velocity` gets the
-  /// mass-weighted mean node velocity.
-  double closing_motion(const RuntimeObject& o, double dt, Eigen::Vector3d& centre_velocity) const;
   /// fit_cycles for the frame of dt: the deformable objects that run the
   /// cycles (not deferred), each weighted by its tets, at its step_cap.
   int aligned_cycles(double dt, int n) const;

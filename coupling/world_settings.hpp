@@ -185,12 +185,11 @@ struct CollisionSpec {
   /// FEM sub-step of the objects that run them (the shortest of theirs):
   /// the cap keeps every node's penalty rate under the explicit limit at any
   /// cycle length, so each cycle may cost each object one sub-step
-  /// (World::contact_cycles). Slow contacts (each pair closing by at most a
-  /// third of collision.cycle_motion per cycle at that count) get the fewer
-  /// of that and the rule below; faster ones get 3x their motion cycles (at
-  /// least the sub-steps), at most the rule below: with the cap, longer
+  /// (World::contact_cycles). The count is the fewer of that and the rule
+  /// below, for slow contacts only (each pair closing by at most a third of
+  /// collision.cycle_motion per cycle at that count: with the cap, longer
   /// cycles mean a softer penalty, and balls thrown head-on at 5 m/s sank
-  /// 2.6 leaf radii deep at one cycle per sub-step. On by default since the deep-contact velocity
+  /// 2.6 leaf radii deep). On by default since the deep-contact velocity
   /// step is order-free (deep_contact_velocity_step): the 0.6 m/s head-on
   /// bounce of HeadOn.SoftSpheresBounceApartSymmetrically leaves with 1.52 %
   /// sideways drift with it, 1.18 % with the rule below (bound 2 %; with
