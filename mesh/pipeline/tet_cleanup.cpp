@@ -123,6 +123,24 @@ double min_dihedral(const MatX3d& V, const Tet& t) {
   return *std::min_element(s.dihedral_deg, s.dihedral_deg + 6);
 }
 
+// Smallest dihedral angle of the tets `around` node i with i at x, -1 when
+// one of them is not positive; V is left as it was.
+double star_min_dihedral(MatX3d& V, const std::vector<Tet>& T, const std::vector<int>& around,
+                         int i, const Eigen::Vector3d& x) {
+  const Eigen::RowVector3d keep = V.row(i);
+  V.row(i) = x.transpose();
+  double d = 180;
+  for (int e : around) {
+    if (!(tet_volume(V, T[static_cast<size_t>(e)]) > 0)) {
+      d = -1;
+      break;
+    }
+    d = std::min(d, min_dihedral(V, T[static_cast<size_t>(e)]));
+  }
+  V.row(i) = keep;
+  return d;
+}
+
 }  // namespace
 
 double ideal_omega(double mean_volume, double poisson) {
@@ -637,18 +655,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     const double cap = std::max(threshold, w.maxCoeff());
     // Smallest angle of i's tets with i at x (-1 when one is not positive).
     const auto star_min = [&](int i, const Eigen::Vector3d& x) {
-      const Eigen::RowVector3d keep = mesh.V.row(i);
-      mesh.V.row(i) = x.transpose();
-      double d = 180;
-      for (int e : L.around[static_cast<size_t>(i)]) {
-        if (!(tet_volume(mesh.V, T[static_cast<size_t>(e)]) > 0)) {
-          d = -1;
-          break;
-        }
-        d = std::min(d, min_dihedral(mesh.V, T[static_cast<size_t>(e)]));
-      }
-      mesh.V.row(i) = keep;
-      return d;
+      return star_min_dihedral(mesh.V, T, L.around[static_cast<size_t>(i)], i, x);
     };
     // The best of a few candidate positions of node i, or false.
     const auto relocate = [&](int i, Eigen::Vector3d& to, double& gain) {
@@ -794,18 +801,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       return std::sqrt(d2);
     };
     const auto star_min = [&](int i, const Eigen::Vector3d& x) {
-      const Eigen::RowVector3d keep = mesh.V.row(i);
-      mesh.V.row(i) = x.transpose();
-      double d = 180;
-      for (int e : L.around[static_cast<size_t>(i)]) {
-        if (!(tet_volume(mesh.V, T[static_cast<size_t>(e)]) > 0)) {
-          d = -1;
-          break;
-        }
-        d = std::min(d, min_dihedral(mesh.V, T[static_cast<size_t>(e)]));
-      }
-      mesh.V.row(i) = keep;
-      return d;
+      return star_min_dihedral(mesh.V, T, L.around[static_cast<size_t>(i)], i, x);
     };
     const double cap = std::max(threshold, w.maxCoeff());
     for (int sweep = 0; sweep < 2 * o.max_relocation_sweeps; ++sweep) {
