@@ -123,6 +123,24 @@ double min_dihedral(const MatX3d& V, const Tet& t) {
   return *std::min_element(s.dihedral_deg, s.dihedral_deg + 6);
 }
 
+// Node i moved to x: the volume change of its tets `around` and the largest
+// node frequency of the mesh then (the step bound); V is left as it was.
+struct TrialMove {
+  double volume_change = 0;
+  double max_frequency = 0;
+};
+TrialMove trial_move(MatX3d& V, const std::vector<Tet>& T, const std::vector<int>& around, int i,
+                     const Eigen::Vector3d& x, double poisson) {
+  const Eigen::RowVector3d keep = V.row(i);
+  TrialMove m;
+  for (int t : around) m.volume_change -= tet_volume(V, T[static_cast<size_t>(t)]);
+  V.row(i) = x.transpose();
+  for (int t : around) m.volume_change += tet_volume(V, T[static_cast<size_t>(t)]);
+  m.max_frequency = node_frequencies(V, T, poisson).maxCoeff();
+  V.row(i) = keep;
+  return m;
+}
+
 // Smallest dihedral angle of the tets `around` node i with i at x, -1 when
 // one of them is not positive; V is left as it was.
 double star_min_dihedral(MatX3d& V, const std::vector<Tet>& T, const std::vector<int>& around,
@@ -737,32 +755,24 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       for (const auto& [d0, e] : bad) {
         if (min_dihedral(mesh.V, T[static_cast<size_t>(e)]) >= o.dihedral_target_deg) continue;
         int best_i = -1;
-        double best_gain = 0;
+        double best_gain = 0, best_dv = 0;
         Eigen::Vector3d best_to = Eigen::Vector3d::Zero();
         for (int i : T[static_cast<size_t>(e)]) {
           Eigen::Vector3d to;
           double gain = 0;
           if (relocate(i, to, gain) && gain > best_gain) {
             // The step and volume bounds at the new position.
-            const Eigen::RowVector3d keep = mesh.V.row(i);
-            double dv = 0;
-            for (int t : L.around[static_cast<size_t>(i)]) dv -= tet_volume(mesh.V, T[static_cast<size_t>(t)]);
-            mesh.V.row(i) = to.transpose();
-            for (int t : L.around[static_cast<size_t>(i)]) dv += tet_volume(mesh.V, T[static_cast<size_t>(t)]);
-            const Eigen::VectorXd wc = node_frequencies(mesh.V, T, o.poisson);
-            mesh.V.row(i) = keep;
-            if (wc.maxCoeff() > cap || !volume_ok(volume + dv)) continue;
+            const TrialMove m = trial_move(mesh.V, T, L.around[static_cast<size_t>(i)], i, to, o.poisson);
+            if (m.max_frequency > cap || !volume_ok(volume + m.volume_change)) continue;
             best_i = i;
             best_gain = gain;
             best_to = to;
+            best_dv = m.volume_change;
           }
         }
         if (best_i < 0) continue;
-        double dv = 0;
-        for (int t : L.around[static_cast<size_t>(best_i)]) dv -= tet_volume(mesh.V, T[static_cast<size_t>(t)]);
         mesh.V.row(best_i) = best_to.transpose();
-        for (int t : L.around[static_cast<size_t>(best_i)]) dv += tet_volume(mesh.V, T[static_cast<size_t>(t)]);
-        volume += dv;
+        volume += best_dv;
         ++rep.relocations;
         ++moved_now;
       }
@@ -859,18 +869,12 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
             if (surf && off_boundary(p) > budget) continue;
             const double d = star_min(i, p);
             if (!(d > now + 1e-9) || d - now <= best_gain) continue;
-            const Eigen::RowVector3d keep = mesh.V.row(i);
-            double dv = 0;
-            for (int k : L.around[static_cast<size_t>(i)]) dv -= tet_volume(mesh.V, T[static_cast<size_t>(k)]);
-            mesh.V.row(i) = p.transpose();
-            for (int k : L.around[static_cast<size_t>(i)]) dv += tet_volume(mesh.V, T[static_cast<size_t>(k)]);
-            const Eigen::VectorXd wc = node_frequencies(mesh.V, T, o.poisson);
-            mesh.V.row(i) = keep;
-            if (wc.maxCoeff() > cap || !volume_ok(volume + dv)) continue;
+            const TrialMove m = trial_move(mesh.V, T, L.around[static_cast<size_t>(i)], i, p, o.poisson);
+            if (m.max_frequency > cap || !volume_ok(volume + m.volume_change)) continue;
             best_i = i;
             best_gain = d - now;
             best_to = p;
-            best_dv = dv;
+            best_dv = m.volume_change;
           }
         }
         if (best_i < 0) continue;
