@@ -45,6 +45,22 @@ WorldSettings deterministic() {
   return s;
 }
 
+/// A scripted (kinematic) ball held at x: its spheres are the same in every
+/// world whatever the budget (the level-of-detail tests).
+WorldObject still_ball(const std::string& name, const Eigen::Vector3d& x) {
+  WorldObject o = ball(name, x, {0, 0, 0});
+  o.setup.kind = ObjectKind::Rigid;
+  o.setup.motion = [](double) { return RigidPose{}; };  // rest = placed pose
+  return o;
+}
+
+/// deterministic() with an unlimited query budget: the level-of-detail oracle.
+WorldSettings unlimited() {
+  WorldSettings s = deterministic();
+  s.collision.query.budget_tests = -1;
+  return s;
+}
+
 /// Balls "left" and "right" at x = -x0 and x0, heading for each other at `speed`.
 std::vector<WorldObject> head_on_pair(double x0, double speed) {
   std::vector<WorldObject> v;
@@ -142,10 +158,7 @@ TEST(WorldScheduling, PrioritySplitFindsTheCriticalPairWhereTheEvenSplitDoesNot)
   const auto scene = [] {
     std::vector<WorldObject> v;
     const auto still = [&v](const std::string& name, const Eigen::Vector3d& x) {
-      WorldObject o = ball(name, x, {0, 0, 0});
-      o.setup.kind = ObjectKind::Rigid;
-      o.setup.motion = [](double) { return RigidPose{}; };  // rest = placed pose
-      v.push_back(std::move(o));
+      v.push_back(still_ball(name, x));
     };
     for (int k = 0; k < 3; ++k) {  // resting pairs: 2 mm overlap
       still("rest" + std::to_string(k) + "a", {-0.1 + 0.001, 1.0 * k, 0});
@@ -156,9 +169,7 @@ TEST(WorldScheduling, PrioritySplitFindsTheCriticalPairWhereTheEvenSplitDoesNot)
     v.push_back(ball("soft", {0, -5, 0}, {0, 0, 0}));  // a deformable object: response on
     return v;
   };
-  WorldSettings oracle_settings = deterministic();
-  oracle_settings.collision.query.budget_tests = -1;
-  World oracle(scene(), oracle_settings);
+  World oracle(scene(), unlimited());
   oracle.step();
   oracle.step();
   // The pairs of the plan: find the critical and the resting ones.
@@ -236,10 +247,7 @@ TEST(WorldScheduling, CheapestSplitAnswersAsManyPairsExactlyAsThePoolPaysFor) {
   const auto scene = [&] {
     std::vector<WorldObject> v;
     const auto still = [&v](const std::string& name, const Eigen::Vector3d& x) {
-      WorldObject o = ball(name, x, {0, 0, 0});
-      o.setup.kind = ObjectKind::Rigid;
-      o.setup.motion = [](double) { return RigidPose{}; };  // rest = placed pose
-      v.push_back(std::move(o));
+      v.push_back(still_ball(name, x));
     };
     for (int k = 0; k < 3; ++k) {
       still("p" + std::to_string(k) + "a", {-0.1 + overlap[k] / 2, 1.0 * k, 0});
@@ -248,9 +256,7 @@ TEST(WorldScheduling, CheapestSplitAnswersAsManyPairsExactlyAsThePoolPaysFor) {
     v.push_back(ball("soft", {0, -5, 0}, {0, 0, 0}));  // a deformable object: response on
     return v;
   };
-  WorldSettings oracle_settings = deterministic();
-  oracle_settings.collision.query.budget_tests = -1;
-  World oracle(scene(), oracle_settings);
+  World oracle(scene(), unlimited());
   oracle.step();
   const auto& pairs = oracle.plan().pairs;
   const auto pair_of = [&](int k) {
