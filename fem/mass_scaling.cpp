@@ -189,8 +189,8 @@ MassScalingReport apply_mass_scaling(Model& model, const Eigen::Ref<const MatX3d
       if (m0[i] > 0) m[i] = std::max(m0[i], lambda[i] / (th * th));
     return m;
   };
-  const auto over_limit = [&](double th) {
-    return masses_at(th).sum() - total > o.max_added_fraction * total;
+  const auto over_limit = [&](const Eigen::VectorXd& m) {
+    return m.sum() - total > o.max_added_fraction * total;
   };
   double prev_threshold = 0, prev_omega = 0;
   double missed = 0;     // the last threshold whose pass did not reach the target
@@ -200,7 +200,8 @@ MassScalingReport apply_mass_scaling(Model& model, const Eigen::Ref<const MatX3d
       r.pass_limited = true;
       break;
     }
-    if (over_limit(threshold)) {
+    Eigen::VectorXd m = masses_at(threshold);
+    if (over_limit(m)) {
       // A pass that would exceed the limit after one within it: the threshold
       // between the two whose added mass is the limit (the mass falls
       // monotonically with the threshold), one more pass there. Without it a
@@ -213,12 +214,12 @@ MassScalingReport apply_mass_scaling(Model& model, const Eigen::Ref<const MatX3d
       double lo = threshold, hi = r.node_omega;  // over the limit, within it
       for (int k = 0; k < 40 && hi > lo * (1 + 1e-9); ++k) {
         const double mid = std::sqrt(lo * hi);
-        (over_limit(mid) ? lo : hi) = mid;
+        (over_limit(masses_at(mid)) ? lo : hi) = mid;
       }
       threshold = hi;
       at_limit = true;
+      m = masses_at(threshold);
     }
-    const Eigen::VectorXd m = masses_at(threshold);
     model.set_masses(m);
     kept = m;
     ++r.passes;
