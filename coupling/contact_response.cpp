@@ -16,15 +16,39 @@ namespace {
 using collision::NodePair;
 using collision::SphereTree;
 
-void check_association(const SphereTree& t, Eigen::Index num_nodes, const char* which) {
+void check_node(int32_t n, Eigen::Index num_nodes, const char* which) {
+  if (n < 0 || n >= num_nodes)
+    throw ParameterError(std::string("contact response: tree ") + which +
+                         " refers to coarse node " + std::to_string(n) + " but the object has " +
+                         std::to_string(num_nodes));
+}
+
+// The tree's sphere-to-node association: every node of the whole tree, or
+// with a result only those of the spheres its pairs name on this side (the
+// per-cycle calls: O(pairs), not O(tree)), and those spheres exist.
+void check_association(const SphereTree& t, Eigen::Index num_nodes, const char* which,
+                       const collision::CollisionResult* result = nullptr) {
   if (t.assoc_offset.size() != t.spheres.size() + 1)
     throw ParameterError(std::string("contact response: tree ") + which +
                          " has no sphere-to-node association");
-  for (int32_t n : t.assoc_nodes)
-    if (n < 0 || n >= num_nodes)
-      throw ParameterError(std::string("contact response: tree ") + which +
-                           " refers to coarse node " + std::to_string(n) + " but the object has " +
-                           std::to_string(num_nodes));
+  if (!result) {
+    for (int32_t n : t.assoc_nodes) check_node(n, num_nodes, which);
+    return;
+  }
+  const bool side_a = which[0] == 'a';
+  const auto check = [&](const std::vector<NodePair>& pairs) {
+    for (const NodePair& p : pairs) {
+      const int32_t s = side_a ? p.a : p.b;
+      if (s < 0 || static_cast<size_t>(s) >= t.spheres.size())
+        throw ParameterError(std::string("contact response: a pair names sphere ") +
+                             std::to_string(s) + " of tree " + which + ", which has " +
+                             std::to_string(t.spheres.size()));
+      for (int32_t j = t.assoc_offset[s]; j < t.assoc_offset[s + 1]; ++j)
+        check_node(t.assoc_nodes[j], num_nodes, which);
+    }
+  };
+  check(result->colliding);
+  check(result->untested);
 }
 
 // Per-object accumulator: forces per node and, for PaperAverage, counts.
@@ -138,8 +162,8 @@ void add_contact_rates(const SphereTree& a, const SphereTree& b,
                        Eigen::VectorXd& rate_a, Eigen::VectorXd& rate_b) {
   if (!options.mass_a || !options.mass_b)
     throw ParameterError("contact response: node rates need mass_a and mass_b");
-  check_association(a, options.mass_a->size(), "a");
-  check_association(b, options.mass_b->size(), "b");
+  check_association(a, options.mass_a->size(), "a", &result);
+  check_association(b, options.mass_b->size(), "b", &result);
   if (rate_a.size() != options.mass_a->size() || rate_b.size() != options.mass_b->size())
     throw ParameterError("contact response: one rate per coarse node needed");
   const double k = options.stiffness;
@@ -162,8 +186,8 @@ ContactStats apply_contact_forces(const SphereTree& a, const SphereTree& b,
   if (!(options.stiffness > 0.0) || !std::isfinite(options.stiffness))
     throw ParameterError("contact response: stiffness must be positive and finite (got " +
                          std::to_string(options.stiffness) + ")");
-  check_association(a, forces_a.rows(), "a");
-  check_association(b, forces_b.rows(), "b");
+  check_association(a, forces_a.rows(), "a", &result);
+  check_association(b, forces_b.rows(), "b", &result);
   auto check_mass = [](const Eigen::VectorXd* m, Eigen::Index rows, const char* which) {
     if (!m) return;
     if (m->size() != rows || !(m->minCoeff() > 0.0) || !m->allFinite())
@@ -272,8 +296,8 @@ DeepContactStats deep_contact_velocity_step(const SphereTree& a, const SphereTre
                                             const Eigen::VectorXd& mass_a,
                                             const Eigen::VectorXd& mass_b, Eigen::Ref<MatX3d> vel_a,
                                             Eigen::Ref<MatX3d> vel_b, double depth_ratio) {
-  check_association(a, vel_a.rows(), "a");
-  check_association(b, vel_b.rows(), "b");
+  check_association(a, vel_a.rows(), "a", &result);
+  check_association(b, vel_b.rows(), "b", &result);
   if (mass_a.size() != vel_a.rows() || mass_b.size() != vel_b.rows() ||
       !(mass_a.minCoeff() > 0.0) || !(mass_b.minCoeff() > 0.0))
     throw ParameterError("deep contact step: one positive mass per node and object needed");

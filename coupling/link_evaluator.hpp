@@ -91,6 +91,18 @@ class LinkEvaluator {
   LinkApplyResult apply_triples(const Eigen::Ref<const MatX3d>& coarse_positions,
                                 const std::vector<int32_t>& triples, Eigen::Ref<MatX3d> dense_out);
 
+  /// As apply_triples(), writing only the listed links (each a link of one
+  /// of the listed triples, any order): their rows bitwise equal to what
+  /// apply() writes there, the other rows left as they are. ParameterError
+  /// for a link outside [0, num_links()) or not of a listed triple. For
+  /// callers that can tell from the coarse nodes which vertices they need.
+  LinkApplyResult apply_links(const Eigen::Ref<const MatX3d>& coarse_positions,
+                              const std::vector<int32_t>& triples,
+                              const std::vector<int32_t>& links, Eigen::Ref<MatX3d> dense_out);
+
+  /// The triple of link k (its index in [0, num_triples())).
+  int32_t link_triple(int k) const { return m_link_triple[static_cast<size_t>(k)]; }
+
   /// Forgets the frame state: the next apply() behaves as on a new evaluator.
   void reset_frames();
 
@@ -132,6 +144,10 @@ class LinkEvaluator {
   /// doubles (aligned packets). The frame part is the state kept between calls.
   Eigen::Matrix<double, 24, Eigen::Dynamic> m_table;
   std::vector<char> m_has_frame;  ///< #T: m_table holds a frame of this triple
+  /// #T: the apply_links() call that last updated each triple's frame
+  /// (that call's number, m_calls), so a link of another triple is refused.
+  std::vector<uint32_t> m_updated_in;
+  uint32_t m_calls = 0;
 };
 
 }  // namespace icd::coupling

@@ -208,6 +208,13 @@ World::World(std::vector<WorldObject> objects, WorldSettings settings)
       if (!o.sim) continue;  // static and kinematic objects move as they are told
       if (o.links.num_links() == 0) o.links = LinkEvaluator(o.asset.links);
       o.max_link = o.asset.links.coeffs.rows() ? o.asset.links.coeffs.rowwise().norm().maxCoeff() : 0;
+      // (in triple order, as obstacle_layer walks them)
+      o.link_bound.resize(4 * static_cast<size_t>(o.asset.links.num_links()));
+      for (size_t j = 0; j < o.links.triple_links().size(); ++j) {
+        const int32_t k = o.links.triple_links()[j];
+        for (int i = 0; i < 3; ++i) o.link_bound[4 * j + i] = o.asset.links.alpha(k, i);
+        o.link_bound[4 * j + 3] = o.asset.links.coeffs.row(k).norm();
+      }
       o.triple_reach.assign(static_cast<size_t>(o.links.num_triples()), 0.0);
       for (int t = 0; t < o.links.num_triples(); ++t)
         for (int32_t j = o.links.links_of_triple(t); j < o.links.links_of_triple(t + 1); ++j) {
@@ -1124,7 +1131,7 @@ void World::obstacle_layer(RuntimeObject& o, double threshold, bool same_triples
   const int num_links = o.asset.links.num_links();
   if (o.obstacle_dense.rows() != num_links) o.obstacle_dense.resize(num_links, 3);
   if (same_triples && m_settings.obstacle_cull) {  // the same layer at the current positions
-    o.links.apply_triples(o.positions, o.obstacle_triples, o.obstacle_dense);
+    o.links.apply_links(o.positions, o.obstacle_triples, o.obstacle_layer, o.obstacle_dense);
     return;
   }
   o.obstacle_layer.clear();
@@ -1158,36 +1165,105 @@ void World::obstacle_layer(RuntimeObject& o, double threshold, bool same_triples
                 (ob.type == Obstacle::Type::Box ? ob.half_extents.maxCoeff() : 0.0));
   }
   o.obstacle_triples.clear();
-  const int num_triples = o.links.num_triples();
-  for (int t = 0; t < num_triples; ++t) {
+  // Per triple, per near obstacle: its nodes' coordinates (node-major, 3 x 3;
+  // a plane: the first of each three), loaded once for the triple's bound
+  // and then for each of its links'.
+  const size_t num_near = o.obstacle_near.size();
+  std::vector<double>& nq = o.obstacle_scratch;
+  nq.resize(9 * num_near);
+  const std::vector<int32_t>& links = o.links.triple_links();
+  // Whether triple t may hold a vertex closer than thr to a near obstacle
+  // (a lower bound of their signed distance, per obstacle: from the range
+  // of its nodes' coordinates on each axis, less triple_reach); loads nq.
+  const auto near_triple = [&](int t, double thr) {
     const double reach = o.triple_reach[static_cast<size_t>(t)];
-    bool take = reach < 0;
     const int32_t* nodes = o.links.triple_nodes(t);
-    for (size_t i = 0; i < o.obstacle_near.size() && !take; ++i) {
+    bool take = false;
+    for (size_t i = 0; i < num_near; ++i) {
       const int b = o.obstacle_near[i];
       const Obstacle& ob = m_settings.obstacles[static_cast<size_t>(b)];
       const MatX3d& q = o.obstacle_local[static_cast<size_t>(b)];
+      double* v = &nq[9 * i];
+      const bool plane = ob.type == Obstacle::Type::Plane;
+      for (int a = 0; a < 3; ++a)
+        for (int d = 0; d < (plane ? 1 : 3); ++d) v[3 * a + d] = q(nodes[a], d);
+      if (take) continue;  // (the loads are still needed for the links)
       double bound;
-      if (ob.type == Obstacle::Type::Plane) {
-        bound = std::min({q(nodes[0], 0), q(nodes[1], 0), q(nodes[2], 0)});
+      if (plane) {
+        bound = std::min({v[0], v[3], v[6]});
       } else {
         bound = -std::numeric_limits<double>::infinity();
         for (int k = 0; k < 3; ++k) {
-          const double lo = std::min({q(nodes[0], k), q(nodes[1], k), q(nodes[2], k)});
-          const double hi = std::max({q(nodes[0], k), q(nodes[1], k), q(nodes[2], k)});
+          const double lo = std::min({v[k], v[3 + k], v[6 + k]});
+          const double hi = std::max({v[k], v[3 + k], v[6 + k]});
           bound = std::max(bound, std::max(lo, -hi) - ob.half_extents[k]);
         }
       }
       // (NaN: taken)
-      take = !(bound - reach - slack[static_cast<size_t>(b)] >= threshold);
+      take = !(bound - reach - slack[static_cast<size_t>(b)] >= thr);
     }
-    if (take) o.obstacle_triples.push_back(t);
+    return take;
+  };
+  // The candidates: the triples within kObstacleListMargin more than the
+  // threshold when the list was made, kept while no node has moved that far
+  // since (a node moving by D changes a bound by at most D: the obstacle
+  // frames are orthonormal) and the near obstacles are the same.
+  const int num_triples = o.links.num_triples();
+  const double list_slack = 1e-9 * (1 + scale);
+  const bool reuse =
+      o.obstacle_list_near == o.obstacle_near && threshold <= o.obstacle_list_threshold &&
+      o.obstacle_list_from.rows() == n &&
+      (o.positions - o.obstacle_list_from).rowwise().squaredNorm().maxCoeff() <=
+          std::pow(std::max(0.0, kObstacleListMargin - list_slack), 2);
+  if (!reuse) {  // (made for the projection's threshold too, so that both callers use it)
+    const double list_threshold = std::max(threshold, kObstacleStep);
+    o.obstacle_list.clear();
+    for (int t = 0; t < num_triples; ++t)
+      if (o.triple_reach[static_cast<size_t>(t)] < 0 ||
+          near_triple(t, list_threshold + kObstacleListMargin))
+        o.obstacle_list.push_back(t);
+    o.obstacle_list_near = o.obstacle_near;
+    o.obstacle_list_threshold = list_threshold;
+    o.obstacle_list_from = o.positions;
   }
-  o.links.apply_triples(o.positions, o.obstacle_triples, o.obstacle_dense);
-  const std::vector<int32_t>& links = o.links.triple_links();
-  for (int32_t t : o.obstacle_triples)
-    o.obstacle_layer.insert(o.obstacle_layer.end(), links.begin() + o.links.links_of_triple(t),
-                            links.begin() + o.links.links_of_triple(t + 1));
+  for (int32_t t : o.obstacle_list) {
+    const double reach = o.triple_reach[static_cast<size_t>(t)];
+    const int32_t begin = o.links.links_of_triple(t), end = o.links.links_of_triple(t + 1);
+    if (reach < 0) {  // no bound: every link
+      o.obstacle_triples.push_back(t);
+      o.obstacle_layer.insert(o.obstacle_layer.end(), links.begin() + begin, links.begin() + end);
+      continue;
+    }
+    const bool take = near_triple(t, threshold);
+    if (!take) continue;
+    o.obstacle_triples.push_back(t);
+    // Per link: the same bound from its own origin (sum_i alpha_i q_i, exact
+    // for any weights: q is linear) and its own link length (its vector c
+    // moves the vertex by at most |c| along any axis of the obstacle's
+    // frame, the link frame being orthonormal).
+    for (int32_t j = begin; j < end; ++j) {
+      const double* w = &o.link_bound[4 * static_cast<size_t>(j)];
+      const double c = w[3];
+      bool near = false;
+      for (size_t i = 0; i < num_near && !near; ++i) {
+        const int b = o.obstacle_near[i];
+        const Obstacle& ob = m_settings.obstacles[static_cast<size_t>(b)];
+        const double* v = &nq[9 * i];
+        double bound;
+        if (ob.type == Obstacle::Type::Plane) {
+          bound = w[0] * v[0] + w[1] * v[3] + w[2] * v[6];
+        } else {
+          bound = -std::numeric_limits<double>::infinity();
+          for (int d = 0; d < 3; ++d)
+            bound = std::max(bound, std::abs(w[0] * v[d] + w[1] * v[3 + d] + w[2] * v[6 + d]) -
+                                        ob.half_extents[d]);
+        }
+        near = !(bound - c - slack[static_cast<size_t>(b)] >= threshold);  // (NaN: taken)
+      }
+      if (near) o.obstacle_layer.push_back(links[static_cast<size_t>(j)]);
+    }
+  }
+  o.links.apply_links(o.positions, o.obstacle_triples, o.obstacle_layer, o.obstacle_dense);
   // (in triple order: the callers break ties by vertex index, as a pass over
   // every vertex in order would)
 }

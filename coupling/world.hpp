@@ -162,12 +162,24 @@ struct RuntimeObject {
   /// evaluated). A link's vertex lies within it of its origin, a convex
   /// combination of the triple's nodes (World::obstacle_layer).
   std::vector<double> triple_reach;
+  /// Per link, in the order of LinkEvaluator::triple_links(): its origin
+  /// weights alpha_0..2 and the length of its link vector |c| (m; its vertex
+  /// lies within it of its origin), 4 doubles (World::obstacle_layer).
+  std::vector<double> link_bound;
   /// Scratch of the obstacle handling: the obstacles within reach, the node
   /// coordinates in each one's frame, the triples and the dense vertices
   /// (in triple order) that may be near one.
   std::vector<int> obstacle_near;
   std::vector<MatX3d> obstacle_local;
   std::vector<int32_t> obstacle_triples, obstacle_layer;
+  std::vector<double> obstacle_scratch;
+  /// The triples that may come within obstacle_list_threshold +
+  /// World::kObstacleListMargin of the obstacles obstacle_list_near, found
+  /// at the node positions obstacle_list_from (World::obstacle_layer).
+  std::vector<int32_t> obstacle_list;
+  std::vector<int> obstacle_list_near;
+  double obstacle_list_threshold = 0;
+  MatX3d obstacle_list_from;
   bool near_obstacle = false;  ///< came within reach of an obstacle in the last cycle
   /// Support of the obstacles for the coming cycle (#coarse nodes x 3, N;
   /// empty when none): see World::obstacle_support.
@@ -390,9 +402,12 @@ class World {
   /// A triple is skipped when a lower bound of the signed distance of its
   /// vertices (from its nodes' coordinates in the obstacle's frame, each
   /// vertex being within triple_reach of a convex combination of them) is
-  /// at least the threshold, so the skipped vertices are exactly ones the
-  /// callers would have found too far: the same results, bitwise, as testing
-  /// every vertex (WorldSettings::obstacle_cull = false).
+  /// at least the threshold; in the triples kept, a vertex is skipped when
+  /// the same bound from its own origin (its weights applied to the nodes'
+  /// coordinates) and its own link length is. So the skipped vertices are
+  /// exactly ones the callers would have found too far: the same results,
+  /// bitwise, as testing every vertex (WorldSettings::obstacle_cull = false).
+  /// Only the layer's vertices are evaluated (LinkEvaluator::apply_links).
   /// With same_triples: the last call's layer, evaluated at the current
   /// positions (for a caller that knows the nodes have not moved enough to
   /// change it).
@@ -469,6 +484,9 @@ class World {
   /// A dense vertex this close to an obstacle (m) is resting on it: its
   /// coarse nodes get the obstacle's support (obstacle_support()).
   static constexpr double kObstacleContact = 1e-4;
+  /// How much farther than asked obstacle_layer lists triples, m: the list
+  /// stands until a node has moved this far.
+  static constexpr double kObstacleListMargin = 4e-3;
   /// Longest cycle near an obstacle, s.
   static constexpr double kObstacleCycle = 1e-3;
   /// Runs f(k) for every object index k, on m_threads workers (each object

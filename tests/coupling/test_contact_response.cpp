@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 
 #include <Eigen/Dense>
 
@@ -174,7 +175,24 @@ TEST(ContactResponse, BadParametersThrow) {
   o.stiffness = -1;
   EXPECT_THROW(apply_contact_forces(a, a, r, o, fa, fb), ParameterError);
   o.stiffness = 1;
-  EXPECT_THROW(apply_contact_forces(a, a, r, o, fa, fb), ParameterError);  // node 5 of 1
+  // The association is checked where a pair uses it (O(pairs) per call, not
+  // O(tree)): sphere 1 refers to node 5 of 1.
+  EXPECT_NO_THROW(apply_contact_forces(a, a, r, o, fa, fb));
+  r.untested.push_back({0, 1});
+  const auto message = [&] {
+    try {
+      apply_contact_forces(a, a, r, o, fa, fb);
+    } catch (const ParameterError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message().find("tree b refers to coarse node 5 but the object has 1"), std::string::npos)
+      << message();
+  r.untested = {{0, 0}};
+  EXPECT_NO_THROW(apply_contact_forces(a, a, r, o, fa, fb));
+  r.colliding.push_back({7, 0});  // no sphere 7
+  EXPECT_NE(message().find("names sphere 7 of tree a, which has 2"), std::string::npos) << message();
   SphereTree none = a;
   none.assoc_offset.clear();
   EXPECT_THROW(apply_contact_forces(none, none, r, {}, fa, fb), ParameterError);

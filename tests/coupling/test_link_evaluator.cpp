@@ -162,6 +162,35 @@ TEST(LinkEvaluator, ApplyTriplesEqualsApplyBitwiseOnTheirLinks) {
     EXPECT_LT(written, N);
   }
   EXPECT_THROW(part.apply_triples(o.coarse.V, {part.num_triples()}, b), ParameterError);
+
+  // apply_links: only the listed links of the listed triples, bitwise as apply().
+  std::vector<int32_t> some;
+  for (int k = 0; k < N; k += 2)
+    if (chosen[static_cast<size_t>(k)]) some.push_back(k);
+  std::shuffle(some.begin(), some.end(), rng);
+  ASSERT_FALSE(some.empty());
+  LinkEvaluator sparse(o.links);
+  for (int trial = 0; trial < 3; ++trial) {
+    const MatX3d X = random_deformation(o.coarse.V, rng, 0.05);
+    full.apply(X, a);
+    b.setConstant(-7.0);
+    sparse.apply_links(X, triples, some, b);
+    std::vector<char> listed(static_cast<size_t>(N), 0);
+    for (int32_t k : some) listed[static_cast<size_t>(k)] = 1;
+    for (int k = 0; k < N; ++k) {
+      if (listed[static_cast<size_t>(k)])
+        for (int d = 0; d < 3; ++d) ASSERT_EQ(a(k, d), b(k, d)) << "link " << k;
+      else
+        ASSERT_EQ(b.row(k), Eigen::RowVector3d::Constant(-7.0)) << "link " << k;
+    }
+  }
+  int outside = -1;  // a link of a triple not listed
+  for (int k = 0; k < N && outside < 0; ++k)
+    if (!chosen[static_cast<size_t>(k)]) outside = k;
+  ASSERT_GE(outside, 0);
+  EXPECT_THROW(sparse.apply_links(o.coarse.V, triples, {outside}, b), ParameterError);
+  EXPECT_THROW(sparse.apply_links(o.coarse.V, triples, {N}, b), ParameterError);
+  EXPECT_NO_THROW(sparse.apply_links(o.coarse.V, {}, {}, b));
 }
 
 // The real dragon bundles (made by the CTest fixture real_bundles into
