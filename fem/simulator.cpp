@@ -34,6 +34,9 @@ Simulator::Simulator(Model model, const SimulatorOptions& options)
     bad("frequency_reuse_time", options.frequency_reuse_time, ">= 0 s");
   if (!(options.frequency_reuse_strain >= 0))
     bad("frequency_reuse_strain", options.frequency_reuse_strain, ">= 0 (inf: no trigger)");
+  if (!(options.frequency_reuse_strain_per_slack >= 0) ||
+      !std::isfinite(options.frequency_reuse_strain_per_slack))
+    bad("frequency_reuse_strain_per_slack", options.frequency_reuse_strain_per_slack, ">= 0, finite");
   m_state.x = m_model.mesh().rest_positions;
   m_state.v = MatX3d::Zero(m_model.num_nodes(), 3);
   m_energy_floor = 1e-10 * m_model.material().young * m_model.mesh().rest_volume.sum();
@@ -66,13 +69,24 @@ void Simulator::set_velocities(const Eigen::Ref<const MatX3d>& v) {
     if (m_model.fixed_nodes()[i]) m_state.v.row(i).setZero();
 }
 
-double Simulator::stable_step_limit() {
+double Simulator::stable_step_limit(double frame_dt) {
   if (m_options.integrator == Integrator::BackwardEuler)
     return std::numeric_limits<double>::infinity();
-  // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time).
-  const bool fresh = m_estimate_time >= 0 &&
-                     m_time - m_estimate_time < m_options.frequency_reuse_time &&
-                     !deformed_since_estimate();
+  // Reuse a recent estimate when allowed (see SimulatorOptions::frequency_reuse_time),
+  // with more strain when the step advance(frame_dt) would take with it has
+  // slack (frequency_reuse_strain_per_slack).
+  bool fresh = m_estimate_time >= 0 && m_time - m_estimate_time < m_options.frequency_reuse_time;
+  if (fresh) {
+    double tolerance = m_options.frequency_reuse_strain;
+    if (frame_dt > 0 && m_options.fixed_step == 0 && m_options.frequency_reuse_strain_per_slack > 0 &&
+        m_cached_limit > 0 && std::isfinite(m_cached_limit)) {
+      const double h = std::min(m_options.max_step, m_options.safety_factor * m_cached_limit);
+      const double taken = frame_dt / std::ceil(frame_dt / std::min(h, frame_dt));
+      const double slack = m_options.safety_factor * m_cached_limit / taken;
+      if (slack > 1) tolerance += m_options.frequency_reuse_strain_per_slack * (slack - 1);
+    }
+    fresh = !deformed_since_estimate(tolerance);
+  }
   m_last_products = 0;
   if (fresh) return m_cached_limit;
   FrequencyOptions fo = m_options.frequency;
@@ -120,9 +134,8 @@ void Simulator::record_estimate_lengths() {
         (m_state.x.row(m_edges[k].first) - m_state.x.row(m_edges[k].second)).norm();
 }
 
-bool Simulator::deformed_since_estimate() const {
+bool Simulator::deformed_since_estimate(double tol) const {
   if (m_estimate_lengths.size() != static_cast<Eigen::Index>(m_edges.size())) return true;
-  const double tol = m_options.frequency_reuse_strain;
   for (size_t k = 0; k < m_edges.size(); ++k) {
     const double l0 = m_estimate_lengths[static_cast<Eigen::Index>(k)];
     const double l = (m_state.x.row(m_edges[k].first) - m_state.x.row(m_edges[k].second)).norm();
@@ -430,7 +443,7 @@ AdvanceReport Simulator::advance(double frame_dt) {
     throw ParameterError("fem::Simulator::advance: frame_dt = " + std::to_string(frame_dt) +
                          " must be > 0");
   AdvanceReport rep;
-  rep.step_limit = stable_step_limit();
+  rep.step_limit = stable_step_limit(frame_dt);
   rep.omega_max = m_frequency.omega_bound;
   rep.frequency_products = m_last_products;
   double h;

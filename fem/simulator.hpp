@@ -76,6 +76,20 @@ struct SimulatorOptions {
   /// Euler step 13% above the true limit. A safeguard tested against the dense
   /// eigensolve, not a proven bound.
   double frequency_reuse_strain = 0.01;
+  /// More strain allowed before a reused estimate is dropped when the step
+  /// that advance() would take with it is below its limit: per unit of slack
+  /// s - 1, where s = safety_factor x the estimate's limit / that step (>= 0;
+  /// 0: frequency_reuse_strain alone). It holds while omega_max grows by at
+  /// most a factor 1 + (strain - frequency_reuse_strain) / this (0.1: 10x the
+  /// edge strain; 0.25 let symplectic Euler step 0.4 % above the dense
+  /// oracle's limit in StableStep.AmortisedEstimateNeverStepsAboveTheTrueLimitOfAnyCycle,
+  /// where part of the slack goes to the estimate's own error). For callers
+  /// that advance in pieces shorter than the step (coupling::World's contact
+  /// cycles), which would otherwise estimate again at almost every piece of a
+  /// vibrating object. A safeguard tested against the dense eigensolve
+  /// (StableStep.SlackAllowsMoreStrainButNeverAStepAboveTheTrueLimit), not a
+  /// proven bound; the health checks still guard every step.
+  double frequency_reuse_strain_per_slack = 0.1;
   /// Sub-steps between health checks (>= 1; default: every step). With the
   /// explicit integrators a check rides on the next step: det F (and, with
   /// EnergyCheck::Full, the elastic energy) of state n in the element pass
@@ -144,7 +158,7 @@ class Simulator {
 
   /// Stable step limit (s) of the configured integrator for the current state
   /// (inf for backward Euler); also updates last_frequency().
-  double stable_step_limit();
+  double stable_step_limit() { return stable_step_limit(0); }
   const FrequencyEstimate& last_frequency() const { return m_frequency; }
 
   /// Advances by frame_dt (s) in equal sub-steps: the fixed step, or
@@ -206,8 +220,11 @@ class Simulator {
   /// Mesh edges (node pairs) and their lengths at the last estimate (m).
   std::vector<std::pair<int, int>> m_edges;
   Eigen::VectorXd m_estimate_lengths;
-  /// Whether every edge is within frequency_reuse_strain of its length at the last estimate.
-  bool deformed_since_estimate() const;
+  /// stable_step_limit() for advance(frame_dt) (0: no step planned, no slack).
+  double stable_step_limit(double frame_dt);
+  /// Whether some edge has changed length by more than `tolerance` (a
+  /// fraction) since the last estimate.
+  bool deformed_since_estimate(double tolerance) const;
   void record_estimate_lengths();
   int m_last_products = 0;       ///< Lanczos products of the last stable_step_limit()
   bool m_checked_valid = false;  ///< m_checked_elastic is the elastic energy of m_state

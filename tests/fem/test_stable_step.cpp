@@ -233,14 +233,15 @@ TEST(StableStep, IntegratorsAreStableAt099AndBlowUpAt105OfTheEstimate) {
 // x and y stretched) that stiffens as it compresses and rebounds (stable
 // Neo-Hookean at nu = 0.45: omega_max from 1920 up to ~2340 rad/s within 30
 // ms). Frames of `frame` s; returns per frame the Simulator's report and the
-// dense omega_max at the frame's start and end states. reuse_time: see
+// dense omega_max at the frame's start and end states (0 without the oracle). reuse_time: see
 // SimulatorOptions::frequency_reuse_time (1e9: the first estimate frozen).
 struct SqueezeFrame {
   AdvanceReport rep;
   double omega_start = 0, omega_end = 0;
 };
 std::vector<SqueezeFrame> squeeze(Integrator integ, double reuse_time, int frames, double frame,
-                                  double k = 150 /* 1/s */) {
+                                  double k = 150 /* 1/s */, double per_slack = 0.1,
+                                  bool oracle = true) {
   const TetMesh m = test::box(3, 3, 3, {0.3, 0.3, 0.3});
   const Material mat = test::material(MaterialModel::StableNeoHookean, 1e6, 0.45);
   Model model(m.V, m.T, mat);
@@ -248,6 +249,7 @@ std::vector<SqueezeFrame> squeeze(Integrator integ, double reuse_time, int frame
   SimulatorOptions o;
   o.integrator = integ;
   o.frequency_reuse_time = reuse_time;
+  o.frequency_reuse_strain_per_slack = per_slack;
   if (reuse_time >= 1e9) o.frequency_reuse_strain = std::numeric_limits<double>::infinity();  // frozen
   Simulator sim(std::move(model), o);
   MatX3d v(m.V.rows(), 3);
@@ -256,12 +258,12 @@ std::vector<SqueezeFrame> squeeze(Integrator integ, double reuse_time, int frame
                                    -(m.V(i, 2) - 0.15));
   sim.set_velocities(v);
   std::vector<SqueezeFrame> out;
-  double omega = dense_omega_max(reference, sim.positions());
+  double omega = oracle ? dense_omega_max(reference, sim.positions()) : 0.0;
   for (int f = 0; f < frames; ++f) {
     SqueezeFrame pf;
     pf.omega_start = omega;
     pf.rep = sim.advance(frame);
-    omega = dense_omega_max(reference, sim.positions());
+    omega = oracle ? dense_omega_max(reference, sim.positions()) : 0.0;
     pf.omega_end = omega;
     out.push_back(pf);
   }
@@ -345,6 +347,40 @@ TEST(StableStep, AmortisedEstimateNeverStepsAboveTheTrueLimitOfAnyCycle) {
   }
 }
 
+// Pieces much shorter than the step (coupling::World's contact cycles: the
+// step is the piece, ~5x below its limit here): the slack lets a reused
+// estimate stand through more strain (SimulatorOptions::
+// frequency_reuse_strain_per_slack), so fewer estimates are made than with
+// the 1% trigger alone, and still no piece's step exceeds the dense
+// oracle's limit at its start or end state, through the hard squeeze
+// (omega_max +20 %) and a harder one (twice the squeeze rate).
+TEST(StableStep, SlackAllowsMoreStrainButNeverAStepAboveTheTrueLimit) {
+  const double piece = 2.5e-4;
+  const int pieces = 60;
+  for (Integrator integ : {Integrator::SymplecticEuler, Integrator::RK4}) {
+    for (double k : {150.0, 300.0}) {
+      int estimates = 0, plain_estimates = 0;
+      double worst = 0, slack = 0;
+      for (const SqueezeFrame& pf : squeeze(integ, 1e-2, pieces, piece, k)) {
+        const double limit = stable_step_limit(integ, std::max(pf.omega_start, pf.omega_end), {});
+        EXPECT_EQ(pf.rep.retries, 0) << to_string(integ);
+        EXPECT_LE(pf.rep.step, limit) << to_string(integ) << " k " << k;
+        worst = std::max(worst, pf.rep.step / limit);
+        slack = std::max(slack, 0.9 * pf.rep.step_limit / pf.rep.step);
+        estimates += pf.rep.frequency_products > 0;
+      }
+      for (const SqueezeFrame& pf :
+           squeeze(integ, 1e-2, pieces, piece, k, /*per_slack=*/0, /*oracle=*/false))
+        plain_estimates += pf.rep.frequency_products > 0;
+      EXPECT_GT(slack, 3) << to_string(integ);  // the pieces are well below the step
+      EXPECT_LT(estimates, plain_estimates) << to_string(integ) << " k " << k;
+      std::printf("%s, squeeze %.0f 1/s: %d estimates in %d pieces (%d with the 1%% trigger "
+                  "alone), largest step / true limit %.3f\n",
+                  to_string(integ), k, estimates, pieces, plain_estimates, worst);
+    }
+  }
+}
+
 // Simulator::correct_positions (a static obstacle's projection in
 // coupling::World): a correction that strains no edge by more than
 // frequency_reuse_strain keeps the estimate (no Lanczos product in the next
@@ -358,6 +394,7 @@ TEST(StableStep, PositionCorrectionKeepsTheEstimateUntilTheStrainTrigger) {
   SimulatorOptions o;
   o.integrator = Integrator::RK4;
   o.frequency_reuse_time = 1e-2;
+  o.frequency_reuse_strain_per_slack = 0;  // the 1% trigger alone (its slack rule: above)
   Simulator sim(Model(m.V, m.T, mat), o);
   const double cycle = 1e-3;
   EXPECT_GT(sim.advance(cycle).frequency_products, 0);  // the first estimate
