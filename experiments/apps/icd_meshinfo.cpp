@@ -12,6 +12,7 @@
 
 #include <icd/mesh/core/error.hpp>
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include <icd/mesh/core/mesh_stats.hpp>
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
@@ -97,9 +98,9 @@ void print_vtu(const std::string& file) {
   for (const std::string& a : point_data) row("point data", a);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// Reports each file that fails ("icd-meshinfo: <what>") and goes on to the
+// next; status 1 if any failed.
+int run(int argc, char** argv) {
   std::vector<std::filesystem::path> files;
   icd::experiments::Cli cli(
       "icd-meshinfo",
@@ -131,4 +132,10 @@ int main(int argc, char** argv) {
     }
   }
   return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("icd-meshinfo", run, argc, argv);
 }

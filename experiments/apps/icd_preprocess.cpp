@@ -8,9 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
-#include <exception>
 #include <filesystem>
-#include <iostream>
 #include <string>
 #include <variant>
 #include <vector>
@@ -21,6 +19,7 @@
 #include <icd/mesh/io/surface_reader.hpp>
 #include <icd/mesh/pipeline/preprocess.hpp>
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 
 namespace {
 
@@ -268,74 +267,73 @@ void print_summary(const Command& c, const icd::mesh::PreprocessResult& r, doubl
               load_cpu_ms);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The program; throws on bad input (main() reports it).
+int run(int argc, char** argv) {
   const auto parsed = parse(argc, argv);
   if (const int* status = std::get_if<int>(&parsed)) return *status;
   const Command& cli = std::get<Command>(parsed);
   using Clock = std::chrono::steady_clock;
-  try {
-    const auto t0 = Clock::now();
-    icd::ReadReport read_report;
-    const icd::SurfaceMesh dense = icd::read_surface_mesh(cli.input, &read_report);
-    for (const std::string& w : read_report.warnings)  // even with --quiet
-      std::fprintf(stderr, "icd-preprocess: warning: %s: %s\n", cli.input.c_str(), w.c_str());
-    if (!cli.quiet)
-      std::printf("[read] %s: %s, %lld vertices, %lld triangles (%.2f s)\n", cli.input.c_str(),
-                  read_report.format.c_str(), static_cast<long long>(read_report.vertices),
-                  static_cast<long long>(read_report.triangles),
-                  std::chrono::duration<double>(Clock::now() - t0).count());
-    const int num_stages = 4 +
-                           (cli.options.sphere_builder != icd::mesh::SphereBuilder::none ? 1 : 0) +
-                           (cli.options.compute_hausdorff ? 1 : 0);
-    int stage_index = 0;
-    const icd::mesh::ProgressFn progress = [&](const std::string& stage, const std::string& msg) {
-      if (cli.quiet) return;
-      if (msg == "start") {
-        std::printf("[%d/%d] %s ...\n", ++stage_index, num_stages, stage.c_str());
-      } else {
-        std::printf("[%d/%d] %s: %s\n", stage_index, num_stages, stage.c_str(), msg.c_str());
-      }
-      std::fflush(stdout);
-    };
-    const icd::mesh::PreprocessResult r =
-        icd::mesh::preprocess(dense, cli.options, progress, cli.input);
+  const auto t0 = Clock::now();
+  icd::ReadReport read_report;
+  const icd::SurfaceMesh dense = icd::read_surface_mesh(cli.input, &read_report);
+  for (const std::string& w : read_report.warnings)  // even with --quiet
+    std::fprintf(stderr, "icd-preprocess: warning: %s: %s\n", cli.input.c_str(), w.c_str());
+  if (!cli.quiet)
+    std::printf("[read] %s: %s, %lld vertices, %lld triangles (%.2f s)\n", cli.input.c_str(),
+                read_report.format.c_str(), static_cast<long long>(read_report.vertices),
+                static_cast<long long>(read_report.triangles),
+                std::chrono::duration<double>(Clock::now() - t0).count());
+  const int num_stages = 4 +
+                         (cli.options.sphere_builder != icd::mesh::SphereBuilder::none ? 1 : 0) +
+                         (cli.options.compute_hausdorff ? 1 : 0);
+  int stage_index = 0;
+  const icd::mesh::ProgressFn progress = [&](const std::string& stage, const std::string& msg) {
+    if (cli.quiet) return;
+    if (msg == "start") {
+      std::printf("[%d/%d] %s ...\n", ++stage_index, num_stages, stage.c_str());
+    } else {
+      std::printf("[%d/%d] %s: %s\n", stage_index, num_stages, stage.c_str(), msg.c_str());
+    }
+    std::fflush(stdout);
+  };
+  const icd::mesh::PreprocessResult r =
+      icd::mesh::preprocess(dense, cli.options, progress, cli.input);
 
-    const auto tw = Clock::now();
-    icd::coupling::write_asset_bundle(cli.output, r.bundle);
-    if (!cli.sph.empty()) {  // under a temporary name until complete
-      const std::string part = cli.sph + ".part";
-      try {
-        icd::collision::write_sph(part, r.bundle.spheres);
-      } catch (...) {
-        std::filesystem::remove(part);
-        throw;
-      }
-      std::filesystem::rename(part, cli.sph);
+  const auto tw = Clock::now();
+  icd::coupling::write_asset_bundle(cli.output, r.bundle);
+  if (!cli.sph.empty()) {  // under a temporary name until complete
+    const std::string part = cli.sph + ".part";
+    try {
+      icd::collision::write_sph(part, r.bundle.spheres);
+    } catch (...) {
+      std::filesystem::remove(part);
+      throw;
     }
-    const double write_s = std::chrono::duration<double>(Clock::now() - tw).count();
-    std::vector<double> load_ms, load_cpu_ms;
-    for (int i = 0; i < 5; ++i) {
-      const auto tl = Clock::now();
-      const std::clock_t cl = std::clock();
-      const icd::coupling::AssetBundle loaded = icd::coupling::read_asset_bundle(cli.output);
-      load_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - tl).count());
-      load_cpu_ms.push_back(1000.0 * static_cast<double>(std::clock() - cl) / CLOCKS_PER_SEC);
-      if (loaded.links.num_links() != r.bundle.links.num_links()) {
-        std::fprintf(stderr, "icd-preprocess: the written bundle does not read back\n");
-        return 1;
-      }
-    }
-    std::sort(load_ms.begin(), load_ms.end());
-    std::sort(load_cpu_ms.begin(), load_cpu_ms.end());
-    print_summary(cli, r, write_s, load_ms[2], load_cpu_ms[2]);
-  } catch (const icd::ParameterError& e) {
-    std::fprintf(stderr, "icd-preprocess: invalid option: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "icd-preprocess: %s\n", e.what());
-    return 1;
+    std::filesystem::rename(part, cli.sph);
   }
+  const double write_s = std::chrono::duration<double>(Clock::now() - tw).count();
+  std::vector<double> load_ms, load_cpu_ms;
+  for (int i = 0; i < 5; ++i) {
+    const auto tl = Clock::now();
+    const std::clock_t cl = std::clock();
+    const icd::coupling::AssetBundle loaded = icd::coupling::read_asset_bundle(cli.output);
+    load_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - tl).count());
+    load_cpu_ms.push_back(1000.0 * static_cast<double>(std::clock() - cl) / CLOCKS_PER_SEC);
+    if (loaded.links.num_links() != r.bundle.links.num_links()) {
+      std::fprintf(stderr, "icd-preprocess: the written bundle does not read back\n");
+      return 1;
+    }
+  }
+  std::sort(load_ms.begin(), load_ms.end());
+  std::sort(load_cpu_ms.begin(), load_cpu_ms.end());
+  print_summary(cli, r, write_s, load_ms[2], load_cpu_ms[2]);
   return 0;
+}
+
+}  // namespace
+
+// A ParameterError (an option value the pipeline refuses) is bad usage:
+// "icd-preprocess: invalid option: ...", status 2.
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main<icd::ParameterError>("icd-preprocess", run, argc, argv);
 }

@@ -19,6 +19,7 @@
 
 #include <icd/mesh/core/error.hpp>
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
 #include <icd/mesh/io/surface_writer.hpp>
@@ -167,9 +168,7 @@ std::string mutate(const std::string& seed, std::mt19937_64& rng) {
   return s;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   long iterations = 200000;
   unsigned long seed = 0;
   using icd::experiments::Cli;
@@ -209,4 +208,10 @@ int main(int argc, char** argv) {
       "%ld mutants of %zu seeds: %ld parsed, %ld rejected with InputError, 0 bugs (%.1f s)\n",
       iterations, seeds.size(), accepted, rejected, sec);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("fuzz_mesh_readers", run, argc, argv);
 }

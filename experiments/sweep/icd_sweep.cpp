@@ -5,7 +5,7 @@
 // results.csv is byte-identical whichever backend ran the cases.
 // See experiments/sweep/README.md.
 #include "experiments/common/cli.hpp"
-#include <unistd.h>
+#include "experiments/common/guarded_main.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -18,8 +18,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include <icd/config.hpp>
 #include <icd/mesh/io/atomic_write.hpp>
@@ -232,9 +230,68 @@ int emit_slurm(const Plan& plan, const fs::path& out, const fs::path& self, std:
   return 0;
 }
 
-}  // namespace
+/// What the command line asks for.
+struct Options {
+  std::string sweep_file, out;
+  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  long long case_k = -1;
+  std::size_t chunk = 0;
+  bool setup_only = false, gather_only = false, emit = false, list = false, force = false,
+       quiet = false, use_mpi = false;
+  fs::path self;  ///< this program
+};
 
-int main(int argc, char** argv) {
+/// Runs the mode the options select; throws on a bad sweep file or a failed
+/// step.
+int sweep(const Options& o) {
+  const Plan plan = load_plan(o.sweep_file, o.self.parent_path());
+  const fs::path out = fs::absolute(o.out.empty() ? fs::path("results/sweeps") / plan.name : fs::path(o.out));
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  if (o.list) {
+    for (const Case& c : plan.cases) {
+      std::printf("%zu %s", c.index, c.id.c_str());
+      for (const auto& [k, v] : c.params) std::printf(" %s=%s", k.c_str(), v.c_str());
+      std::printf("\n");
+    }
+    return 0;
+  }
+  if (o.emit) return emit_slurm(plan, out, o.self, o.chunk);
+  if (o.setup_only) {
+    run_setup(plan, out);
+    return 0;
+  }
+  if (o.gather_only) return report(plan, read_results(plan, out), out, 0);
+  if (o.case_k >= 0) {
+    const std::size_t c = o.chunk ? o.chunk : 1;
+    const auto first = static_cast<std::size_t>(o.case_k) * c;
+    if (first >= plan.cases.size()) {
+      std::fprintf(stderr, "icd-sweep: --case %lld: the sweep has %zu cases (%zu per task)\n", o.case_k,
+                   plan.cases.size(), c);
+      return 2;
+    }
+    int status = 0;
+    for (std::size_t k = first; k < std::min(plan.cases.size(), first + c) && !stop_requested(); ++k) {
+      CaseResult r;
+      if (!o.force && finished(out, plan.cases[k], &r)) {
+        std::fprintf(stderr, "[icd-sweep] case %zu %s: finished earlier (skipped)\n", k, r.id.c_str());
+        continue;
+      }
+      r = run_case(plan, plan.cases[k], out);
+      std::fprintf(stderr, "[icd-sweep] case %zu %s: %s%s%s\n", k, r.id.c_str(), r.status.c_str(),
+                   r.message.empty() ? "" : ": ", r.message.c_str());
+      if (r.status != "ok") status = 1;
+    }
+    return status;
+  }
+#ifdef ICD_SWEEP_WITH_MPI
+  if (o.use_mpi) return run_mpi(plan, out, o.force, o.quiet);
+#endif
+  return run_local(plan, out, o.jobs, o.force, o.quiet);
+}
+
+/// The program; throws on a bad sweep file (main() reports it).
+int run(int argc, char** argv) {
   icd::experiments::Cli cli(
       "icd-sweep",
       "Runs a parameter study (a sweep file, JSON) as independent cases and gathers one\n"
@@ -243,101 +300,59 @@ int main(int argc, char** argv) {
       "SWEEP.json), a Slurm job array (--emit-slurm; then --case K per task, --gather).\n"
       "Exit status: 0 all cases ok, 1 a case not ok or a bad sweep file, 2 a bad command line.");
   std::filesystem::path sweep_path;
-  std::string sweep_file, out_opt, backend = "auto";
-  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  long long case_k = -1;
-  std::size_t chunk = 0;
-  bool setup_only = false, gather_only = false, emit = false, list = false, force = false, quiet = false;
+  std::string backend = "auto";
+  Options o;
   cli.argument("SWEEP", sweep_path, "the sweep file (JSON; see experiments/sweep/README.md)", true)
-      .text("--out", out_opt, "DIR", "output folder (default results/sweeps/<sweep name>)")
-      .integer("-j,--jobs", jobs, "N", "local backend: cases run at once (default: the CPU count)", 1, 4096)
+      .text("--out", o.out, "DIR", "output folder (default results/sweeps/<sweep name>)")
+      .integer("-j,--jobs", o.jobs, "N", "local backend: cases run at once (default: the CPU count)", 1, 4096)
       .custom("--backend", "auto|local|mpi", "local, mpi, or auto (mpi when started by mpirun/srun)",
               [&](const std::string& v) {
                 if (v != "auto" && v != "local" && v != "mpi")
                   throw std::invalid_argument("must be auto, local or mpi, not '" + v + "'");
                 backend = v;
               })
-      .integer("--case", case_k, "K",
+      .integer("--case", o.case_k, "K",
                "run only case K (with --chunk C: cases K*C .. K*C+C-1), no gather", 0LL, 1LL << 40)
-      .integer("--chunk", chunk, "C",
+      .integer("--chunk", o.chunk, "C",
                "cases per --case task / Slurm array task (default 1; --emit-slurm: N/1000 rounded up)",
                std::size_t{1}, std::size_t{1} << 30)
-      .flag("--setup", setup_only, "run the sweep file's setup commands only (the Slurm setup step)")
-      .flag("--gather", gather_only, "gather the finished cases' results only (the Slurm gather step)")
-      .flag("--emit-slurm", emit, "write <out>/slurm/{array,gather}.sbatch and submit.sh, run nothing")
-      .flag("--list", list, "print the expanded cases (index, id, parameters), run nothing")
-      .flag("--force", force, "run the finished cases again too")
-      .flag("--quiet", quiet, "no progress lines");
+      .flag("--setup", o.setup_only, "run the sweep file's setup commands only (the Slurm setup step)")
+      .flag("--gather", o.gather_only, "gather the finished cases' results only (the Slurm gather step)")
+      .flag("--emit-slurm", o.emit, "write <out>/slurm/{array,gather}.sbatch and submit.sh, run nothing")
+      .flag("--list", o.list, "print the expanded cases (index, id, parameters), run nothing")
+      .flag("--force", o.force, "run the finished cases again too")
+      .flag("--quiet", o.quiet, "no progress lines");
   if (const auto status = cli.parse(argc, argv)) return *status;
-  sweep_file = sweep_path.string();
-  const int modes = (case_k >= 0) + setup_only + gather_only + emit + list;
+  o.sweep_file = sweep_path.string();
+  const int modes = (o.case_k >= 0) + o.setup_only + o.gather_only + o.emit + o.list;
   if (modes > 1) {
     return icd::experiments::Cli::fail("icd-sweep", "--case, --setup, --gather, --emit-slurm and --list exclude each other");
   }
-  const fs::path self = fs::canonical("/proc/self/exe");
-  bool use_mpi = backend == "mpi";
+  o.self = fs::canonical("/proc/self/exe");
+  o.use_mpi = backend == "mpi";
 #ifdef ICD_SWEEP_WITH_MPI
-  if (backend == "auto" && modes == 0) use_mpi = under_mpi_launcher();
-  if (use_mpi) MPI_Init(&argc, &argv);
+  if (backend == "auto" && modes == 0) o.use_mpi = under_mpi_launcher();
+  if (o.use_mpi) {
+    MPI_Init(&argc, &argv);
+    int status = 1;
+    try {
+      status = sweep(o);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "icd-sweep: %s\n", e.what());
+      MPI_Abort(MPI_COMM_WORLD, 1);  // the other ranks may wait for this one
+    }
+    MPI_Finalize();
+    return status;
+  }
 #else
-  if (use_mpi) {
+  if (o.use_mpi) {
     std::fprintf(stderr, "icd-sweep: --backend mpi: this icd-sweep was built without MPI\n");
     return 2;
   }
 #endif
-  int status = 0;
-  try {
-    const Plan plan = load_plan(sweep_file, self.parent_path());
-    const fs::path out = fs::absolute(out_opt.empty() ? fs::path("results/sweeps") / plan.name : fs::path(out_opt));
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
-    if (list) {
-      for (const Case& c : plan.cases) {
-        std::printf("%zu %s", c.index, c.id.c_str());
-        for (const auto& [k, v] : c.params) std::printf(" %s=%s", k.c_str(), v.c_str());
-        std::printf("\n");
-      }
-    } else if (emit) {
-      status = emit_slurm(plan, out, self, chunk);
-    } else if (setup_only) {
-      run_setup(plan, out);
-    } else if (gather_only) {
-      status = report(plan, read_results(plan, out), out, 0);
-    } else if (case_k >= 0) {
-      const std::size_t c = chunk ? chunk : 1;
-      const auto first = static_cast<std::size_t>(case_k) * c;
-      if (first >= plan.cases.size()) {
-        std::fprintf(stderr, "icd-sweep: --case %lld: the sweep has %zu cases (%zu per task)\n", case_k,
-                     plan.cases.size(), c);
-        return 2;
-      }
-      for (std::size_t k = first; k < std::min(plan.cases.size(), first + c) && !stop_requested(); ++k) {
-        CaseResult r;
-        if (!force && finished(out, plan.cases[k], &r)) {
-          std::fprintf(stderr, "[icd-sweep] case %zu %s: finished earlier (skipped)\n", k, r.id.c_str());
-          continue;
-        }
-        r = run_case(plan, plan.cases[k], out);
-        std::fprintf(stderr, "[icd-sweep] case %zu %s: %s%s%s\n", k, r.id.c_str(), r.status.c_str(),
-                     r.message.empty() ? "" : ": ", r.message.c_str());
-        if (r.status != "ok") status = 1;
-      }
-    } else if (use_mpi) {
-#ifdef ICD_SWEEP_WITH_MPI
-      status = run_mpi(plan, out, force, quiet);
-#endif
-    } else {
-      status = run_local(plan, out, jobs, force, quiet);
-    }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "icd-sweep: %s\n", e.what());
-    status = 1;
-#ifdef ICD_SWEEP_WITH_MPI
-    if (use_mpi) MPI_Abort(MPI_COMM_WORLD, 1);  // the other ranks may wait for this one
-#endif
-  }
-#ifdef ICD_SWEEP_WITH_MPI
-  if (use_mpi) MPI_Finalize();
-#endif
-  return status;
+  return sweep(o);
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return icd::experiments::guarded_main("icd-sweep", run, argc, argv); }

@@ -12,7 +12,11 @@ in a fresh empty working folder, with a 20 s limit, and must:
                     "<name>: unknown option '--no-such-option' (see --help)"
                     on stderr, nothing on stdout, create no file.
 The programs that read files named on the command line, given a file that
-does not exist, exit non-zero, name the file on stderr and create nothing.
+does not exist, exit non-zero (not by a signal), name the file on stderr and
+create nothing. The programs that write a file named on the command line,
+given one in a folder that does not exist, exit 1 (not by a signal: no
+std::terminate), print "<name>: ..." naming the file on stderr and create
+nothing.
 Prints one line per failure and exits 1 if any.
 """
 import argparse
@@ -33,6 +37,13 @@ FILE_PROGRAMS = {
     "icd-preprocess": ["{missing}", "-o", "{out}"],
     "icd-read-check": ["{missing}"],
     "evaluate_sph": ["{missing}", "{missing}"],
+}
+
+# Programs that write a file named on the command line, and the arguments
+# that name one they cannot create ({unwritable}: in a missing folder).
+OUTPUT_PROGRAMS = {
+    "icd_collision_overrun": ["--csv", "{unwritable}"],
+    "fem_compression": ["{unwritable}"],
 }
 
 
@@ -56,6 +67,7 @@ def main():
         programs = [line.strip() for line in f if line.strip()]
     failures = []
     checked_files = 0
+    checked_outputs = 0
 
     def fail(program, what):
         failures.append(f"{os.path.basename(program)}: {what}")
@@ -102,16 +114,35 @@ def main():
                 out_dir = os.path.join(cwd, "out")
                 args = [x.format(missing=missing, out=out_dir) for x in FILE_PROGRAMS[name]]
                 status, out, err, _ = run(program, args, cwd)
-                if status is None or status == 0:
-                    fail(program, f"missing input: exit {status}, expected non-zero")
+                if status is None or status <= 0:
+                    fail(program, f"missing input: exit {status}, expected non-zero (not a "
+                                  f"signal)")
                 if "no_such_input.off" not in err:
                     fail(program, f"missing input: stderr does not name the file: {err.strip()!r}")
                 if os.listdir(cwd):
                     fail(program, f"missing input: created {sorted(os.listdir(cwd))}")
+        if name in OUTPUT_PROGRAMS:
+            checked_outputs += 1
+            with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
+                unwritable = os.path.join(cwd, "no_such_folder", "out.csv")
+                args = [x.format(unwritable=unwritable) for x in OUTPUT_PROGRAMS[name]]
+                status, out, err, _ = run(program, args, cwd)
+                if status != 1:
+                    fail(program, f"unwritable output: exit {status}, expected 1; stderr: "
+                                  f"{err.strip()[:200]!r}")
+                if not err.startswith(f"{name}: ") or unwritable not in err:
+                    fail(program, f"unwritable output: stderr does not start with '{name}: ' "
+                                  f"and name the file: {err.strip()[:200]!r}")
+                if os.listdir(cwd):
+                    fail(program, f"unwritable output: created {sorted(os.listdir(cwd))}")
+    names = {os.path.basename(p) for p in programs}
+    for name in sorted(set(OUTPUT_PROGRAMS) - names):
+        fail(name, "in OUTPUT_PROGRAMS but not in the program list (renamed?)")
     for line in failures:
         print("FAIL", line)
     print(f"{len(programs)} programs checked (--help, --version, unknown option); "
-          f"{checked_files} given a missing input file; {len(failures)} failures")
+          f"{checked_files} given a missing input file, {checked_outputs} an unwritable output "
+          f"file; {len(failures)} failures")
     return 1 if failures else 0
 
 

@@ -19,6 +19,8 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <stdexcept>
+#include <stop_token>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,6 +28,7 @@
 #include <icd/collision/traversal.hpp>
 #include "experiments/studies/collision/workloads.hpp"
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 
 using namespace icd::collision;
 using namespace icd::collision::experiments;
@@ -45,19 +48,18 @@ void spin_for(double s) {
 // records how late it sees them, binned per budget, plus the gaps between
 // consecutive clock reads.
 struct Floor {
-  std::atomic<bool> stop{false};
   std::atomic<int> bin{-1};  // index of the budget being measured, -1 = idle
   std::vector<double> budgets;
   std::vector<std::vector<double>> lateness;  // per budget, seconds past the deadline
   std::vector<double> gaps;                   // gaps > 1 us between consecutive clock reads
   double spun = 0;
-  void run() {
+  void run(const std::stop_token& stop) {
     std::mt19937 rng(42);
     std::uniform_real_distribution<double> jitter(0.0, 20e-6);
     lateness.assign(budgets.size(), {});
     const auto t_begin = Clock::now();
     auto prev = Clock::now();
-    while (!stop.load(std::memory_order_relaxed)) {
+    while (!stop.stop_requested()) {
       const int k = bin.load(std::memory_order_relaxed);
       const double wait = (k < 0 ? 10e-6 : budgets[k]) + jitter(rng);
       const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -82,9 +84,7 @@ struct Config {
   CollisionRequest request;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   long long max_queries = 10000;
   double max_seconds = 4.0;
   std::string csv_path;
@@ -93,6 +93,13 @@ int main(int argc, char** argv) {
       .real("--max-seconds", max_seconds, "S", "wall time at most (default 4)", 0.0)
       .text("--csv", csv_path, "FILE", "also write the measurements as CSV");
   if (const auto status = cli.parse(argc, argv)) return *status;
+  std::ofstream csv;
+  if (!csv_path.empty()) {
+    csv.open(csv_path);
+    if (!csv) throw std::runtime_error("--csv: cannot write '" + csv_path + "'");
+    csv << "config,budget_s,queries,completed,early,early_p50_us,early_max_us,overruns,p50_us,"
+           "p99_us,p999_us,max_us,median_tests\n";
+  }
   std::printf("icd_collision_overrun: load average at start %s (/proc/loadavg)\n",
               icd::experiments::load_average().c_str());
   // Workload: two deep octree trees over overlapping icospheres: a full
@@ -137,19 +144,10 @@ int main(int argc, char** argv) {
 
   Floor floor;
   floor.budgets = budgets;
-  std::thread floor_thread([&] { floor.run(); });
+  // Stopped and joined on every way out (jthread), an exception included.
+  std::jthread floor_thread([&](const std::stop_token& stop) { floor.run(stop); });
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> jitter(0.0, 20e-6);
-  std::ofstream csv;
-  if (!csv_path.empty()) {
-    csv.open(csv_path);
-    if (!csv) {
-      std::fprintf(stderr, "error: --csv: cannot write '%s'\n", csv_path.c_str());
-      return 1;
-    }
-    csv << "config,budget_s,queries,completed,early,early_p50_us,early_max_us,overruns,p50_us,"
-           "p99_us,p999_us,max_us,median_tests\n";
-  }
   // Warm up the result buffers and calibrations.
   for (const Config& c : configs) {
     CollisionRequest r = c.request;
@@ -206,7 +204,7 @@ int main(int argc, char** argv) {
     }
   }
   floor.bin = -1;
-  floor.stop = true;
+  floor_thread.request_stop();
   floor_thread.join();
   std::printf(
       "\nfloor (other thread, same run, %.1f s): lateness past deadlines of the same length, per "
@@ -230,4 +228,10 @@ int main(int argc, char** argv) {
       1e6 * quantile(floor.gaps, 0.99), 1e6 * quantile(floor.gaps, 1.0));
   std::printf("load average at end %s\n", icd::experiments::load_average().c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("icd_collision_overrun", run, argc, argv);
 }

@@ -22,6 +22,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include <icd/fem/constitutive.hpp>
 #include <icd/fem/stable_step.hpp>
 #include <icd/mesh/core/primitives.hpp>
@@ -76,9 +77,7 @@ double dense_omega_max(Model& model, const MatX3d& x) {
   return std::sqrt(es.eigenvalues().maxCoeff());
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   using icd::experiments::Cli;
   std::filesystem::path out_path;
   Cli cli("fem_compression", "  Prints the table; OUTPUT gets a copy.");
@@ -145,4 +144,10 @@ int main(int argc, char** argv) {
   emit(line);
   if (out) std::fclose(out);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("fem_compression", run, argc, argv);
 }

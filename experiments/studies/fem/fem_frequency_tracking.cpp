@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/studies/fem/clamped_bar.hpp"
 #include <icd/fem/simulator.hpp>
 #include <icd/mesh/core/primitives.hpp>
@@ -26,9 +27,7 @@ namespace {
 using namespace icd;
 using namespace icd::fem;
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   icd::experiments::Cli cli("fem_frequency_tracking",
                             "  Prints how the per-frame omega_max re-estimate tracks the truth and "
                             "the\n  safety margin per integrator (see the top of "
@@ -106,4 +105,10 @@ int main(int argc, char** argv) {
                   to_string(integ), safety, substeps, retries, outcome.substr(0, 160).c_str());
     }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("fem_frequency_tracking", run, argc, argv);
 }

@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/common/timing.hpp"
 #include "experiments/studies/fem/clamped_bar.hpp"
 #include <icd/fem/lane_loops.hpp>
@@ -85,9 +86,7 @@ double cpu_per_call(Op&& op) {
   return median(t);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   using icd::experiments::Cli;
   bool block = false;
   int threads = 1;
@@ -290,4 +289,10 @@ int main(int argc, char** argv) {
   }
   std::printf("load average after: %s\n", load_average().c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("fem_realtime", run, argc, argv);
 }

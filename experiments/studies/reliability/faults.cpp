@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "experiments/common/cli.hpp"
+#include "experiments/common/guarded_main.hpp"
 #include "experiments/runner/scene.hpp"
 #include "experiments/runner/run.hpp"
 #include <icd/config.hpp>
@@ -115,9 +116,7 @@ Outcome run_case(const Case& c, int frames) {
   return out;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   int frames = 120;
   icd::experiments::Cli cli("faults", "  Fault cases of the full loop, each reported.");
   cli.integer("--frames", frames, "N", "frames per case (default 120)", 1);
@@ -168,4 +167,10 @@ int main(int argc, char** argv) {
     ok = ok && o.status != "FAILED";
   }
   return ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return icd::experiments::guarded_main("faults", run, argc, argv);
 }
