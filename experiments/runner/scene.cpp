@@ -767,7 +767,8 @@ void apply_overrides(Json& json, const std::vector<std::string>& overrides) {
     Json value = Json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (value.is_discarded()) value = text;  // not JSON: a string
     Json* at = &json;
-    std::string path;
+    Json* parent = nullptr;  // the object holding the last key (null: none)
+    std::string path, last;
     size_t start = 0;
     while (true) {
       const size_t dot = key.find('.', start);
@@ -783,10 +784,13 @@ void apply_overrides(Json& json, const std::vector<std::string>& overrides) {
           throw InputError(shown + ": " + path + "[" + part + "]: index past the end (" + path +
                            " has " + std::to_string(at->size()) + " entries)");
         path += "[" + part + "]";
+        parent = nullptr;
         at = &(*at)[idx];
       } else if (at->is_object() || at->is_null()) {
         if (at->is_null()) *at = Json::object();
         path += (path.empty() ? "" : ".") + part;
+        parent = at;
+        last = part;
         at = &(*at)[part];
       } else {
         throw InputError(shown + ": " + path + " is a " + at->type_name() +
@@ -795,7 +799,10 @@ void apply_overrides(Json& json, const std::vector<std::string>& overrides) {
       if (dot == std::string::npos) break;
       start = dot + 1;
     }
-    *at = std::move(value);
+    if (value.is_null() && parent)  // key=null removes the key (as a JSON merge patch does)
+      parent->erase(last);
+    else
+      *at = std::move(value);
   }
 }
 

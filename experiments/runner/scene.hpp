@@ -47,7 +47,10 @@ Json read_scene_json(const std::filesystem::path& path);
 /// Applies "dotted.path=value" overrides to a scene document (after its
 /// includes): the path's parts are object keys or array indices
 /// ("objects.1.material.young=2e5"); the value is parsed as JSON, or taken
-/// as a string when it is not JSON ("name=probe run"). Missing object keys
+/// as a string when it is not JSON ("name=probe run"); `key=null` removes
+/// the key (as in a JSON merge patch: the field's default applies, e.g.
+/// "collision.budget_seconds=null" with "collision.budget_tests=400" for a
+/// test budget in a scene that gives seconds). Missing object keys
 /// are created (an unknown one is then refused by parse_scene as in a file);
 /// an index past the end of an array, a path through a number or a string,
 /// or an override without '=' throws InputError naming the override.

@@ -211,6 +211,18 @@ TEST(SceneJson, OverridesSetValuesOfEveryType) {
   write(d / "inc.json", R"({"include": "s.json", "frames": 7})");
   EXPECT_EQ(load_scene(d / "inc.json", {"frames=8"}).frames, 8);
   EXPECT_EQ(load_scene(d / "inc.json").frames, 7);
+  // key=null removes the key: the default applies, and a budget in seconds
+  // can be swapped for a test budget (both at once are refused).
+  write(d / "b.json", std::string("{\"frames\": 5, \"collision\": {\"budget_seconds\": 0.002}, "
+                                  "\"objects\": [") + kSphere + "]}");
+  EXPECT_EQ(load_scene(d / "b.json", {"frames=null"}).frames, Scene{}.frames);
+  EXPECT_NE(input_error([&] { load_scene(d / "b.json", {"collision.budget_tests=400"}); })
+                .find("contradict"),
+            std::string::npos);
+  const Scene t = load_scene(d / "b.json", {"collision.budget_seconds=null", "collision.budget_tests=400"});
+  EXPECT_EQ(t.world.collision.query.budget_tests, 400);
+  EXPECT_EQ(load_scene(d / "b.json").world.collision.query.budget_seconds, 0.002);
+  EXPECT_EQ(load_scene(d / "b.json", {"collision.nothing=null"}).frames, 5);  // absent: nothing to remove
 }
 
 TEST(SceneJson, BadOverridesAreRefusedNamingTheKey) {
