@@ -18,13 +18,6 @@ constexpr double kInvSqrt3 = 0.57735026918962576451;
 /// to right triangles with legs <= step, covering radius about 0.57 spacing,
 /// like the lattice's spacing / sqrt(3).
 constexpr double kColumnStep = 0.8;
-/// A triangle is sampled by columns when the lattice would give it at least
-/// this many times as many points. Well-shaped triangles (the bunny's and
-/// the dragon's at the builder's spacings) stay on the lattice, so their
-/// samples are unchanged; on CAD parts with long thin triangles (gear
-/// teeth, fans) the lattice grows with the longest edge squared: joint
-/// 12.8 M coverage samples at spacing 1/400, 2.5 M by columns.
-constexpr long long kColumnSaving = 8;
 
 void check_input(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F) {
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
@@ -237,6 +230,10 @@ SurfaceSamples sample_surface(const Eigen::Ref<const MatX3d>& V, const Eigen::Re
     throw ParameterError("SamplingOptions::spacing must be positive and finite, got " +
                          std::to_string(options.spacing));
   }
+  if (!(options.column_ratio >= 1)) {
+    throw ParameterError("SamplingOptions::column_ratio must be >= 1, got " +
+                         std::to_string(options.column_ratio));
+  }
   check_input(V, F);
   const auto nv = static_cast<size_t>(V.rows());
   SampleBuffers buffers;
@@ -260,7 +257,8 @@ SurfaceSamples sample_surface(const Eigen::Ref<const MatX3d>& V, const Eigen::Re
     if (n >= 2) {
       const Eigen::Vector3d corner[3] = {a, b, c};
       const long long lattice = static_cast<long long>(n + 1) * (n + 2) / 2;
-      if (lattice >= kColumnSaving * column_sample_count(corner, column_step)) {
+      if (static_cast<double>(lattice) >=
+          options.column_ratio * static_cast<double>(column_sample_count(corner, column_step))) {
         const int ids[3] = {ia, ib, ic};
         // The gap stays within spacing / sqrt(3), as on the lattice: a
         // finer step where a zipper triangle came out too wide (rare).

@@ -125,6 +125,7 @@ TEST(SurfaceSampling, RejectsBadInput) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   EXPECT_THROW(sample_surface(box.V, box.F, SamplingOptions{0.0}), icd::ParameterError);
   EXPECT_THROW(sample_surface(box.V, box.F, SamplingOptions{std::nan("")}), icd::ParameterError);
+  EXPECT_THROW(sample_surface(box.V, box.F, SamplingOptions{0.5, 0.5}), icd::ParameterError);
   icd::SurfaceMesh bad = box;
   bad.F(3, 1) = 99;
   EXPECT_THROW(sample_surface(bad.V, bad.F, SamplingOptions{0.5}), icd::InputError);
