@@ -581,8 +581,13 @@ SphereTreeBuild build_sphere_tree(const SurfaceMesh& input, const SphereTreeOpti
   // Samples: coverage (dense) on the input surface, medial (coarse) on the closed one.
   const SphereTreeOptions::Sampling& sampling = options.sampling;
   out.samples = sample_surface(input.V, input.F, SamplingOptions{sampling.cover_spacing * scale});
-  const SurfaceSamples medial_samples =
-      sample_surface(closed.V, closed.F, SamplingOptions{sampling.medial_spacing * scale});
+  // Medial samples: thin triangles by columns from a saving of 3 (the
+  // coverage samples' default 8 would leave most of pinion_small's teeth on
+  // the lattice: 303 000 medial samples instead of 87 000); the bunny's and
+  // the dragon's triangles stay below it at the medial spacings.
+  SamplingOptions medial_sampling{sampling.medial_spacing * scale};
+  medial_sampling.column_ratio = 3.0;
+  const SurfaceSamples medial_samples = sample_surface(closed.V, closed.F, medial_sampling);
   end_step("hole closing, oracle, sampling");
   MedialAxisOptions medial_options;
   medial_options.refinement_iterations = sampling.refinement_iterations;

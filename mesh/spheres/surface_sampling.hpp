@@ -13,10 +13,20 @@ struct SamplingOptions {
   /// n = ceil(L / spacing), so the number of samples per triangle grows with
   /// its area (about 2 area / (sqrt(3) spacing^2) for well-shaped triangles).
   double spacing = 1.0;
+  /// Thin triangles (CAD fans, gear teeth) would get (L / spacing)^2 / 2
+  /// needle-shaped lattice points whatever their area: a triangle is sampled
+  /// by columns instead (points about 0.8 spacing apart on columns
+  /// perpendicular to the longer leg of each half of it; samples about
+  /// area / (0.8 spacing)^2 plus its edges' lengths / (0.8 spacing)) when
+  /// the lattice would give it at least this many times as many points
+  /// (>= 1). The default 8 leaves every triangle of the bunny and the dragon
+  /// at the builder's coverage spacings on the lattice.
+  double column_ratio = 8.0;
 };
 
 /// Surface samples: every mesh vertex, then the lattice points of each
-/// triangle's n x n subdivision (edge points of neighbouring triangles may
+/// triangle's n x n subdivision, or its column points (see
+/// SamplingOptions::column_ratio) (edge points of neighbouring triangles may
 /// appear twice; harmless).
 ///
 /// Coverage guarantee: every surface point p lies within gap[i] of some
@@ -33,10 +43,12 @@ struct SurfaceSamples {
 
 /// Samples the triangle mesh (V #V x 3, F #F x 3). Deterministic. The gap of
 /// a sample is the largest circumradius bound (longest edge / sqrt(3)) of the
-/// sub-triangles it is a corner of: any point of a triangle with longest edge
-/// L is within L / sqrt(3) of one of its corners. Throws ParameterError for a
-/// non-positive or non-finite spacing and InputError for bad indices or
-/// non-finite coordinates.
+/// lattice sub-triangles it is a corner of: any point of a triangle with
+/// longest edge L is within L / sqrt(3) of one of its corners; on column
+/// sub-triangles the exact bound (circumradius, or half the longest edge when
+/// an angle is >= 90 deg), kept <= spacing / sqrt(3). Throws ParameterError
+/// for a non-positive or non-finite spacing or a column_ratio below 1, and
+/// InputError for bad indices or non-finite coordinates.
 SurfaceSamples sample_surface(const Eigen::Ref<const MatX3d>& V, const Eigen::Ref<const MatX3i>& F,
                               const SamplingOptions& options);
 

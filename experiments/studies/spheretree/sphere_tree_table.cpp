@@ -16,6 +16,10 @@
 //                   [--branching B]  (children per node at most; default 8)
 //                   [--build-branching B]  (SphereTreeOptions::Allocation::build_branching)
 //                   [--threads N]  (worker threads of the build; 0 = all cores, the default)
+//                   [--fit light|full|shell]  (icd-preprocess's --sphere-fit presets; give it
+//                                 first: it resets the optimisation options before it)
+//                   [--refinement N]  (adaptive medial-axis rounds)
+//                   [--canonical 0|1]  (build on the mesh in canonical order, as icd-preprocess)
 //                   [--flat N]  (diagnostic: one level of at most N spheres under the root,
 //                                every other step as usual: the cost of the nested partition)
 //                   [--perturb E]  (build for the mesh scaled by 1 + E, evaluate on the
@@ -46,6 +50,8 @@
 #include <icd/config.hpp>
 #include <icd/mesh/io/surface_reader.hpp>
 #include <icd/mesh/io/vtk_writer.hpp>
+#include <icd/mesh/pipeline/canonical.hpp>
+#include <icd/mesh/pipeline/preprocess.hpp>
 #include <icd/mesh/spheres/builder.hpp>
 #include <icd/mesh/spheres/evaluation.hpp>
 #include <icd/mesh/spheres/mesh_oracle.hpp>
@@ -157,6 +163,7 @@ int run(int argc, char** argv) {
   int diagnose = 0;
   bool fit_probes = false;
   double perturb = 0;
+  bool canonical = false;
   icd::mesh::EvaluationOptions evaluation;
   using icd::experiments::Cli;
   Cli cli(
@@ -224,6 +231,16 @@ int run(int argc, char** argv) {
       .integer("--build-branching", allocation.build_branching, "B",
                "SphereTreeOptions::Allocation::build_branching")
       .integer("--threads", options.threads, "N", "worker threads (0: all cores)", 0)
+      .custom("--fit", "FIT",
+              "icd-preprocess's --sphere-fit preset (light, full, shell); give it first: it "
+              "resets the optimisation options given before it",
+              [&](const std::string& v) {
+                icd::mesh::apply_sphere_fit(icd::mesh::parse_sphere_fit(v, "--fit"), options);
+              })
+      .integer("--refinement", options.sampling.refinement_iterations, "N",
+               "adaptive medial-axis rounds", 0)
+      .boolean("--canonical", canonical,
+               "build on the mesh in canonical order (as icd-preprocess does)")
       .custom("--flat", "N", "diagnostic: one level of at most N spheres under the root",
               [&](const std::string& v) {
                 const int n = Cli::parse_integer<int>(v, 1);
@@ -259,7 +276,7 @@ int run(int argc, char** argv) {
     // --perturb E: the tree is built for the mesh scaled by 1 + E (E ~ 1e-12
     // changes coordinates in their last bits only) and evaluated on the mesh:
     // how much the result depends on rounding.
-    icd::SurfaceMesh build_mesh = mesh;
+    icd::SurfaceMesh build_mesh = canonical ? icd::mesh::canonical_order(mesh) : mesh;
     build_mesh.V *= 1.0 + perturb;
     const icd::mesh::SphereTreeBuild ours = icd::mesh::build_sphere_tree(build_mesh, options);
     const double build_cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;

@@ -3,6 +3,8 @@
 // the area bookkeeping against closed-form areas.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -67,10 +69,63 @@ TEST(SurfaceSampling, VerticesComeFirstAndOutputIsDeterministic) {
   EXPECT_GT(fine.points.rows(), 3 * (a.points.rows() - torus.V.rows()));
 }
 
+// A slab of long thin faces (gear teeth, CAD fans): the lattice would put
+// (L / spacing)^2 / 2 needles on each long triangle whatever its area; the
+// column sampling keeps the count near area / spacing^2 plus the edges'
+// lengths / spacing, with the same coverage guarantee and area bookkeeping.
+TEST(SurfaceSampling, ThinTrianglesAreSampledByAreaWithTheSameGuarantee) {
+  const Eigen::Vector3d hi(40, 1, 0.05);
+  const auto slab = icd::make_box_surface({0, 0, 0}, hi);
+  const double spacing = 0.25;
+  expect_gap_guarantee(slab, spacing);
+  const auto samples = sample_surface(slab.V, slab.F, SamplingOptions{spacing});
+  const double area = 2 * (hi.x() * hi.y() + hi.x() * hi.z() + hi.y() * hi.z());
+  EXPECT_NEAR(samples.area.sum(), area, 1e-9 * area);
+  EXPECT_GE(samples.area.minCoeff(), 0.0);
+  double lattice = 0, edges = 0;  // what the n x n lattice would give; longest edges
+  for (Eigen::Index f = 0; f < slab.F.rows(); ++f) {
+    const Eigen::Vector3d a = slab.V.row(slab.F(f, 0)), b = slab.V.row(slab.F(f, 1)),
+                          c = slab.V.row(slab.F(f, 2));
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const double n = std::max(1.0, std::ceil(longest / spacing));
+    lattice += (n + 1) * (n + 2) / 2 - 3;
+    edges += longest / spacing;
+  }
+  const double bound = 3 * (area / (spacing * spacing) + edges);
+  EXPECT_LT(static_cast<double>(samples.points.rows()), bound);
+  EXPECT_GT(lattice, 4 * bound);  // the lattice would not meet it
+  for (Eigen::Index s = 0; s < samples.points.rows(); ++s) {
+    ASSERT_GE(samples.face[s], 0);
+    // Every sample lies on its face's plane and within its bounding box.
+    const Eigen::Vector3d a = slab.V.row(slab.F(samples.face[s], 0)),
+                          b = slab.V.row(slab.F(samples.face[s], 1)),
+                          c = slab.V.row(slab.F(samples.face[s], 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+    EXPECT_NEAR(n.dot(samples.points.row(s).transpose() - a), 0.0, 1e-9);
+  }
+}
+
+// Well-shaped triangles keep the n x n lattice: the count is the lattice's.
+TEST(SurfaceSampling, WellShapedTrianglesKeepTheLattice) {
+  const auto sphere = icd::make_icosphere(2);
+  const double spacing = 0.05;
+  const auto samples = sample_surface(sphere.V, sphere.F, SamplingOptions{spacing});
+  long long expected = sphere.V.rows();
+  for (Eigen::Index f = 0; f < sphere.F.rows(); ++f) {
+    const Eigen::Vector3d a = sphere.V.row(sphere.F(f, 0)), b = sphere.V.row(sphere.F(f, 1)),
+                          c = sphere.V.row(sphere.F(f, 2));
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const long long n = std::max(1LL, static_cast<long long>(std::ceil(longest / spacing)));
+    expected += (n + 1) * (n + 2) / 2 - 3;
+  }
+  EXPECT_EQ(samples.points.rows(), expected);
+}
+
 TEST(SurfaceSampling, RejectsBadInput) {
   const auto box = icd::make_box_surface({0, 0, 0}, {1, 1, 1});
   EXPECT_THROW(sample_surface(box.V, box.F, SamplingOptions{0.0}), icd::ParameterError);
   EXPECT_THROW(sample_surface(box.V, box.F, SamplingOptions{std::nan("")}), icd::ParameterError);
+  EXPECT_THROW(sample_surface(box.V, box.F, SamplingOptions{0.5, 0.5}), icd::ParameterError);
   icd::SurfaceMesh bad = box;
   bad.F(3, 1) = 99;
   EXPECT_THROW(sample_surface(bad.V, bad.F, SamplingOptions{0.5}), icd::InputError);
