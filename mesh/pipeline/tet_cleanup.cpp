@@ -404,8 +404,14 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
   };
   std::set<int> stuck;
   long attempts = 0;  // nodes tried: bounded whatever the mesh
+  // The mesh around T, rebuilt only after a move changed T (a node found
+  // stuck changes nothing: rotor's wrap had 614 of them).
+  Local cached;
+  bool fresh = false;
   while (rep.collapses < o.max_collapses && attempts++ < 4L * n) {
-    const Local L = local();
+    if (!fresh) cached = local();
+    fresh = true;
+    const Local& L = cached;
     // The worst node not known to be stuck.
     int i = -1;
     for (int v = 0; v < n; ++v)
@@ -430,6 +436,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       continue;
     }
     apply(L, i, best);
+    fresh = false;
     ++rep.collapses;
     // A collapse changes the tets of i's neighbours only: they may have new
     // moves; a node stuck elsewhere stays stuck (retrying every stuck node
@@ -461,7 +468,9 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       }
     }
     if (bad < 0) break;
-    const Local L = local();
+    if (!fresh) cached = local();
+    fresh = true;
+    const Local& L = cached;
     const double cap = std::max(threshold, w.maxCoeff());
     Move best;
     int best_i = -1;
@@ -489,6 +498,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       continue;
     }
     apply(L, best_i, best);
+    fresh = false;
     ++rep.dihedral_collapses;
   }
   // Flips and drops of the tets below the dihedral target (the smallest
