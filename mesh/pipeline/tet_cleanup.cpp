@@ -30,38 +30,87 @@ double tet_volume(const MatX3d& V, const Tet& t) {
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
 }
 
-/// Node frequencies sqrt(lambda_max(K_ii) / m_i) (linear elasticity, lumped
-/// mass), rad/s, for the scene's default density and Young's modulus; 0 for
-/// unused nodes.
-Eigen::VectorXd node_frequencies(const MatX3d& V, const std::vector<Tet>& T, double poisson) {
-  fem::Material m;
-  m.poisson = poisson;
-  const double E = m.young, nu = m.poisson;
-  const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
-  const Eigen::Index n = V.rows();
-  std::vector<Eigen::Matrix3d> K(static_cast<size_t>(n), Eigen::Matrix3d::Zero());
-  Eigen::VectorXd mass = Eigen::VectorXd::Zero(n);
-  for (const Tet& t : T) {
+/// The stiffness block and lumped mass a tet adds to each of its nodes
+/// (linear elasticity, the scene's default density and Young's modulus).
+struct NodeBlocks {
+  double lambda = 0, mu = 0, density = 0;
+  explicit NodeBlocks(double poisson) {
+    fem::Material m;
+    m.poisson = poisson;
+    const double E = m.young, nu = m.poisson;
+    lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+    mu = E / (2 * (1 + nu));
+    density = m.density;
+  }
+  /// Adds tet t's contributions to K[v] and mass[v] of its nodes v with
+  /// keep(v), in the node order of t.
+  template <class Keep>
+  void add(const MatX3d& V, const Tet& t, std::vector<Eigen::Matrix3d>& K, Eigen::VectorXd& mass,
+           const Keep& keep) const {
     Eigen::Matrix3d Dm;
     for (int k = 0; k < 3; ++k) Dm.col(k) = (V.row(t[k + 1]) - V.row(t[0])).transpose();
     const double vol = Dm.determinant() / 6.0;
     const Eigen::Matrix3d G = Dm.inverse();  // rows: gradients of nodes 1..3
     for (int a = 0; a < 4; ++a) {
+      if (!keep(t[a])) continue;
       const Eigen::Vector3d g =
           a == 0 ? Eigen::Vector3d(-G.colwise().sum().transpose()) : Eigen::Vector3d(G.row(a - 1));
       K[static_cast<size_t>(t[a])] +=
           vol * ((lambda + mu) * g * g.transpose() + mu * g.squaredNorm() * Eigen::Matrix3d::Identity());
-      mass[t[a]] += m.density * vol / 4.0;
+      mass[t[a]] += density * vol / 4.0;
     }
   }
+  static double frequency(const Eigen::Matrix3d& K, double mass) {
+    if (!(mass > 0)) return 0.0;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(K, Eigen::EigenvaluesOnly);
+    return std::sqrt(std::max(0.0, es.eigenvalues()[2]) / mass);
+  }
+};
+
+/// Node frequencies sqrt(lambda_max(K_ii) / m_i) (linear elasticity, lumped
+/// mass), rad/s, for the scene's default density and Young's modulus; 0 for
+/// unused nodes.
+Eigen::VectorXd node_frequencies(const MatX3d& V, const std::vector<Tet>& T, double poisson) {
+  const NodeBlocks nb(poisson);
+  const Eigen::Index n = V.rows();
+  std::vector<Eigen::Matrix3d> K(static_cast<size_t>(n), Eigen::Matrix3d::Zero());
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(n);
+  for (const Tet& t : T) nb.add(V, t, K, mass, [](int) { return true; });
   Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index i = 0; i < n; ++i)
-    if (mass[i] > 0) {
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(K[static_cast<size_t>(i)],
-                                                        Eigen::EigenvaluesOnly);
-      w[i] = std::sqrt(std::max(0.0, es.eigenvalues()[2]) / mass[i]);
-    }
+  for (Eigen::Index i = 0; i < n; ++i) w[i] = NodeBlocks::frequency(K[static_cast<size_t>(i)], mass[i]);
   return w;
+}
+
+/// node_frequencies(V, T, poisson)[v] for the nodes v of `nodes` only (the
+/// same sums in the same order: the same bits), and whether each is in a
+/// tet of T; O(|T|) without a decomposition per node.
+void node_frequencies_of(const MatX3d& V, const std::vector<Tet>& T, double poisson,
+                         const std::set<int>& nodes, std::vector<double>& w,
+                         std::vector<char>& used) {
+  const NodeBlocks nb(poisson);
+  const size_t n = static_cast<size_t>(V.rows());
+  std::vector<char> flag(n, 0);
+  for (int v : nodes) flag[static_cast<size_t>(v)] = 1;
+  std::vector<Eigen::Matrix3d> K(n);
+  Eigen::VectorXd mass(static_cast<Eigen::Index>(n));
+  for (int v : nodes) {
+    K[static_cast<size_t>(v)].setZero();
+    mass[v] = 0;
+  }
+  const auto keep = [&](int v) { return flag[static_cast<size_t>(v)] != 0; };
+  used.assign(nodes.size(), 0);
+  for (const Tet& t : T)
+    if (keep(t[0]) || keep(t[1]) || keep(t[2]) || keep(t[3])) {
+      nb.add(V, t, K, mass, keep);
+      for (int v : t)
+        if (keep(v)) flag[static_cast<size_t>(v)] = 2;
+    }
+  w.clear();
+  size_t k = 0;
+  for (int v : nodes) {
+    used[k++] = flag[static_cast<size_t>(v)] == 2;
+    w.push_back(NodeBlocks::frequency(K[static_cast<size_t>(v)], mass[v]));
+  }
 }
 
 struct Topology {
@@ -281,8 +330,12 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     std::vector<Tet> T;
     double volume = 0, worst = 0, dihedral = 180;
   };
+  // `promising(worst, dihedral)`: whether the caller would take a move with
+  // these figures; checked before the topology and surface checks (most
+  // candidate moves fail it: on rotor's wrap the pass took 34 s with those
+  // checks first).
   const auto evaluate = [&](const Local& L, const std::set<int>& nbrs, int i, int j,
-                            double floor_deg, Move& out) {
+                            double floor_deg, Move& out, const auto& promising) {
     const bool surf = L.surface[static_cast<size_t>(i)] != 0;
     if (j >= 0 && surf && !L.bedges.count(std::minmax(i, j))) return false;
     if (j >= 0 && surf && (mesh.V.row(i) - mesh.V.row(j)).norm() > o.max_shift * diagonal)
@@ -301,7 +354,6 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     Move m;
     m.T.reserve(T.size());
     double vol = volume;
-    std::vector<int> changed;
     for (size_t e = 0; e < T.size(); ++e) {
       Tet t = T[e];
       const bool has_i = std::find(t.begin(), t.end(), i) != t.end();
@@ -318,10 +370,20 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       if (d < floor_deg) return false;
       m.dihedral = std::min(m.dihedral, d);
       vol += v;
-      changed.push_back(static_cast<int>(m.T.size()));
       m.T.push_back(t);
     }
     if (!volume_ok(vol)) return false;
+    // The largest node frequency around i: the tets the move changes hold
+    // i's neighbours only (j is one of them).
+    std::vector<double> wc;
+    std::vector<char> used;
+    node_frequencies_of(mesh.V, m.T, o.poisson, nbrs, wc, used);
+    double worst = 0.0;
+    for (size_t k = 0; k < wc.size(); ++k) {
+      worst = std::max(worst, wc[k]);
+      if (j < 0 && !used[k]) worst = INFINITY;  // a node left without a tet
+    }
+    if (!promising(worst, m.dihedral)) return false;
     const Topology topo = topology(m.T, n);
     if (!topo.ok || topo.euler != topo0.euler || topo.components != topo0.components) return false;
     {  // an interior collapse may expose nothing; the check is cheap
@@ -329,17 +391,6 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       if (surf) pts.emplace_back(mesh.V.row(i).transpose());
       if (!within(m.T, pts, nbrs)) return false;
     }
-    const Eigen::VectorXd wc = node_frequencies(mesh.V, m.T, o.poisson);
-    double worst = j >= 0 ? wc[j] : 0.0;
-    for (int e : changed)
-      for (int v : m.T[static_cast<size_t>(e)]) worst = std::max(worst, wc[v]);
-    for (int v : nbrs) worst = std::max(worst, wc[v]);
-    if (j < 0)  // the nodes left without a tet
-      for (int v : nbrs)
-        if (wc[v] == 0 && std::none_of(m.T.begin(), m.T.end(), [&](const Tet& t) {
-              return std::find(t.begin(), t.end(), v) != t.end();
-            }))
-          worst = INFINITY;
     m.volume = vol;
     m.worst = worst;
     out = std::move(m);
@@ -353,8 +404,14 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
   };
   std::set<int> stuck;
   long attempts = 0;  // nodes tried: bounded whatever the mesh
+  // The mesh around T, rebuilt only after a move changed T (a node found
+  // stuck changes nothing: rotor's wrap had 614 of them).
+  Local cached;
+  bool fresh = false;
   while (rep.collapses < o.max_collapses && attempts++ < 4L * n) {
-    const Local L = local();
+    if (!fresh) cached = local();
+    fresh = true;
+    const Local& L = cached;
     // The worst node not known to be stuck.
     int i = -1;
     for (int v = 0; v < n; ++v)
@@ -368,7 +425,8 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
     if (L.surface[static_cast<size_t>(i)]) options.push_back(-1);
     for (int j : options) {
       Move m;
-      if (evaluate(L, nbrs, i, j, dmin, m) && m.worst < best.worst) {
+      if (evaluate(L, nbrs, i, j, dmin, m,
+                   [&](double worst, double) { return worst < best.worst; })) {
         best = std::move(m);
         found = true;
       }
@@ -378,6 +436,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       continue;
     }
     apply(L, i, best);
+    fresh = false;
     ++rep.collapses;
     // A collapse changes the tets of i's neighbours only: they may have new
     // moves; a node stuck elsewhere stays stuck (retrying every stuck node
@@ -409,7 +468,9 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       }
     }
     if (bad < 0) break;
-    const Local L = local();
+    if (!fresh) cached = local();
+    fresh = true;
+    const Local& L = cached;
     const double cap = std::max(threshold, w.maxCoeff());
     Move best;
     int best_i = -1;
@@ -420,8 +481,10 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       if (L.surface[static_cast<size_t>(i)]) options.push_back(-1);
       for (int j : options) {
         Move m;
-        if (evaluate(L, nbrs, i, j, std::nextafter(angle, 180.0), m) && m.worst <= cap &&
-            (best_i < 0 || m.dihedral > best.dihedral)) {
+        if (evaluate(L, nbrs, i, j, std::nextafter(angle, 180.0), m,
+                     [&](double worst, double dihedral) {
+                       return worst <= cap && (best_i < 0 || dihedral > best.dihedral);
+                     })) {
           best = std::move(m);
           best_i = i;
           best_nbrs = nbrs;
@@ -435,6 +498,7 @@ StepCleanupReport raise_stable_step(TetMesh& mesh, const StepCleanupOptions& o) 
       continue;
     }
     apply(L, best_i, best);
+    fresh = false;
     ++rep.dihedral_collapses;
   }
   // Flips and drops of the tets below the dihedral target (the smallest
