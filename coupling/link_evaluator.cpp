@@ -108,13 +108,7 @@ LinkApplyResult LinkEvaluator::apply(const Eigen::Ref<const MatX3d>& coarse_posi
 LinkApplyResult LinkEvaluator::apply_triples(const Eigen::Ref<const MatX3d>& coarse_positions,
                                              const std::vector<int32_t>& triples,
                                              Eigen::Ref<MatX3d> dense_out) {
-  check_sizes("apply_triples", coarse_positions.rows(), dense_out.rows());
-  for (int32_t t : triples)
-    if (t < 0 || t >= num_triples())
-      throw ParameterError("LinkEvaluator::apply_triples: no triple " + std::to_string(t));
-  const int count = static_cast<int>(triples.size());
-  const LinkApplyResult result =
-      update_triples(coarse_positions, count, [&](int i) { return triples[static_cast<size_t>(i)]; });
+  const LinkApplyResult result = update_listed("apply_triples", coarse_positions, triples, dense_out);
   const double* table = m_table.data();
   const double* weights = m_weights.data();
   double* out = dense_out.data();
@@ -134,23 +128,18 @@ LinkApplyResult LinkEvaluator::apply_links(const Eigen::Ref<const MatX3d>& coars
                                            const std::vector<int32_t>& triples,
                                            const std::vector<int32_t>& links,
                                            Eigen::Ref<MatX3d> dense_out) {
-  check_sizes("apply_links", coarse_positions.rows(), dense_out.rows());
-  for (int32_t t : triples)
-    if (t < 0 || t >= num_triples())
-      throw ParameterError("LinkEvaluator::apply_links: no triple " + std::to_string(t));
   if (m_updated_in.size() != m_has_frame.size() || ++m_calls == 0) {  // (wrapped: start again)
     m_updated_in.assign(m_has_frame.size(), 0);
     m_calls = 1;
   }
-  for (int32_t t : triples) m_updated_in[static_cast<size_t>(t)] = m_calls;
+  for (int32_t t : triples)
+    if (t >= 0 && t < num_triples()) m_updated_in[static_cast<size_t>(t)] = m_calls;
   for (int32_t k : links)
     if (k < 0 || k >= num_links() || m_updated_in[static_cast<size_t>(m_link_triple[k])] != m_calls)
       throw ParameterError("LinkEvaluator::apply_links: link " + std::to_string(k) +
                            (k < 0 || k >= num_links() ? " does not exist"
                                                       : " is not a link of the listed triples"));
-  const int count = static_cast<int>(triples.size());
-  const LinkApplyResult result =
-      update_triples(coarse_positions, count, [&](int i) { return triples[static_cast<size_t>(i)]; });
+  const LinkApplyResult result = update_listed("apply_links", coarse_positions, triples, dense_out);
   const double* table = m_table.data();
   const double* weights = m_weights.data();
   double* out = dense_out.data();
@@ -159,6 +148,18 @@ LinkApplyResult LinkEvaluator::apply_links(const Eigen::Ref<const MatX3d>& coars
     write_link(table + 24 * static_cast<Eigen::Index>(m_link_triple[k]),
                weights + 6 * static_cast<Eigen::Index>(k), out + k * stride);
   return result;
+}
+
+LinkApplyResult LinkEvaluator::update_listed(const char* who,
+                                             const Eigen::Ref<const MatX3d>& coarse_positions,
+                                             const std::vector<int32_t>& triples,
+                                             const Eigen::Ref<MatX3d>& dense_out) {
+  check_sizes(who, coarse_positions.rows(), dense_out.rows());
+  for (int32_t t : triples)
+    if (t < 0 || t >= num_triples())
+      throw ParameterError(std::string("LinkEvaluator::") + who + ": no triple " + std::to_string(t));
+  return update_triples(coarse_positions, static_cast<int>(triples.size()),
+                        [&](int i) { return triples[static_cast<size_t>(i)]; });
 }
 
 void LinkEvaluator::check_sizes(const char* who, Eigen::Index coarse_rows,

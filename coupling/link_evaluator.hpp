@@ -121,6 +121,11 @@ class LinkEvaluator {
   /// The size checks of apply() and apply_triples() (`who` names the caller).
   void check_sizes(const char* who, Eigen::Index coarse_rows, Eigen::Index dense_rows) const;
   void check_finite(const Eigen::Ref<const MatX3d>& coarse_positions) const;
+  /// The size checks (`who` names the caller), each listed triple in
+  /// range, then their frames (update_triples).
+  LinkApplyResult update_listed(const char* who, const Eigen::Ref<const MatX3d>& coarse_positions,
+                                const std::vector<int32_t>& triples,
+                                const Eigen::Ref<MatX3d>& dense_out);
   /// Frames of the triples index(0), ..., index(count - 1).
   template <class Index>
   LinkApplyResult update_triples(const Eigen::Ref<const MatX3d>& coarse_positions, int count,
