@@ -9,6 +9,16 @@
 #include <icd/mesh/core/error.hpp>
 
 namespace icd::fem {
+namespace {
+
+// Equal sub-steps of at most h that cover `span` (at least one; a span a
+// rounding error past a multiple of h takes no extra step): run() steps by
+// it, and stable_step_limit() predicts the step advance() will take from it.
+int substep_count(double span, double h) {
+  return std::max(static_cast<int>(std::ceil(span / h * (1 - 1e-12))), 1);
+}
+
+}  // namespace
 
 Simulator::Simulator(Model model, const SimulatorOptions& options)
     : m_model(std::move(model)), m_options(options) {
@@ -81,7 +91,7 @@ double Simulator::stable_step_limit(double frame_dt) {
     if (frame_dt > 0 && m_options.fixed_step == 0 && m_options.frequency_reuse_strain_per_slack > 0 &&
         m_cached_limit > 0 && std::isfinite(m_cached_limit)) {
       const double h = std::min(m_options.max_step, m_options.safety_factor * m_cached_limit);
-      const double taken = frame_dt / std::ceil(frame_dt / std::min(h, frame_dt));
+      const double taken = frame_dt / substep_count(frame_dt, std::min(h, frame_dt));
       const double slack = m_options.safety_factor * m_cached_limit / taken;
       if (slack > 1) tolerance += m_options.frequency_reuse_strain_per_slack * (slack - 1);
     }
@@ -382,8 +392,8 @@ AdvanceReport Simulator::run(double total, double h, AdvanceReport rep) {
       steps_good = steps;
     }
     if (t >= total) break;
-    const int remaining = static_cast<int>(std::ceil((total - t) / h * (1 - 1e-12)));
-    hh = (total - t) / std::max(remaining, 1);
+    const int remaining = substep_count(total - t, h);
+    hh = (total - t) / remaining;
     ElementHealth health;
     StateEnergies energies;
     bool oriented = true;
