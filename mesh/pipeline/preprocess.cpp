@@ -13,6 +13,7 @@
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/pipeline/canonical.hpp>
 #include <icd/mesh/pipeline/hausdorff.hpp>
+#include <icd/mesh/pipeline/near_contact.hpp>
 
 namespace icd::mesh {
 namespace {
@@ -257,8 +258,57 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     };
     const double cpu0 = children_cpu();
     const auto wall0 = std::chrono::steady_clock::now();
+    // The first cell size, and the parts in near contact: distinct
+    // components closer than the mesher's surface tolerance (the facet
+    // distance bound at that size) make every pass refine between them up to
+    // its vertex cap (bones: 26 bones 0.1 % of the diagonal apart), so the
+    // first attempt is skipped for the wrap retry below.
+    double first_size = to.cell_size, tolerance = 0.0;
+    ComponentGap gap;
+    StageUsage check;
+    if (retry_possible) {
+      const bool check_gap = o.wrap_near_contact;
+      ByteReader in(run_bounded(
+          "tetrahedralize", limits,
+          [&] {
+            double volume = 0.0;
+            for (int f = 0; f < simplified.F.rows(); ++f) {
+              const Eigen::Vector3d p0 = simplified.V.row(simplified.F(f, 0)),
+                                    p1 = simplified.V.row(simplified.F(f, 1)),
+                                    p2 = simplified.V.row(simplified.F(f, 2));
+              volume += p0.dot(p1.cross(p2)) / 6.0;
+            }
+            const double size =
+                to.cell_size > 0.0 ? to.cell_size : initial_cell_size(volume, to.target_tets);
+            ByteWriter w;
+            w.pod(size);
+            w.pod(check_gap ? closest_component_gap(simplified, to.facet_distance_factor * size)
+                            : ComponentGap{});
+            return w.take();
+          },
+          &check));
+      first_size = in.pod<double>();
+      gap = in.pod<ComponentGap>();
+      tolerance = to.facet_distance_factor * first_size;
+    }
+    const bool near_contact = gap.distance < tolerance;
     try {
+      if (near_contact) {
+        std::ostringstream m;
+        m << "components " << gap.first + 1 << " and " << gap.second + 1 << " of its "
+          << gap.components << " lie " << fmt(gap.distance / s) << " apart ("
+          << fmt(100.0 * gap.distance / r.bbox_diagonal) << " % of the diagonal) near ("
+          << fmt(gap.where[0] / s + norm.centre[0]) << ", "
+          << fmt(gap.where[1] / s + norm.centre[1]) << ", "
+          << fmt(gap.where[2] / s + norm.centre[2])
+          << "), closer than the mesher's surface tolerance " << fmt(tolerance / s) << " ("
+          << fmt(to.facet_distance_factor) << " x the first cell size " << fmt(first_size / s)
+          << "): every pass would refine between them up to its vertex cap";
+        throw InputError(m.str());
+      }
       tet = tetrahedralize_surface(simplified, to, t.heartbeat());
+      tet.usage.cpu_seconds += check.cpu_seconds;
+      tet.usage.wall_seconds += check.wall_seconds;
     } catch (const ParameterError&) {
       throw;
     } catch (const InputError& e) {
@@ -276,10 +326,24 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
       const HeartbeatFn beat = t.heartbeat();
       if (beat)
-        beat("the mesher failed on the repaired surface at every size; retrying once on its "
-             "alpha wrap (--wrap never refuses instead)");
+        beat(near_contact ? "parts of the repaired surface in near contact (" + first +
+                                "); meshing its alpha wrap at once (--wrap never refuses instead)"
+                          : "the mesher failed on the repaired surface at every size; retrying "
+                            "once on its alpha wrap (--wrap never refuses instead)");
       RepairOptions ro = o.repair;
       ro.wrap = RepairOptions::Wrap::always;
+      // Parts in near contact: the wrap joins them into one solid. It closes
+      // straits narrower than 2 alpha, so alpha half the first cell size
+      // closes the gaps between them that no cell can resolve (the default
+      // 0.01 of the diagonal left bones' 1-5 % gaps open, and a pass refined
+      // between them into its CPU limit). The user's --wrap-alpha is the
+      // floor; a wrap that lies too far from the input falls back to it. (Not
+      // after a failed first attempt: camel's retry meshes at 0.01 and a
+      // larger alpha webs its legs: 0.94 -> 2.48 % of the diagonal from the
+      // input.)
+      if (near_contact)
+        ro.wrap_alpha = std::max(o.repair.wrap_alpha, 0.5 * first_size / r.bbox_diagonal);
+      std::string alpha_note;
       StageUsage ru, su;
       try {
         // What is left of the stage's CPU limit bounds the retry's repair and
@@ -295,7 +359,28 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
         StageLimits rl = limits;
         rl.cpu_seconds = left();
         require(rl.cpu_seconds);
-        repair_once(ro, &ru, beat, rl);
+        try {
+          repair_once(ro, &ru, beat, rl);
+          if (ro.wrap_alpha > o.repair.wrap_alpha)
+            alpha_note = "alpha " + fmt(ro.wrap_alpha) + " of the diagonal: half the first cell "
+                         "size " + fmt(first_size / s) + ", so that gaps narrower than a cell "
+                         "are closed; --wrap-alpha " + fmt(o.repair.wrap_alpha) + " is the floor";
+        } catch (const ParameterError&) {
+          throw;
+        } catch (const InputError& w) {
+          if (!(ro.wrap_alpha > o.repair.wrap_alpha)) throw;
+          alpha_note = "alpha " + fmt(o.repair.wrap_alpha) + " of the diagonal (--wrap-alpha): "
+                       "the wrap at " + fmt(ro.wrap_alpha) + " (half the first cell size " +
+                       fmt(first_size / s) + ") was refused: " + w.what();
+          ro.wrap_alpha = o.repair.wrap_alpha;
+          rl.cpu_seconds = left();
+          require(rl.cpu_seconds);
+          StageUsage ru2;
+          repair_once(ro, &ru2, beat, rl);
+          ru.cpu_seconds += ru2.cpu_seconds;
+          ru.wall_seconds += ru2.wall_seconds;
+          ru.peak_mb = std::max(ru.peak_mb, ru2.peak_mb);
+        }
         rl.cpu_seconds = left();
         require(rl.cpu_seconds);
         simplify_once(&su, beat, rl);
@@ -310,16 +395,23 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
                          " [after the automatic retry on the alpha-wrapped surface; on the "
                          "repaired surface first: " + first + "]");
       }
-      r.repair.wrap_cause = 4;
+      r.repair.wrap_cause = near_contact ? 5 : 4;
       tet.usage.cpu_seconds += first_cpu + ru.cpu_seconds + su.cpu_seconds;
       tet.usage.wall_seconds += first_wall + ru.wall_seconds + su.wall_seconds;
       tet.usage.peak_mb = std::max({tet.usage.peak_mb, ru.peak_mb, su.peak_mb});
       r.wrap_retry_cause = first;
-      r.notes.push_back("tetrahedralize: the mesher failed on the repaired surface at every "
-                        "size (" + first + "; " + fmt(first_cpu) + " s CPU); the surface was "
-                        "rebuilt by alpha wrapping and meshed once more (both attempts, with "
-                        "the second repair and simplification, in this stage's time and its "
-                        "one CPU limit; --wrap never refuses instead)");
+      if (near_contact)
+        r.notes.push_back("tetrahedralize: parts of the repaired surface in near contact (" +
+                          first + "); the mesher was not run on it: the surface was rebuilt by "
+                          "alpha wrapping" + (alpha_note.empty() ? "" : " (" + alpha_note + ")") +
+                          " and meshed at once (in this stage's time and CPU limit; --wrap never "
+                          "refuses instead)");
+      else
+        r.notes.push_back("tetrahedralize: the mesher failed on the repaired surface at every "
+                          "size (" + first + "; " + fmt(first_cpu) + " s CPU); the surface was "
+                          "rebuilt by alpha wrapping and meshed once more (both attempts, with "
+                          "the second repair and simplification, in this stage's time and its "
+                          "one CPU limit; --wrap never refuses instead)");
     }
     t.set_usage(tet.usage);
     b.coarse = std::move(tet.mesh);

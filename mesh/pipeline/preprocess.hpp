@@ -83,6 +83,13 @@ struct PreprocessOptions {
   /// Each mesher pass keeps its own bound (TetrahedralizeOptions::pass_share
   /// of the limit). In (0, 1].
   double wrap_retry_first_share = 0.5;
+  /// When the automatic wrap retry may follow and two distinct components of
+  /// the repaired surface lie closer than the mesher's surface tolerance (the
+  /// facet distance bound at the first cell size), skip the first attempt,
+  /// which would refine between them up to its vertex cap at every size, and
+  /// mesh the alpha wrap at once (repair.wrap_cause 5, a note naming the two
+  /// components, their gap and where). false: the first attempt runs and fails.
+  bool wrap_near_contact = true;
   PreprocessOptions() {
     spheres.time_limit = 1e9;
     apply_sphere_fit(SphereFit::light, spheres);
@@ -132,8 +139,9 @@ struct PreprocessResult {
   double bbox_diagonal = 0.0;                ///< of the repaired dense surface
   std::vector<StageTime> times;              ///< in stage order
   Normalisation normalisation;               ///< the stages' coordinates
-  /// Why the mesher failed on the repaired surface when the automatic wrap
-  /// retry meshed its alpha wrap instead (repair.wrap_cause 4); else empty.
+  /// Why the mesher failed on the repaired surface (repair.wrap_cause 4), or
+  /// which parts lie in near contact (5), when the automatic wrap retry
+  /// meshed its alpha wrap instead; else empty.
   std::string wrap_retry_cause;
   /// Retries and warnings of every stage, for the summary (one line each).
   std::vector<std::string> notes;
@@ -149,7 +157,11 @@ using ProgressFn = std::function<void(const std::string& stage, const std::strin
 /// the mesher fails at every size is rebuilt by alpha wrapping and meshed
 /// once more (the automatic wrap retry; repair.wrap_cause 4, a note, its CPU
 /// in the tetrahedralize stage, both attempts within the stage's one CPU
-/// limit: wrap_retry_first_share). Every stage runs bounded by
+/// limit: wrap_retry_first_share); distinct parts closer than the mesher's
+/// surface tolerance are wrapped at once (wrap_near_contact), at an alpha of
+/// half the first cell size (as a fraction of the diagonal; at least
+/// repair.wrap_alpha, which it falls back to when that wrap is refused), so
+/// that the gaps between them that no cell resolves are closed. Every stage runs bounded by
 /// options.limits. Deterministic for identical input and options unless the
 /// sphere builder hits its time limit (reported). Throws what the stages
 /// throw: InputError for unusable input (StageError for a stage beyond its

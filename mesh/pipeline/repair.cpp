@@ -155,7 +155,9 @@ std::string RepairReport::to_string() const {
   if (wrap_cause) {
     static const char* why[] = {"", "a non-manifold edge", "self-intersections that repair could not resolve",
                                 "--wrap always",
-                                "the mesher failed at every size on the repaired surface"};
+                                "the mesher failed at every size on the repaired surface",
+                                "parts of the repaired surface in near contact: the mesher would "
+                                "refine between them"};
     s << (wrap_cause == 3 ? "" : "WARNING: ") << "rebuilt the surface by alpha wrapping ("
       << why[wrap_cause] << "; alpha " << wrap_alpha
       << " of the diagonal): every point of it lies within " << 100.0 * wrap_distance

@@ -78,8 +78,10 @@ struct RepairReport {
   double volume_change = 0.0;           ///< relative volume change of the local repair
   /// Why the surface was rebuilt by alpha wrapping: 0 not wrapped, 1 a
   /// non-manifold edge, 2 unresolved self-intersections, 3 asked (--wrap always),
-  /// 4 the mesher failed on the repaired surface (set by preprocess()'s
-  /// automatic wrap retry, never by repair_surface()).
+  /// 4 the mesher failed on the repaired surface, 5 distinct components of
+  /// the repaired surface lie closer than the mesher's surface tolerance (4
+  /// and 5 are set by preprocess()'s automatic wrap retry, never by
+  /// repair_surface()).
   int wrap_cause = 0;
   double wrap_alpha = 0.0;     ///< alpha used, fraction of the diagonal
   double wrap_distance = 0.0;  ///< largest distance wrap -> input / diagonal (approximate)

@@ -180,6 +180,12 @@ std::string fmt(double x) {
 
 }  // namespace
 
+double initial_cell_size(double volume, int target_tets) {
+  // A regular tet of edge a has volume a^3 / (6 sqrt 2) and circumradius a sqrt(6) / 4.
+  const double a = std::cbrt(6.0 * std::sqrt(2.0) * volume / target_tets);
+  return a * std::sqrt(6.0) / 4.0 * 2.0;
+}
+
 TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
                                             const TetrahedralizeOptions& o,
                                             const HeartbeatFn& heartbeat) {
@@ -333,11 +339,8 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     if (attempt_near(o.cell_size, true, res.mesh, used)) res.cell_size = used;
   } else {
     // Size search without sliver optimisation (which changes the count only
-    // slightly), then one optimised pass at the best size. Initial guess: a
-    // regular tet of edge a has volume a^3 / (6 sqrt 2) and circumradius
-    // a sqrt(6) / 4; refinement stops well below the bound, hence the factor.
-    const double a = std::cbrt(6.0 * std::sqrt(2.0) * volume / o.target_tets);
-    double size = std::min(max_size, a * std::sqrt(6.0) / 4.0 * 2.0);
+    // slightly), then one optimised pass at the best size.
+    double size = std::min(max_size, initial_cell_size(volume, o.target_tets));
     double best_err = INFINITY, best_size = 0.0;
     for (int pass = 1; pass <= o.max_size_iterations; ++pass) {
       TetMesh m;

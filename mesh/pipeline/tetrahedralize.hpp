@@ -91,6 +91,12 @@ struct TetrahedralizeResult {
   StageUsage usage;  ///< summed over the passes (peak: the largest)
 };
 
+/// The cell size tetrahedralize_surface() tries first when options.cell_size
+/// is 0, for a surface enclosing `volume` and target_tets tets: twice the
+/// circumradius of regular tets of that mean volume (refinement stops well
+/// below the bound).
+double initial_cell_size(double volume, int target_tets);
+
 /// Tetrahedralizes the region bounded by `surface` (closed, outward-oriented,
 /// no self-intersection: the output of repair_surface()/simplify_surface()).
 /// Deterministic: CGAL's default random generator is reset to random_seed
