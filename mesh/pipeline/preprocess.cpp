@@ -337,7 +337,8 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       // closes the gaps between them that no cell can resolve (the default
       // 0.01 of the diagonal left bones' 1-5 % gaps open, and a pass refined
       // between them into its CPU limit). The user's --wrap-alpha is the
-      // floor; a wrap that lies too far from the input falls back to it. (Not
+      // floor; a wrap that lies too far from the input is redone at a smaller
+      // alpha (below). (Not
       // after a failed first attempt: camel's retry meshes at 0.01 and a
       // larger alpha webs its legs: 0.94 -> 2.48 % of the diagonal from the
       // input.)
@@ -359,28 +360,42 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
         StageLimits rl = limits;
         rl.cpu_seconds = left();
         require(rl.cpu_seconds);
-        try {
-          repair_once(ro, &ru, beat, rl);
-          if (ro.wrap_alpha > o.repair.wrap_alpha)
-            alpha_note = "alpha " + fmt(ro.wrap_alpha) + " of the diagonal: half the first cell "
-                         "size " + fmt(first_size / s) + ", so that gaps narrower than a cell "
-                         "are closed; --wrap-alpha " + fmt(o.repair.wrap_alpha) + " is the floor";
-        } catch (const ParameterError&) {
-          throw;
-        } catch (const InputError& w) {
-          if (!(ro.wrap_alpha > o.repair.wrap_alpha)) throw;
-          alpha_note = "alpha " + fmt(o.repair.wrap_alpha) + " of the diagonal (--wrap-alpha): "
-                       "the wrap at " + fmt(ro.wrap_alpha) + " (half the first cell size " +
-                       fmt(first_size / s) + ") was refused: " + w.what();
-          ro.wrap_alpha = o.repair.wrap_alpha;
-          rl.cpu_seconds = left();
-          require(rl.cpu_seconds);
-          StageUsage ru2;
-          repair_once(ro, &ru2, beat, rl);
-          ru.cpu_seconds += ru2.cpu_seconds;
-          ru.wall_seconds += ru2.wall_seconds;
-          ru.peak_mb = std::max(ru.peak_mb, ru2.peak_mb);
+        // A wrap refused (too far from the input) is redone at 0.75 x its
+        // alpha, down to --wrap-alpha (refused there: the refusal stands).
+        std::string refused;
+        const double scaled = ro.wrap_alpha;
+        for (;;) {
+          StageUsage u;
+          try {
+            repair_once(ro, &u, beat, rl);
+          } catch (const ParameterError&) {
+            throw;
+          } catch (const InputError& w) {
+            ru.cpu_seconds += u.cpu_seconds;
+            ru.wall_seconds += u.wall_seconds;
+            ru.peak_mb = std::max(ru.peak_mb, u.peak_mb);
+            if (!(ro.wrap_alpha > o.repair.wrap_alpha)) throw;
+            refused += (refused.empty() ? "" : ", ") + fmt(ro.wrap_alpha);
+            if (beat)
+              beat("the wrap at alpha " + fmt(ro.wrap_alpha) + " was refused: " + w.what());
+            ro.wrap_alpha = std::max(o.repair.wrap_alpha, 0.75 * ro.wrap_alpha);
+            rl.cpu_seconds = left();
+            require(rl.cpu_seconds);
+            continue;
+          }
+          ru.cpu_seconds += u.cpu_seconds;
+          ru.wall_seconds += u.wall_seconds;
+          ru.peak_mb = std::max(ru.peak_mb, u.peak_mb);
+          break;
         }
+        if (scaled > o.repair.wrap_alpha)
+          alpha_note = "alpha " + fmt(ro.wrap_alpha) + " of the diagonal: half the first cell " +
+                       "size " + fmt(first_size / s) +
+                       " so that gaps narrower than a cell are closed" +
+                       (refused.empty() ? ""
+                                        : ", or less: the wraps at alpha " + refused +
+                                              " were refused (too far from the input)") +
+                       "; --wrap-alpha " + fmt(o.repair.wrap_alpha) + " is the floor";
         rl.cpu_seconds = left();
         require(rl.cpu_seconds);
         simplify_once(&su, beat, rl);
@@ -392,8 +407,9 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
         throw;
       } catch (const InputError& e2) {
         throw InputError(std::string(e2.what()) +
-                         " [after the automatic retry on the alpha-wrapped surface; on the "
-                         "repaired surface first: " + first + "]");
+                         " [after the automatic retry on the alpha-wrapped surface" +
+                         (alpha_note.empty() ? "" : " (" + alpha_note + ")") +
+                         "; on the repaired surface first: " + first + "]");
       }
       r.repair.wrap_cause = near_contact ? 5 : 4;
       tet.usage.cpu_seconds += first_cpu + ru.cpu_seconds + su.cpu_seconds;

@@ -107,6 +107,28 @@ TEST(Preprocess, PartsInNearContactAreWrappedWithoutMeshingTheRepairedSurface) {
   EXPECT_EQ(late.repair.wrap_alpha, 0.05);
 }
 
+TEST(Preprocess, NearContactWrapTooFarFromTheInputIsRedoneAtASmallerAlpha) {
+  // The wrap lies about its offset (alpha / 30 of the diagonal) from the
+  // cubes: with a limit of 0.0018 of the diagonal the wrap at half the first
+  // cell size (alpha 0.081, ~0.0027) is refused, and so on down by 0.75
+  // until one lies within the limit (measured: 0.081 and 0.061 refused,
+  // 0.046 kept at 0.0015); the note lists the refused alphas.
+  PreprocessOptions o = near_contact_options();
+  o.repair.max_wrap_distance = 0.0018;
+  const PreprocessResult r = preprocess(cubes_in_near_contact(1e-3, false), o);
+  EXPECT_EQ(r.repair.wrap_cause, 5);
+  const double a = std::cbrt(6.0 * std::sqrt(2.0) * 2.0 / 500);
+  const double scaled = 0.5 * (a * std::sqrt(6.0) / 4.0 * 2.0) / std::sqrt(2.001 * 2.001 + 2.0);
+  EXPECT_LT(r.repair.wrap_alpha, 0.75 * scaled + 1e-9);
+  EXPECT_GT(r.repair.wrap_alpha, o.repair.wrap_alpha);
+  EXPECT_LE(r.repair.wrap_distance, 0.0018);
+  bool noted = false;
+  for (const std::string& n : r.notes)
+    noted |= n.find("were refused (too far from the input)") != std::string::npos;
+  EXPECT_TRUE(noted);
+  EXPECT_TRUE(test::closed_and_oriented(r.bundle.coarse.F));
+}
+
 TEST(Preprocess, PartsFartherApartThanTheToleranceAreMeshedAsTheyAre) {
   // 0.3 apart (the first cell size is ~0.4: tolerance ~0.04): both cubes
   // meshed from the repaired surface, no wrap, two components.
