@@ -71,6 +71,10 @@ ComponentGap closest_component_gap(const SurfaceMesh& surface, double within) {
     return Point(surface.V(v, 0), surface.V(v, 1), surface.V(v, 2));
   };
   double best2 = INFINITY;
+  std::vector<char> close(static_cast<std::size_t>(nv), 0);
+  // Pruned by `within` when it is finite (every vertex within it is
+  // counted), else by the best distance so far.
+  const auto reach = [&] { return std::isfinite(within) ? within : std::sqrt(best2); };
   for (std::size_t c = 0; c < faces.size(); ++c) {
     std::vector<Triangle> tris;
     tris.reserve(faces[c].size());
@@ -78,21 +82,21 @@ ComponentGap closest_component_gap(const SurfaceMesh& surface, double within) {
       tris.emplace_back(point(surface.F(f, 0)), point(surface.F(f, 1)), point(surface.F(f, 2)));
     Tree tree(tris.begin(), tris.end());
     tree.accelerate_distance_queries();
-    // Vertices of the other components within `within` (and the best so
-    // far) of this component's bounding box.
+    // Vertices of the other components within reach() of this component's
+    // bounding box.
     for (std::size_t d = 0; d < faces.size(); ++d) {
       if (d == c) continue;
-      const double reach = std::min(within, std::sqrt(best2));
-      if (((lo[d].array() - hi[c].array()) > reach).any() ||
-          ((lo[c].array() - hi[d].array()) > reach).any())
+      if (((lo[d].array() - hi[c].array()) > reach()).any() ||
+          ((lo[c].array() - hi[d].array()) > reach()).any())
         continue;
       for (int v : verts[d]) {
         const Eigen::RowVector3d p = surface.V.row(v);
-        const double r = std::min(within, std::sqrt(best2));
+        const double r = reach();
         if (((p.array() - hi[c].array()) > r).any() || ((lo[c].array() - p.array()) > r).any())
           continue;
         const Point q = tree.closest_point(point(v));
         const double d2 = CGAL::squared_distance(q, point(v));
+        if (d2 <= within * within) close[static_cast<std::size_t>(v)] = 1;
         if (d2 < best2) {
           best2 = d2;
           gap.first = static_cast<int>(std::min(c, d));
@@ -103,6 +107,7 @@ ComponentGap closest_component_gap(const SurfaceMesh& surface, double within) {
     }
   }
   gap.distance = std::sqrt(best2);
+  gap.close_vertices = static_cast<int>(std::count(close.begin(), close.end(), 1));
   return gap;
 }
 

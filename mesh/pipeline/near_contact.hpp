@@ -21,12 +21,16 @@ struct ComponentGap {
   double distance = INFINITY;
   int first = -1, second = -1;    ///< the two components (numbered by their first face)
   std::array<double, 3> where{};  ///< midpoint of the closest pair
+  /// Vertices within `within` of another component's triangles (a contact
+  /// at one point, as the two fans of a split non-manifold vertex, gives 2).
+  int close_vertices = 0;
 };
 
 /// Measures the closest approach of distinct components of `surface`
-/// (triangles, indices in range). Components whose bounding boxes lie
-/// farther apart than `within` are not compared (the result is then
-/// infinity for them; pass INFINITY to compare all). Deterministic.
+/// (triangles, indices in range) and counts the vertices within `within` of
+/// another component. Components whose bounding boxes lie farther apart than
+/// `within` are not compared (the distance is then infinity for them; pass
+/// INFINITY to compare all). Deterministic.
 ComponentGap closest_component_gap(const SurfaceMesh& surface, double within = INFINITY);
 
 }  // namespace icd::mesh

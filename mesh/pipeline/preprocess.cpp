@@ -260,9 +260,10 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     const auto wall0 = std::chrono::steady_clock::now();
     // The first cell size, and the parts in near contact: distinct
     // components closer than the mesher's surface tolerance (the facet
-    // distance bound at that size) make every pass refine between them up to
-    // its vertex cap (bones: 26 bones 0.1 % of the diagonal apart), so the
-    // first attempt is skipped for the wrap retry below.
+    // distance bound at that size) over more than a point make every pass
+    // refine between them up to its vertex cap (bones: 26 bones 0.1 % of the
+    // diagonal apart), so the first attempt is skipped for the wrap retry
+    // below.
     double first_size = to.cell_size, tolerance = 0.0;
     ComponentGap gap;
     StageUsage check;
@@ -291,7 +292,9 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       gap = in.pod<ComponentGap>();
       tolerance = to.facet_distance_factor * first_size;
     }
-    const bool near_contact = gap.distance < tolerance;
+    // More than a contact at one point (2-3 vertices: the fans of a split
+    // non-manifold vertex, which the mesher resolves).
+    const bool near_contact = gap.distance < tolerance && gap.close_vertices >= 4;
     try {
       if (near_contact) {
         std::ostringstream m;
@@ -301,8 +304,9 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
           << fmt(gap.where[0] / s + norm.centre[0]) << ", "
           << fmt(gap.where[1] / s + norm.centre[1]) << ", "
           << fmt(gap.where[2] / s + norm.centre[2])
-          << "), closer than the mesher's surface tolerance " << fmt(tolerance / s) << " ("
-          << fmt(to.facet_distance_factor) << " x the first cell size " << fmt(first_size / s)
+          << "), " << gap.close_vertices << " vertices closer to another part than the mesher's "
+          << "surface tolerance " << fmt(tolerance / s) << " (" << fmt(to.facet_distance_factor)
+          << " x the first cell size " << fmt(first_size / s)
           << "): every pass would refine between them up to its vertex cap";
         throw InputError(m.str());
       }

@@ -44,7 +44,11 @@ TEST(NearContact, ClosestComponentGapIsTheFacingCubesDistance) {
   EXPECT_NEAR(g.where[0], 1.005, 1e-12);
   // Bounding boxes farther apart than `within` are not compared.
   EXPECT_TRUE(std::isinf(closest_component_gap(cubes_in_near_contact(0.01), 0.005).distance));
-  EXPECT_NEAR(closest_component_gap(cubes_in_near_contact(0.01), 0.02).distance, 0.01, 1e-12);
+  const ComponentGap within = closest_component_gap(cubes_in_near_contact(0.01), 0.02);
+  EXPECT_NEAR(within.distance, 0.01, 1e-12);
+  // The corners of both facing faces lie within 0.02 of the other cube
+  // (a contact over a face, not at a point: preprocess() wraps from 4 on).
+  EXPECT_EQ(within.close_vertices, 8);
   // One component: no gap.
   const ComponentGap one = closest_component_gap(make_box_surface({0, 0, 0}, {1, 1, 1}));
   EXPECT_EQ(one.components, 1);
