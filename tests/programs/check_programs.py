@@ -21,6 +21,11 @@ checked, before it is complete: MIDWAY) they leave no file; fem_compression,
 when the write itself fails (RLIMIT_FSIZE below the output's size), exits 1,
 not 0, and leaves no file either (the output is written whole at the end,
 atomically: no truncated file that looks complete).
+Under a memory limit (RLIMIT_AS = 100 MiB, below the 128 MiB buffer each of
+OpenBLAS's worker threads allocates when the library is loaded, and retries
+for ever when that fails) every program answers --help, and the programs that
+read files report a missing one, within the 20 s limit: no hang in exit()
+(process_exit.hpp).
 Prints one line per failure and exits 1 if any.
 """
 import argparse
@@ -105,11 +110,18 @@ def run_fsize_limited(program, args, cwd):
     return p.returncode, p.stderr.decode(errors="replace")
 
 
-def run(program, args, cwd):
+MEMORY_LIMIT = 100 << 20  # bytes of address space: see the top
+
+
+def limit_memory():
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
+
+
+def run(program, args, cwd, preexec_fn=None):
     t0 = time.monotonic()
     try:
         p = subprocess.run([program] + args, cwd=cwd, stdin=subprocess.DEVNULL,
-                           capture_output=True, timeout=LIMIT_S)
+                           capture_output=True, timeout=LIMIT_S, preexec_fn=preexec_fn)
     except subprocess.TimeoutExpired:
         return None, "", "", LIMIT_S
     return (p.returncode, p.stdout.decode(errors="replace"), p.stderr.decode(errors="replace"),
@@ -165,6 +177,14 @@ def main():
                     if status != 2 or err != want or out:
                         fail(program, f"--no-such-option: exit {status}, stderr {err!r}, stdout "
                                       f"{out[:200]!r}; expected exit 2 and {want!r}")
+        with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
+            status, out, err, _ = run(program, ["--help"], cwd, limit_memory)
+            if status is None:
+                fail(program, f"--help under RLIMIT_AS {MEMORY_LIMIT >> 20} MiB: still running "
+                              f"after {LIMIT_S} s (hung in exit()?)")
+            elif status != 0 or f"Usage: {name}" not in out:
+                fail(program, f"--help under RLIMIT_AS {MEMORY_LIMIT >> 20} MiB: exit {status}; "
+                              f"stderr: {err.strip()[-200:]!r}")
         if name in FILE_PROGRAMS:
             checked_files += 1
             with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
@@ -179,6 +199,11 @@ def main():
                     fail(program, f"missing input: stderr does not name the file: {err.strip()!r}")
                 if os.listdir(cwd):
                     fail(program, f"missing input: created {sorted(os.listdir(cwd))}")
+                status, out, err, _ = run(program, args, cwd, limit_memory)
+                if status is None or status <= 0:
+                    fail(program, f"missing input under RLIMIT_AS {MEMORY_LIMIT >> 20} MiB: exit "
+                                  f"{status} (None: still running after {LIMIT_S} s, hung in "
+                                  f"exit()?), expected non-zero (not a signal)")
         if name in OUTPUT_PROGRAMS:
             checked_outputs += 1
             with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
@@ -223,7 +248,8 @@ def main():
         fail(name, "in OUTPUT_PROGRAMS but not in the program list (renamed?)")
     for line in failures:
         print("FAIL", line)
-    print(f"{len(programs)} programs checked (--help, --version, unknown option); "
+    print(f"{len(programs)} programs checked (--help, also under a memory limit, --version, "
+          f"unknown option); "
           f"{checked_files} given a missing input file, {checked_outputs} an unwritable output "
           f"file, stopped midway and a failing write; {len(failures)} failures")
     return 1 if failures else 0
