@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/union_find.hpp>
 
 namespace icd::coupling {
 namespace {
@@ -337,21 +338,18 @@ DeepContactStats deep_contact_velocity_step(const SphereTree& a, const SphereTre
   };
   const auto na = static_cast<int32_t>(vel_a.rows()), nb = static_cast<int32_t>(vel_b.rows());
   MatX3d impulse(na + nb, 3);  // per node of a, then of b
-  std::vector<int32_t> parent(static_cast<size_t>(na + nb)), patch_of(parent.size());
+  // Nodes of a and b (b's numbered from na): those of the pairs still
+  // approaching (touched), grouped into patches by the nodes they share.
+  UnionFind shared(na + nb);
+  std::vector<char> touched(static_cast<size_t>(na + nb));
+  std::vector<int32_t> patch_of(touched.size());
   struct Patch {
     double g = 0, h = 0, scale = 0;
   };
   std::vector<Patch> patches;
-  auto find = [&](int32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
   auto join = [&](int32_t x, int32_t y) {
-    if (parent[x] < 0) parent[x] = x;
-    if (parent[y] < 0) parent[y] = y;
-    x = find(x);
-    y = find(y);
-    if (x != y) parent[std::max(x, y)] = std::min(x, y);
+    touched[x] = touched[y] = 1;
+    shared.unite(x, y);
   };
   auto node_mass = [&](int32_t x) { return x < na ? mass_a[x] : mass_b[x - na]; };
   auto node_vel = [&](int32_t x) {
@@ -374,7 +372,8 @@ DeepContactStats deep_contact_velocity_step(const SphereTree& a, const SphereTre
   const double tiny = 1e-12;
   for (int sweep = 0; sweep < kSweeps; ++sweep) {
     impulse.setZero();
-    std::fill(parent.begin(), parent.end(), -1);
+    shared.reset(na + nb);
+    std::fill(touched.begin(), touched.end(), 0);
     std::fill(patch_of.begin(), patch_of.end(), -1);
     bool any = false;
     for (Deep& q : deep) {
@@ -402,8 +401,8 @@ DeepContactStats deep_contact_velocity_step(const SphereTree& a, const SphereTre
     if (!any) break;
     patches.clear();
     for (int32_t x = 0; x < na + nb; ++x) {
-      if (parent[x] < 0) continue;
-      const int32_t root = find(x);
+      if (!touched[x]) continue;
+      const int32_t root = shared.find(x);
       if (patch_of[root] < 0) {
         patch_of[root] = static_cast<int32_t>(patches.size());
         patches.emplace_back();

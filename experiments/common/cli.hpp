@@ -35,6 +35,8 @@
 
 #include <icd/config.hpp>
 
+#include "experiments/common/process_exit.hpp"
+
 namespace icd::experiments {
 
 class Cli {
@@ -177,9 +179,11 @@ class Cli {
 /// The command line of a Google Benchmark program: `--help` prints this
 /// program's description and the benchmark flags it takes, `--version` the
 /// version, both without running anything; call before
-/// benchmark::Initialize(), then benchmark_leftover() after it.
+/// benchmark::Initialize(), then benchmark_leftover() after it. Under a memory
+/// limit the process ends without the libraries' shutdown (process_exit.hpp).
 inline std::optional<int> benchmark_preamble(int argc, char** argv, const std::string& program,
                                              const std::string& description) {
+  exit_without_library_shutdown_under_memory_limits();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {

@@ -14,8 +14,12 @@
 /// command-line error of cli.hpp):
 ///   return guarded_main<icd::ParameterError>("icd-preprocess", run, argc, argv);
 /// prints "<program>: invalid option: <what>" and returns 2 for it.
+/// Under a memory limit the process ends without the libraries' shutdown
+/// (exit_without_library_shutdown_under_memory_limits: OpenBLAS's would hang).
 #include <exception>
 #include <iostream>
+
+#include "experiments/common/process_exit.hpp"
 
 namespace icd::experiments {
 
@@ -32,6 +36,7 @@ struct NoUsageError {
 /// one that is not a std::exception).
 template <class UsageError = detail::NoUsageError, class Run>
 int guarded_main(const char* program, Run&& run, int argc, char** argv) noexcept {
+  exit_without_library_shutdown_under_memory_limits();
   try {
     return run(argc, argv);
   } catch (const UsageError& e) {

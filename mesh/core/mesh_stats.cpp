@@ -8,19 +8,9 @@
 #include <vector>
 
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/union_find.hpp>
 
 namespace icd {
-namespace {
-
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[i] != i) {
-    parent[i] = parent[parent[i]];
-    i = parent[i];
-  }
-  return i;
-}
-
-}  // namespace
 
 SurfaceStats compute_surface_stats(const SurfaceMesh& mesh) {
   const MatX3d& V = mesh.V;
@@ -47,8 +37,7 @@ SurfaceStats compute_surface_stats(const SurfaceMesh& mesh) {
   };
   std::vector<HalfEdge> half(static_cast<size_t>(3) * nf);
   std::vector<char> referenced(nv, 0);
-  std::vector<int> parent(nv);
-  std::iota(parent.begin(), parent.end(), 0);
+  UnionFind components(nv);
   for (int f = 0; f < nf; ++f) {
     const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
     const Eigen::Vector3d n = (b - a).cross(c - a);
@@ -64,8 +53,7 @@ SurfaceStats compute_surface_stats(const SurfaceMesh& mesh) {
                  hi = static_cast<uint64_t>(std::max(i, j));
       half[3 * f + k] = {lo << 32 | hi, i < j};
       referenced[i] = 1;
-      const int ri = find_root(parent, i), rj = find_root(parent, j);
-      if (ri != rj) parent[ri] = rj;
+      components.unite(i, j);
     }
   }
   std::sort(half.begin(), half.end(),
@@ -86,7 +74,7 @@ SurfaceStats compute_surface_stats(const SurfaceMesh& mesh) {
   for (int i = 0; i < nv; ++i) {
     if (!referenced[i])
       ++s.unreferenced_vertices;
-    else if (find_root(parent, i) == i)
+    else if (components.find(i) == i)
       ++s.components;
   }
 

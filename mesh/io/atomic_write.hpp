@@ -12,4 +12,11 @@ namespace icd {
 /// is thrown. The parent folder must exist.
 void write_file_atomically(const std::filesystem::path& path, std::string_view contents);
 
+/// For a program that builds its output while it works and writes it with
+/// write_file_atomically at the end: checks up front that it could, by
+/// creating `<path>.part` and removing it again, so that a missing or
+/// read-only folder is reported before the work (the same InputError as
+/// write_file_atomically). Creates nothing that stays; `path` is not touched.
+void check_writable(const std::filesystem::path& path);
+
 }  // namespace icd

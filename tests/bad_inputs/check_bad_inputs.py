@@ -8,9 +8,14 @@ sanitizer abort), stderr/stdout naming the problem (the expected substring of
 the manifest, case-insensitive), and, for icd-run and icd-preprocess, no
 output file that looks complete (frames.csv, a .pvd series, bundle.icdb).
 Good inputs: exit status 0 and the expected substring in the output.
-Every input: at most --max-seconds of wall-clock time and --max-memory-mb of
-memory (RLIMIT_AS in the child, so an allocation above the bound fails, and
-the child's peak resident memory is checked too); no file written outside
+Every input: at most --max-cpu-seconds of CPU time (user + system of the
+child, from os.wait4: the same on a loaded machine as on an idle one;
+RLIMIT_CPU stops a child that runs past it) and --max-memory-mb of memory
+(RLIMIT_AS in the child, so an allocation above the bound fails, and the
+child's peak resident memory is checked too); --max-wall-seconds of wall-clock
+time only as a guard against a hang (a child that waits without using CPU),
+generous because a loaded machine stretches wall time (load 7-10: 26 s wall
+for 4 s CPU); no file written outside
 its output folder (the runs start in an empty folder); no shell command of a
 hostile path run (no marker file "icd_injected_marker" appears).
 
@@ -24,11 +29,16 @@ DIR; skipped without CGAL).
 
 usage: check_bad_inputs.py --files DIR --manifest FILE [--good FILE] --work DIR
                            --meshinfo EXE --run EXE --read-check EXE
-                           [--preprocess EXE] [--max-seconds S] [--max-memory-mb M]
-                           [--min-files N]
+                           [--preprocess EXE] [--max-cpu-seconds S] [--max-wall-seconds W]
+                           [--max-memory-mb M] [--min-files N]
+       check_bad_inputs.py --self-test
 Rows whose program is not given (e.g. preprocess without CGAL) are skipped.
+--self-test: the limits must catch fake programs (one burning CPU past the CPU
+limit, one hanging without CPU) and must pass one that only waits (wall time
+without CPU time, as on a loaded machine); exit 1 if they do not.
 """
 import argparse
+import math
 import os
 import resource
 import shlex
@@ -128,8 +138,8 @@ GENERATORS = {
     "scene_too_many_values.json": lambda p: gen_scene_values(p, (1 << 20) + 1),
     "scene_most_values.json": lambda p: gen_scene_values(p, 1 << 20),
     # (A quarter to a third of the limits, so that they stay well within 10 s
-    # on the shared 2-core machine under load, where the at-limit files take
-    # 8-20 s; the reliability README gives the at-limit figures.)
+    # of CPU time: about 1 s each; the at-limit files take 3-7 s on an idle
+    # machine; the reliability README gives the at-limit figures.)
     "off_worst_vertices.off": lambda p: lines_file(
         p, b"OFF\n4000000 1 0\n", b"0 0 0\n", 4000000, b"3 0 1 2\n"),
     "off_worst_faces.off": lambda p: lines_file(
@@ -173,11 +183,15 @@ def tree(folder):
     return out
 
 
-def run_limited(cmd, cwd, max_seconds, max_memory, env=None):
-    """Runs cmd in cwd (environment env, None: this one) under RLIMIT_AS = max_memory (0: none); returns
-    (returncode, stdout, stderr, seconds, peak RSS bytes of this child, timed out)."""
+def run_limited(cmd, cwd, max_cpu, max_wall, max_memory, env=None):
+    """Runs cmd in cwd (environment env, None: this one) under RLIMIT_AS = max_memory (0: none)
+    and RLIMIT_CPU (SIGXCPU a second past max_cpu), killed after max_wall seconds of wall time;
+    returns (returncode, stdout, stderr, CPU seconds (user + system), wall seconds, peak RSS bytes
+    of this child, timed out)."""
     def limit():
         resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+        cpu = math.ceil(max_cpu) + 1
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 2))
         if max_memory:
             resource.setrlimit(resource.RLIMIT_AS, (max_memory, max_memory))
     out_path, err_path = os.path.join(cwd, ".stdout"), os.path.join(cwd, ".stderr")
@@ -189,28 +203,80 @@ def run_limited(cmd, cwd, max_seconds, max_memory, env=None):
         pid, status, usage = os.wait4(p.pid, os.WNOHANG)
         if pid == p.pid:
             break
-        if time.monotonic() - t0 > max_seconds and not timed_out:
+        if time.monotonic() - t0 > max_wall and not timed_out:
             p.kill()
             timed_out = True
         time.sleep(0.01)
     p.returncode = os.waitstatus_to_exitcode(status)
-    dt = time.monotonic() - t0
+    wall = time.monotonic() - t0
     with open(out_path, "rb") as f:
         out = f.read().decode("utf-8", "replace")
     with open(err_path, "rb") as f:
         err = f.read().decode("utf-8", "replace")
     os.remove(out_path)
     os.remove(err_path)
-    return p.returncode, out, err, dt, usage.ru_maxrss * 1024, timed_out
+    cpu = usage.ru_utime + usage.ru_stime
+    return p.returncode, out, err, cpu, wall, usage.ru_maxrss * 1024, timed_out
+
+
+def limit_problems(rc, cpu, wall, timed_out, max_cpu, max_wall):
+    """What the time limits say of a run: CPU time above max_cpu (stopped by SIGXCPU or not), a
+    hang past the wall-clock guard, a crash (any other signal). Empty when the run is within."""
+    problems = []
+    xcpu = rc in (-signal.SIGXCPU, 128 + signal.SIGXCPU)
+    if cpu > max_cpu or xcpu:
+        problems.append(f"used {cpu:.1f} s of CPU time, above the limit of {max_cpu:g} s"
+                        + (" (stopped by SIGXCPU)" if xcpu else ""))
+    elif timed_out:
+        problems.append(f"still running after {max_wall:g} s of wall time ({cpu:.1f} s CPU): hung?")
+    elif rc < 0 or rc >= 128:
+        sig = -rc if rc < 0 else rc - 128
+        problems.append(f"killed by signal {sig} ({signal.Signals(sig).name})")
+    return problems
+
+
+def self_test():
+    """The limits catch a CPU burner and a hang, and pass a program that only waits."""
+    import tempfile
+    failures = []
+    with tempfile.TemporaryDirectory(prefix="icd_bad_inputs_self_test_") as cwd:
+        def judge(name, code, max_cpu, max_wall, expect):
+            cmd = [sys.executable, "-c", code]
+            rc, _, err, cpu, wall, _, timed_out = run_limited(cmd, cwd, max_cpu, max_wall, 0)
+            problems = limit_problems(rc, cpu, wall, timed_out, max_cpu, max_wall)
+            print(f"self-test {name}: rc={rc} cpu {cpu:.2f} s wall {wall:.2f} s: "
+                  f"{'; '.join(problems) or 'within the limits'}")
+            if expect is None and problems:
+                failures.append(f"{name}: flagged ({'; '.join(problems)}), expected within limits")
+            if expect is not None and not any(expect in p for p in problems):
+                failures.append(f"{name}: not flagged with '{expect}': {problems}; {err[-300:]}")
+        # Burns CPU forever: stopped by RLIMIT_CPU (SIGXCPU) near 2 s of CPU.
+        judge("cpu burner", "while True: pass", 1, 60, "of CPU time, above the limit of 1 s")
+        # Burns 1.3 s of CPU, then exits 0: the CPU figure alone flags it.
+        judge("cpu burner that exits", "import signal, time\n"
+              "signal.signal(signal.SIGXCPU, signal.SIG_IGN)\n"
+              "t = time.process_time()\nwhile time.process_time() - t < 1.3: pass",
+              1, 60, "of CPU time, above the limit of 1 s")
+        # Sleeps 1.5 s (wall time without CPU time, as on a loaded machine): within a 1 s CPU limit.
+        judge("sleeper", "import time; time.sleep(1.5)", 1, 60, None)
+        # Hangs without CPU: the wall-clock guard.
+        judge("hang", "import time; time.sleep(600)", 1, 1.5, "wall time")
+    for f in failures:
+        print("FAILED:", f)
+    return 1 if failures else 0
 
 
 def main():
+    if sys.argv[1:] == ["--self-test"]:
+        return self_test()
     ap = argparse.ArgumentParser()
     for opt in ("files", "manifest", "work", "meshinfo", "run", "read-check"):
         ap.add_argument("--" + opt, required=True)
     ap.add_argument("--good")
     ap.add_argument("--preprocess")
-    ap.add_argument("--max-seconds", type=float, default=10)
+    ap.add_argument("--max-cpu-seconds", type=float, default=10)
+    ap.add_argument("--max-wall-seconds", type=float, default=120,
+                    help="hang guard only: wall time stretches with the machine's load")
     ap.add_argument("--max-memory-mb", type=float, default=1024,
                     help="0: no memory bound (sanitizer builds reserve terabytes of address space)")
     ap.add_argument("--min-files", type=int, default=110)
@@ -236,7 +302,7 @@ def main():
     os.makedirs(a.work)
     max_memory = int(a.max_memory_mb * MiB)
     ran = skipped = 0
-    slowest = (0.0, "")
+    slowest = (0.0, 0.0, "")
     t_all = time.monotonic()
     # The runner's asset cache (a scene's raw mesh is preprocessed into it,
     # with a lock file named after the mesh, hostile names included) is a
@@ -285,17 +351,15 @@ def main():
                 cmd.append("--dry-run")
         cmd += extra
         before = tree(cwd) | {".stdout", ".stderr"}
-        rc, out, err, dt, rss, timed_out = run_limited(cmd, cwd, a.max_seconds, max_memory, child_env)
+        rc, out, err, cpu, wall, rss, timed_out = run_limited(
+            cmd, cwd, a.max_cpu_seconds, a.max_wall_seconds, max_memory, child_env)
         ran += 1
-        slowest = max(slowest, (dt, name))
+        slowest = max(slowest, (cpu, wall, name))
         text = out + err
         last = (err.strip().splitlines() or out.strip().splitlines() or ["<no output>"])[-1]
-        problems = []
-        if timed_out:
-            problems.append(f"did not finish in {a.max_seconds} s")
-        elif rc < 0 or rc >= 128:
-            sig = -rc if rc < 0 else rc - 128
-            problems.append(f"killed by signal {sig} ({signal.Signals(sig).name})")
+        problems = limit_problems(rc, cpu, wall, timed_out, a.max_cpu_seconds, a.max_wall_seconds)
+        if problems:
+            pass  # a crash, a hang or too much CPU: the exit status says nothing more
         elif good and rc != 0:
             problems.append(f"exit status {rc} (a valid input refused)")
         elif not good and rc == 0:
@@ -321,15 +385,18 @@ def main():
                 problems.append(f"a shell ran a command from a path ({MARKER} created in {root})")
                 os.remove(os.path.join(root, MARKER))
         status = "FAIL" if problems else ("good" if good else "ok")
-        print(f"{status:4} {name:40} {program_args:16} rc={rc} {dt:5.2f}s {rss / MiB:6.0f}MiB  "
+        print(f"{status:4} {name:40} {program_args:16} rc={rc} {cpu:5.2f}s cpu {wall:5.2f}s wall "
+              f"{rss / MiB:5.0f}MiB  "
               f"{last[:150]}")
         if problems:
             failures.append(f"{where}: " + "; ".join(problems) +
                             f"\n    command: {shlex.join(cmd)}\n    output: {text.strip()[-600:]}")
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024  # MiB
     print(f"\n{ran} inputs run ({len(bad_files)} bad, {len({r[2] for r in good_rows})} good), "
-          f"{skipped} skipped (program not built), {time.monotonic() - t_all:.1f} s; "
-          f"slowest {slowest[0]:.2f} s ({slowest[1]}), largest peak memory {peak:.0f} MiB")
+          f"{skipped} skipped (program not built), {time.monotonic() - t_all:.1f} s wall; "
+          f"most CPU {slowest[0]:.2f} s ({slowest[2]}, {slowest[1]:.2f} s wall; limit "
+          f"{a.max_cpu_seconds:g} s CPU, {a.max_wall_seconds:g} s wall), "
+          f"largest peak memory {peak:.0f} MiB")
     if ran < 30:
         failures.append(f"only {ran} inputs were run (at least 30 expected)")
     # The hostile-named mesh was preprocessed through the private cache: its

@@ -16,11 +16,22 @@ does not exist, exit non-zero (not by a signal), name the file on stderr and
 create nothing. The programs that write a file named on the command line,
 given one in a folder that does not exist, exit 1 (not by a signal: no
 std::terminate), print "<name>: ..." naming the file on stderr and create
-nothing.
+nothing; stopped midway (killed by a signal after the output is opened or
+checked, before it is complete: MIDWAY) they leave no file; fem_compression,
+when the write itself fails (RLIMIT_FSIZE below the output's size), exits 1,
+not 0, and leaves no file either (the output is written whole at the end,
+atomically: no truncated file that looks complete).
+Under a memory limit (RLIMIT_AS = 100 MiB, below the 128 MiB buffer each of
+OpenBLAS's worker threads allocates when the library is loaded, and retries
+for ever when that fails) every program answers --help, and the programs that
+read files report a missing one, within the 20 s limit: no hang in exit()
+(process_exit.hpp).
 Prints one line per failure and exits 1 if any.
 """
 import argparse
 import os
+import resource
+import signal
 import subprocess
 import sys
 import tempfile
@@ -46,12 +57,71 @@ OUTPUT_PROGRAMS = {
     "fem_compression": ["{unwritable}"],
 }
 
+# How to stop each of these programs midway, writing {out}: after its output
+# file is opened (or checked writable) and before it is complete, at the same
+# point on every run. "stdout": killed by SIGXFSZ by the write that takes its
+# stdout (a file, under RLIMIT_FSIZE) past that many bytes, i.e. after its
+# first result lines; "cpu": killed by SIGXCPU after that many seconds of CPU
+# time (icd_collision_overrun spends tens of seconds of CPU building its
+# trees, after opening or checking its output, and prints nothing before).
+# "write_fails": also run it whole with a failing write (RLIMIT_FSIZE below its
+# output's size); not for icd_collision_overrun, whose whole run takes
+# minutes (its output goes through the same write_file_atomically).
+MIDWAY = {
+    "icd_collision_overrun": {"args": ["--csv", "{out}"], "cpu": 1},
+    "fem_compression": {"args": ["{out}"], "stdout": 1000, "write_fails": True},
+}
+FSIZE_LIMIT = 100  # bytes: below fem_compression's output (4 KB)
 
-def run(program, args, cwd):
+
+def stop_midway(program, args, cwd, how):
+    """Runs program and stops it midway as `how` says (a MIDWAY entry), its stdout to a file
+    outside cwd. Returns None when stopped that way, else what happened instead."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+        if "stdout" in how:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (how["stdout"], how["stdout"]))
+        if "cpu" in how:
+            resource.setrlimit(resource.RLIMIT_CPU, (how["cpu"], how["cpu"] + 1))
+    signal_expected = signal.SIGXFSZ if "stdout" in how else signal.SIGXCPU
+    with tempfile.TemporaryFile() as out:
+        try:
+            p = subprocess.run([program] + args, cwd=cwd, stdin=subprocess.DEVNULL, stdout=out,
+                               stderr=subprocess.PIPE, timeout=LIMIT_S * 3, preexec_fn=limit)
+        except subprocess.TimeoutExpired:
+            return f"still running after {LIMIT_S * 3} s"
+    if p.returncode != -signal_expected:
+        return (f"exit {p.returncode}, not stopped by {signal_expected.name} (too short a run?); "
+                f"stderr: {p.stderr.decode(errors='replace').strip()[-200:]!r}")
+    return None
+
+
+def run_fsize_limited(program, args, cwd):
+    """Runs program with RLIMIT_FSIZE = FSIZE_LIMIT bytes (SIGXFSZ ignored, so a write past it
+    fails with EFBIG). Returns (exit status or None on timeout, stderr)."""
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (FSIZE_LIMIT, FSIZE_LIMIT))
+    try:
+        p = subprocess.run([program] + args, cwd=cwd, stdin=subprocess.DEVNULL,
+                           capture_output=True, timeout=LIMIT_S * 3, preexec_fn=limit)
+    except subprocess.TimeoutExpired:
+        return None, ""
+    return p.returncode, p.stderr.decode(errors="replace")
+
+
+MEMORY_LIMIT = 100 << 20  # bytes of address space: see the top
+
+
+def limit_memory():
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
+
+
+def run(program, args, cwd, preexec_fn=None):
     t0 = time.monotonic()
     try:
         p = subprocess.run([program] + args, cwd=cwd, stdin=subprocess.DEVNULL,
-                           capture_output=True, timeout=LIMIT_S)
+                           capture_output=True, timeout=LIMIT_S, preexec_fn=preexec_fn)
     except subprocess.TimeoutExpired:
         return None, "", "", LIMIT_S
     return (p.returncode, p.stdout.decode(errors="replace"), p.stderr.decode(errors="replace"),
@@ -107,6 +177,14 @@ def main():
                     if status != 2 or err != want or out:
                         fail(program, f"--no-such-option: exit {status}, stderr {err!r}, stdout "
                                       f"{out[:200]!r}; expected exit 2 and {want!r}")
+        with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
+            status, out, err, _ = run(program, ["--help"], cwd, limit_memory)
+            if status is None:
+                fail(program, f"--help under RLIMIT_AS {MEMORY_LIMIT >> 20} MiB: still running "
+                              f"after {LIMIT_S} s (hung in exit()?)")
+            elif status != 0 or f"Usage: {name}" not in out:
+                fail(program, f"--help under RLIMIT_AS {MEMORY_LIMIT >> 20} MiB: exit {status}; "
+                              f"stderr: {err.strip()[-200:]!r}")
         if name in FILE_PROGRAMS:
             checked_files += 1
             with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
@@ -121,6 +199,11 @@ def main():
                     fail(program, f"missing input: stderr does not name the file: {err.strip()!r}")
                 if os.listdir(cwd):
                     fail(program, f"missing input: created {sorted(os.listdir(cwd))}")
+                status, out, err, _ = run(program, args, cwd, limit_memory)
+                if status is None or status <= 0:
+                    fail(program, f"missing input under RLIMIT_AS {MEMORY_LIMIT >> 20} MiB: exit "
+                                  f"{status} (None: still running after {LIMIT_S} s, hung in "
+                                  f"exit()?), expected non-zero (not a signal)")
         if name in OUTPUT_PROGRAMS:
             checked_outputs += 1
             with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
@@ -135,14 +218,40 @@ def main():
                                   f"and name the file: {err.strip()[:200]!r}")
                 if os.listdir(cwd):
                     fail(program, f"unwritable output: created {sorted(os.listdir(cwd))}")
+            how = MIDWAY[name]
+            with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
+                out_file = os.path.join(cwd, "out.txt")
+                args = [x.format(out=out_file) for x in how["args"]]
+                problem = stop_midway(program, args, cwd, how)
+                if problem:
+                    fail(program, f"stopped midway: {problem}")
+                elif os.listdir(cwd):
+                    when = (f"when its stdout reached {how['stdout']} bytes" if "stdout" in how
+                            else f"after {how['cpu']} s of CPU time")
+                    fail(program, f"stopped midway (killed {when}): left "
+                                  f"{sorted(os.listdir(cwd))}")
+            if how.get("write_fails"):
+                with tempfile.TemporaryDirectory(prefix="icd_programs_") as cwd:
+                    out_file = os.path.join(cwd, "out.txt")
+                    args = [x.format(out=out_file) for x in how["args"]]
+                    status, err = run_fsize_limited(program, args, cwd)
+                    if status != 1 or out_file not in err:
+                        fail(program, f"output write failing (RLIMIT_FSIZE {FSIZE_LIMIT} bytes): "
+                                      f"exit {status}, expected 1 with a message naming "
+                                      f"{out_file}; stderr: {err.strip()[-200:]!r}")
+                    if os.listdir(cwd):
+                        fail(program, f"output write failing (RLIMIT_FSIZE {FSIZE_LIMIT} bytes): "
+                                      f"left {sorted(os.listdir(cwd))}")
     names = {os.path.basename(p) for p in programs}
+    assert set(MIDWAY) == set(OUTPUT_PROGRAMS)
     for name in sorted(set(OUTPUT_PROGRAMS) - names):
         fail(name, "in OUTPUT_PROGRAMS but not in the program list (renamed?)")
     for line in failures:
         print("FAIL", line)
-    print(f"{len(programs)} programs checked (--help, --version, unknown option); "
+    print(f"{len(programs)} programs checked (--help, also under a memory limit, --version, "
+          f"unknown option); "
           f"{checked_files} given a missing input file, {checked_outputs} an unwritable output "
-          f"file; {len(failures)} failures")
+          f"file, stopped midway and a failing write; {len(failures)} failures")
     return 1 if failures else 0
 
 

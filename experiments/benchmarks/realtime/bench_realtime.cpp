@@ -9,6 +9,7 @@
 //   default scenes: experiments/scenes/bunny_dragon.json (the main job) and
 //   experiments/scenes/many_objects.json; default 120 frames each.
 #include "experiments/common/cli.hpp"
+#include "experiments/common/process_exit.hpp"
 #include <time.h>
 
 #include <algorithm>
@@ -490,6 +491,7 @@ void run_lod(const std::filesystem::path& path, const std::vector<std::string>& 
 }  // namespace
 
 int main(int argc, char** argv) {
+  icd::experiments::exit_without_library_shutdown_under_memory_limits();
   int frames = 120;
   bool lod = false, trace = false;
   std::vector<std::filesystem::path> scenes;

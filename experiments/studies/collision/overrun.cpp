@@ -14,18 +14,19 @@
 // Usage: icd_collision_overrun [--queries N] [--max-seconds S] [--csv FILE]
 //   N: queries per (configuration, budget), default 10000; S: time cap per
 //   (configuration, budget), default 4 s (so 100 ms budgets run S/0.1 queries).
+//   FILE is written whole at the end, atomically: a run stopped midway leaves none.
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <random>
-#include <stdexcept>
+#include <sstream>
 #include <stop_token>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <icd/collision/traversal.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
 #include "experiments/studies/collision/workloads.hpp"
 #include "experiments/common/cli.hpp"
 #include "experiments/common/guarded_main.hpp"
@@ -93,10 +94,11 @@ int run(int argc, char** argv) {
       .real("--max-seconds", max_seconds, "S", "wall time at most (default 4)", 0.0)
       .text("--csv", csv_path, "FILE", "also write the measurements as CSV");
   if (const auto status = cli.parse(argc, argv)) return *status;
-  std::ofstream csv;
-  if (!csv_path.empty()) {
-    csv.open(csv_path);
-    if (!csv) throw std::runtime_error("--csv: cannot write '" + csv_path + "'");
+  // The CSV is built here and written whole at the end (checked writable first).
+  const bool want_csv = !csv_path.empty();
+  std::ostringstream csv;
+  if (want_csv) {
+    icd::check_writable(csv_path);
     csv << "config,budget_s,queries,completed,early,early_p50_us,early_max_us,overruns,p50_us,"
            "p99_us,p999_us,max_us,median_tests\n";
   }
@@ -195,7 +197,7 @@ int run(int argc, char** argv) {
                     "", "", 1e6 * quantile(early_reserve, 0.5), 1e9 * finish_cost_per_pair(),
                     1e9 * calibrated_finish_cost_per_pair());
       std::fflush(stdout);
-      if (csv)
+      if (want_csv)
         csv << '"' << c.name << "\"," << budget << ',' << n << ',' << completed << ','
             << early.size() << ',' << 1e6 * quantile(early, 0.5) << ',' << 1e6 * quantile(early, 1.0)
             << ',' << over.size() << ',' << 1e6 * quantile(over, 0.5) << ','
@@ -217,7 +219,7 @@ int run(int argc, char** argv) {
     std::printf("%8.0fus %9zu %9.2f %9.2f %9.2f %9.1f\n", budgets[bi] * 1e6, l.size(),
                 1e6 * quantile(l, 0.5), 1e6 * quantile(l, 0.99), 1e6 * quantile(l, 0.999),
                 1e6 * quantile(l, 1.0));
-    if (csv)
+    if (want_csv)
       csv << "floor," << budgets[bi] << ',' << l.size() << ",0,0,,," << l.size() << ','
           << 1e6 * quantile(l, 0.5) << ',' << 1e6 * quantile(l, 0.99) << ',' << 1e6 * quantile(l, 0.999) << ','
           << 1e6 * quantile(l, 1.0) << ",0\n";
@@ -227,6 +229,7 @@ int run(int argc, char** argv) {
       floor.gaps.size(), floor.gaps.size() / floor.spun, 1e6 * quantile(floor.gaps, 0.5),
       1e6 * quantile(floor.gaps, 0.99), 1e6 * quantile(floor.gaps, 1.0));
   std::printf("load average at end %s\n", icd::experiments::load_average().c_str());
+  if (want_csv) icd::write_file_atomically(csv_path, csv.str());
   return 0;
 }
 

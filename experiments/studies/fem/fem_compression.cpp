@@ -12,7 +12,8 @@
 // state, M lumped) from a dense generalized eigensolver (the reference) and
 // from estimate_max_frequency (Lanczos, cold start); ratios to the rest state.
 //
-// Usage: fem_compression [output.txt]   (also prints to stdout)
+// Usage: fem_compression [output.txt]   (also prints to stdout; the file is
+// written whole at the end, atomically: a run stopped midway leaves none)
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -26,6 +27,7 @@
 #include <icd/fem/constitutive.hpp>
 #include <icd/fem/stable_step.hpp>
 #include <icd/mesh/core/primitives.hpp>
+#include <icd/mesh/io/atomic_write.hpp>
 
 namespace {
 
@@ -84,14 +86,11 @@ int run(int argc, char** argv) {
   cli.argument("OUTPUT", out_path, "also write the table to this file", false);
   if (const auto status = cli.parse(argc, argv)) return *status;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  FILE* out = nullptr;
-  if (!out_path.empty() && (out = std::fopen(out_path.c_str(), "w")) == nullptr) {
-    std::fprintf(stderr, "fem_compression: cannot write %s\n", out_path.c_str());
-    return 1;
-  }
+  if (!out_path.empty()) check_writable(out_path);  // before the work
+  std::string table;  // the copy for OUTPUT, written whole at the end
   auto emit = [&](const char* line) {
     std::fputs(line, stdout);
-    if (out) std::fputs(line, out);
+    table += line;
   };
   BoxMeshOptions bo;
   bo.nx = bo.ny = bo.nz = 3;
@@ -142,7 +141,7 @@ int run(int argc, char** argv) {
   std::snprintf(line, sizeof line,
                 "largest |Lanczos / dense - 1| over all compressed states: %.1e\n", worst);
   emit(line);
-  if (out) std::fclose(out);
+  if (!out_path.empty()) write_file_atomically(out_path, table);
   return 0;
 }
 
