@@ -73,6 +73,9 @@ struct TetrahedralizeOptions {
   /// The surface is already an alpha wrap (repair's or the automatic wrap
   /// retry's): a refusal names --wrap-alpha instead of --wrap always.
   bool wrapped_surface = false;
+  /// The wrap's alpha (fraction of the diagonal; 0: unknown): a refusal
+  /// after every pass over-refined suggests 10 x this alpha.
+  double wrap_alpha = 0.0;
 };
 
 /// Result of tetrahedralize_surface().
