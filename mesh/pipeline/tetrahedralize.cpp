@@ -372,20 +372,24 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       s << ". Cause: every pass over-refined: parts of the surface lie closer to each other "
            "than the cell size (thin walls between holes or tunnels, near-contact gaps, thin "
            "sheets), which other cell sizes, more tets or longer limits do not resolve. ";
-      if (o.wrapped_surface) {
-        const double alpha = o.wrap_alpha > 0.0 ? std::min(1.0, 10.0 * o.wrap_alpha) : 0.0;
-        const std::string a = alpha > 0.0 ? fmt(alpha) : "A";
-        s << "The option that fixes this: a coarser alpha wrap, which closes the holes, tunnels "
-             "and gaps narrower than alpha so that no thin wall is left: --wrap always "
-             "--wrap-alpha " << a << " --max-wrap-distance " << a
-          << " (alpha" << (alpha > 0.0 ? " 10 x this wrap's" : "") << ", a fraction of the "
-             "diagonal; such a wrap lies farther from the input than the default limit, 3 % of "
-             "the diagonal, and fills the holes: the summary gives its distance and the volume it "
-             "adds; a smaller alpha keeps more holes but may over-refine again)";
-      } else {
-        s << "The option that fixes this: --wrap always (mesh an alpha-wrapped surface "
-             "instead: gaps narrower than --wrap-alpha are closed)";
-      }
+      const double alpha = o.wrap_alpha > 0.0 ? std::min(1.0, 10.0 * o.wrap_alpha) : 0.0;
+      const std::string a = alpha > 0.0 ? fmt(alpha) : "A";
+      const std::string coarser =
+          "a coarser alpha wrap, which closes the holes, tunnels and gaps narrower than alpha so "
+          "that no thin wall is left: --wrap always --wrap-alpha " + a + " --max-wrap-distance " +
+          a + " (alpha" +
+          (alpha > 0.0 ? (o.wrapped_surface ? " 10 x this wrap's" : " 10 x --wrap-alpha") : "") +
+          ", a fraction of the "
+          "diagonal; such a wrap lies farther from the input than the default limit, 3 % of the "
+          "diagonal, and fills the holes: the summary gives its distance and the volume it adds; "
+          "a smaller alpha keeps more holes but may over-refine again)";
+      if (o.wrapped_surface)
+        s << "The option that fixes this: " << coarser;
+      else
+        s << "The options that fix this: --wrap always (mesh an alpha-wrapped surface instead: "
+             "gaps narrower than --wrap-alpha are closed); when its mesher over-refines too "
+             "(thin walls between holes or tunnels wider than alpha, which the wrap follows), "
+          << coarser;
       throw InputError(s.str());
     }
     s << ". Options that change this: --coarse-tets N or --cell-size H (other sizes), "

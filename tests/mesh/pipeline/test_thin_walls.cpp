@@ -159,19 +159,26 @@ TEST(ThinWalls, MesherRefusalNamesTheCauseAndACoarserWrap) {
     EXPECT_EQ(m.find("--cell-size"), std::string::npos) << m;
     EXPECT_EQ(m.find("--time-limit"), std::string::npos) << m;
   }
-  // Not marked as a wrap (--wrap never): the option is the wrap itself.
+  // Not marked as a wrap (--wrap never): the wrap first (it fixes
+  // near-contact gaps: Preprocess.MesherFailureIsRetriedOnTheAlphaWrap), then
+  // the coarser wrap (this block: RefusedAfterTheWrapRetry... below).
   o.wrapped_surface = false;
-  o.wrap_alpha = 0.0;
   try {
     tetrahedralize_surface(block_with_two_tunnels(1e-3), o);
     FAIL() << "a wall of 1e-3 meshed at 500 tets";
   } catch (const InputError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find(std::string(kOverRefinedEverywhere) +
-                     "The option that fixes this: --wrap always (mesh an alpha-wrapped surface "
-                     "instead: gaps narrower than --wrap-alpha are closed)"),
+                     "The options that fix this: --wrap always (mesh an alpha-wrapped surface "
+                     "instead: gaps narrower than --wrap-alpha are closed); when its mesher "
+                     "over-refines too (thin walls between holes or tunnels wider than alpha, "
+                     "which the wrap follows), a coarser alpha wrap, which closes the holes, "
+                     "tunnels and gaps narrower than alpha so that no thin wall is left: --wrap "
+                     "always --wrap-alpha 0.1 --max-wrap-distance 0.1 (alpha 10 x --wrap-alpha, "
+                     "a fraction of the diagonal;"),
               std::string::npos)
         << m;
+    EXPECT_EQ(m.find("--coarse-tets"), std::string::npos) << m;
   }
 }
 
