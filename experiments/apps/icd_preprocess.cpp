@@ -42,8 +42,9 @@ std::string help_footer(const PreprocessOptions& d) {
       d.repair.max_hole_diameter, d.repair.max_surface_change, d.repair.wrap_alpha,
       d.repair.max_wrap_distance, d.tetrahedralize.radius_edge_bound,
       d.tetrahedralize.facet_distance_factor, d.tetrahedralize.feature_angle_deg,
-      d.tetrahedralize.sliver_bound_deg, d.tetrahedralize.step_cleanup.target_ratio, d.spheres.depth, d.spheres.branching,
-      d.association.k_nearest, d.limits.cpu_seconds, d.limits.memory_mb);
+      d.tetrahedralize.sliver_bound_deg, d.tetrahedralize.step_cleanup.target_ratio,
+      d.spheres.depth, d.spheres.branching, d.association.k_nearest, d.limits.cpu_seconds,
+      d.limits.memory_mb);
   return std::string(
              "  Prepares a deformable object: repairs the dense surface INPUT (.off .obj .ply\n"
              "  .stl), simplifies it with quadric error metrics, tetrahedralizes it into the\n"

@@ -590,8 +590,8 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
       else s << name << ": ";
       s << "alpha wrapping (--wrap, alpha " << options.wrap_alpha << " of the diagonal) ";
       if (valid)
-        s << "reaches " << 100.0 * rep.wrap_distance << " % of the diagonal away from the input (limit "
-          << 100.0 * options.max_wrap_distance
+        s << "reaches " << 100.0 * rep.wrap_distance
+          << " % of the diagonal away from the input (limit " << 100.0 * options.max_wrap_distance
           << " %, --max-wrap-distance " << options.max_wrap_distance
           << "): a smaller --wrap-alpha, e.g. " << options.wrap_alpha / 2
           << ", follows it more closely; --max-wrap-distance "

@@ -376,8 +376,8 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       const std::string a = alpha > 0.0 ? fmt(alpha) : "A";
       const std::string coarser =
           "a coarser alpha wrap, which closes the holes, tunnels and gaps narrower than alpha so "
-          "that no thin wall is left: --wrap always --wrap-alpha " + a + " --max-wrap-distance " +
-          a + " (alpha" +
+          "that no thin wall is left: --wrap always --wrap-alpha " +
+          a + " --max-wrap-distance " + a + " (alpha" +
           (alpha > 0.0 ? (o.wrapped_surface ? " 10 x this wrap's" : " 10 x --wrap-alpha") : "") +
           ", a fraction of the "
           "diagonal; such a wrap lies farther from the input than the default limit, 3 % of the "

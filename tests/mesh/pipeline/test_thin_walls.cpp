@@ -93,7 +93,8 @@ SurfaceMesh voxel_surface(const std::vector<double>& xs, const std::vector<doubl
 SurfaceMesh block_with_two_tunnels(double wall) {
   const std::vector<double> xs{0, 0.2, 0.5, 0.5 + wall, 0.8 + wall, 1 + wall};
   const std::vector<double> ys{0, 0.35, 0.65, 1}, zs{0, 1};
-  return voxel_surface(xs, ys, zs, [](int i, int j, int) { return !(j == 1 && (i == 1 || i == 3)); });
+  return voxel_surface(xs, ys, zs,
+                       [](int i, int j, int) { return !(j == 1 && (i == 1 || i == 3)); });
 }
 
 TEST(ThinWalls, BlockWithTwoTunnelsIsAClosedSurfaceOfGenusTwo) {
@@ -128,7 +129,8 @@ constexpr const char* kOverRefinedEverywhere =
 
 TEST(ThinWalls, MesherRefusalNamesTheCauseAndACoarserWrap) {
   // Control: the same block with a wall as wide as the tunnels meshes.
-  const TetrahedralizeResult ok = tetrahedralize_surface(block_with_two_tunnels(0.3), thin_wall_options());
+  const TetrahedralizeResult ok =
+      tetrahedralize_surface(block_with_two_tunnels(0.3), thin_wall_options());
   EXPECT_TRUE(closed_and_oriented(ok.mesh.F));
   EXPECT_EQ(ok.over_refined_passes, 0);
   // A wall of 1e-3 on a surface marked as an alpha wrap of alpha 0.01 (as the
@@ -144,7 +146,8 @@ TEST(ThinWalls, MesherRefusalNamesTheCauseAndACoarserWrap) {
     FAIL() << "a limit fired instead of the vertex cap: " << e.what();
   } catch (const InputError& e) {
     const std::string m = e.what();
-    EXPECT_EQ(m.rfind("tetrahedralize: the mesher failed in all 2 pass(es); cell size ", 0), 0u) << m;
+    EXPECT_EQ(m.rfind("tetrahedralize: the mesher failed in all 2 pass(es); cell size ", 0), 0u)
+        << m;
     EXPECT_NE(m.find(std::string(kOverRefinedEverywhere) +
                      "The option that fixes this: a coarser alpha wrap, which closes the holes, "
                      "tunnels and gaps narrower than alpha so that no thin wall is left: --wrap "
@@ -207,7 +210,8 @@ TEST(ThinWalls, RefusedAfterTheWrapRetryAndMeshedWithTheOptionTheRefusalNames) {
                    "surface first: tetrahedralize: the mesher failed in all 2 pass(es)"),
             std::string::npos)
       << m;
-  const double alpha = option_value(m, "--wrap-alpha"), limit = option_value(m, "--max-wrap-distance");
+  const double alpha = option_value(m, "--wrap-alpha"),
+               limit = option_value(m, "--max-wrap-distance");
   EXPECT_DOUBLE_EQ(alpha, 0.2) << m;
   EXPECT_DOUBLE_EQ(limit, 0.2) << m;
   // The option the refusal names meshes the same block: the wrap closes the
@@ -257,7 +261,9 @@ TEST(ThinWalls, WrapBeyondTheDistanceLimitNamesMaxWrapDistance) {
   } catch (const InputError& e) {
     m = e.what();
   }
-  EXPECT_EQ(m.rfind("block.off: alpha wrapping (--wrap, alpha 0.2 of the diagonal) reaches ", 0), 0u) << m;
+  EXPECT_EQ(m.rfind("block.off: alpha wrapping (--wrap, alpha 0.2 of the diagonal) reaches ", 0),
+            0u)
+      << m;
   EXPECT_NE(m.find("% of the diagonal away from the input (limit 3 %, --max-wrap-distance 0.03): "
                    "a smaller --wrap-alpha, e.g. 0.1, follows it more closely; "
                    "--max-wrap-distance "),
