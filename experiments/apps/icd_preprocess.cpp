@@ -32,16 +32,19 @@ std::string help_footer(const PreprocessOptions& d) {
   std::snprintf(
       defaults, sizeof defaults,
       "  Defaults: --coarse-tets %d, --simplify-faces %d, --max-hole-edges %d,\n"
-      "  --max-hole-diameter %g, --max-surface-change %g, --radius-edge %g,\n"
+      "  --max-hole-diameter %g, --max-surface-change %g, --wrap-alpha %g,\n"
+      "  --max-wrap-distance %g, --radius-edge %g,\n"
       "  --facet-distance %g, --feature-angle %g, --sliver-bound %g, --step-target %g,\n"
       "  --spheres medial, --sphere-depth %d, --sphere-branching %d, --sphere-fit light,\n"
       "  --assoc-nearest %d,"
       " --time-limit %g, --memory-limit %g.\n",
       d.tetrahedralize.target_tets, d.simplify.target_faces, d.repair.max_hole_edges,
-      d.repair.max_hole_diameter, d.repair.max_surface_change, d.tetrahedralize.radius_edge_bound,
+      d.repair.max_hole_diameter, d.repair.max_surface_change, d.repair.wrap_alpha,
+      d.repair.max_wrap_distance, d.tetrahedralize.radius_edge_bound,
       d.tetrahedralize.facet_distance_factor, d.tetrahedralize.feature_angle_deg,
-      d.tetrahedralize.sliver_bound_deg, d.tetrahedralize.step_cleanup.target_ratio, d.spheres.depth, d.spheres.branching,
-      d.association.k_nearest, d.limits.cpu_seconds, d.limits.memory_mb);
+      d.tetrahedralize.sliver_bound_deg, d.tetrahedralize.step_cleanup.target_ratio,
+      d.spheres.depth, d.spheres.branching, d.association.k_nearest, d.limits.cpu_seconds,
+      d.limits.memory_mb);
   return std::string(
              "  Prepares a deformable object: repairs the dense surface INPUT (.off .obj .ply\n"
              "  .stl), simplifies it with quadric error metrics, tetrahedralizes it into the\n"
@@ -105,6 +108,14 @@ std::variant<Command, int> parse(int argc, char** argv) {
               })
       .real("--wrap-alpha", o.repair.wrap_alpha, "F",
             "alpha of the wrap, F * bbox diagonal (smaller: closer to the input, more faces)")
+      .custom("--max-wrap-distance", "F",
+              "refuse a wrap farther than F * bbox diagonal from the input, in (0, 1] (a wrap "
+              "that closes holes lies about their radius away)",
+              [&](const std::string& v) {
+                o.repair.max_wrap_distance = Cli::parse_real(v);
+                if (!(o.repair.max_wrap_distance > 0 && o.repair.max_wrap_distance <= 1))
+                  throw std::invalid_argument("must be in (0, 1], got '" + v + "'");
+              })
       .real("--radius-edge", o.tetrahedralize.radius_edge_bound, "B",
             "tet radius-edge ratio bound, >= 2")
       .real("--interior-size", o.tetrahedralize.interior_size_factor, "F",

@@ -239,6 +239,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
     to.limits = limits;
     to.cell_size *= s;
     to.wrapped_surface = r.repair.wrap_cause != 0;
+    to.wrap_alpha = o.repair.wrap_alpha;
     const bool retry_possible =
         o.repair.wrap == RepairOptions::Wrap::fallback && r.repair.wrap_cause == 0;
     if (!(o.wrap_retry_first_share > 0.0 && o.wrap_retry_first_share <= 1.0))
@@ -324,7 +325,9 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       // stage; the summary's repair section and notes say so.
       if (!retry_possible) throw;
       std::string first = e.what();
-      first = first.substr(0, first.find(". Options that change this"));  // the retry is the option
+      // The retry is the option: the first attempt's cause without its options.
+      first = first.substr(0, std::min(first.find(". Options that change this"),
+                                       first.find(". Cause: every pass over-refined")));
       const double first_cpu = children_cpu() - cpu0;
       const double first_wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -562,6 +565,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
   for (double& d : b.spheres.assoc_rest_dist) d /= s;
   r.bbox_diagonal /= s;
   r.repair.volume /= s3;
+  r.repair.input_volume /= s3;
   r.quality = tet_quality(b.coarse);
   r.stable_step = stable_step_report(b.coarse, o.stable_step);
   return r;

@@ -162,6 +162,14 @@ std::string RepairReport::to_string() const {
       << why[wrap_cause] << "; alpha " << wrap_alpha
       << " of the diagonal): every point of it lies within " << 100.0 * wrap_distance
       << " % of the diagonal of the input (parts of the input inside it are dropped; --wrap never refuses instead)\n";
+    if (input_volume > 0.0) {
+      const double change = volume / input_volume - 1.0;
+      s << (std::abs(change) > 0.05 ? "WARNING: " : "")
+        << "the wrap changes the enclosed volume by " << std::showpos << 100.0 * change
+        << std::noshowpos << " % (the input encloses " << input_volume
+        << (change > 0.05 ? "; the wrap fills holes, tunnels and gaps narrower than alpha" : "")
+        << ")\n";
+    }
   }
   s << "output " << output_vertices << " vertices, " << output_faces << " faces, " << components
     << " component(s), volume " << volume << "\n";
@@ -535,6 +543,27 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
     }
   }
   if (rep.wrap_cause != 0) {
+    // The input's enclosed volume, when it is a closed, consistently oriented
+    // surface (each directed edge once, its reverse once): the summary gives
+    // the volume the wrap adds.
+    {
+      std::map<std::pair<int, int>, int> directed;
+      for (const auto& t : faces)
+        for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+      bool closed = true;
+      for (const auto& [e, n] : directed) {
+        const auto rev = directed.find({e.second, e.first});
+        closed = closed && n == 1 && rev != directed.end() && rev->second == 1;
+      }
+      double v = 0.0;
+      for (const auto& t : faces) {
+        const Eigen::Vector3d a(points[t[0]].x(), points[t[0]].y(), points[t[0]].z()),
+            b(points[t[1]].x(), points[t[1]].y(), points[t[1]].z()),
+            c(points[t[2]].x(), points[t[2]].y(), points[t[2]].z());
+        v += a.dot(b.cross(c)) / 6.0;
+      }
+      rep.input_volume = closed ? std::abs(v) : 0.0;
+    }
     const double alpha = options.wrap_alpha * diag;
     const double offset = (options.wrap_offset > 0.0 ? options.wrap_offset : options.wrap_alpha / 30.0) * diag;
     std::vector<std::array<std::size_t, 3>> tris;
@@ -563,10 +592,12 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
       else s << name << ": ";
       s << "alpha wrapping (--wrap, alpha " << options.wrap_alpha << " of the diagonal) ";
       if (valid)
-        s << "reaches " << 100.0 * rep.wrap_distance << " % of the diagonal away from the input (limit "
-          << 100.0 * options.max_wrap_distance
-          << " %): a smaller --wrap-alpha, e.g. " << options.wrap_alpha / 2
-          << ", follows it more closely";
+        s << "reaches " << 100.0 * rep.wrap_distance
+          << " % of the diagonal away from the input (limit " << 100.0 * options.max_wrap_distance
+          << " %, --max-wrap-distance " << options.max_wrap_distance
+          << "): a smaller --wrap-alpha, e.g. " << options.wrap_alpha / 2
+          << ", follows it more closely; --max-wrap-distance "
+          << std::ceil(rep.wrap_distance * 100.0 + 1e-9) / 100.0 << " accepts this wrap";
       else
         s << "gave no closed surface; try another --wrap-alpha";
       throw InputError(s.str());

@@ -50,7 +50,9 @@ struct RepairOptions {
   /// A wrap with a point farther than this fraction of the diagonal from the
   /// input (approximate one-sided distance, wrap to input: surfaces of the
   /// input inside the wrap, e.g. overlapping parts, do not count) is refused, naming
-  /// --wrap-alpha (a smaller alpha follows the input more closely).
+  /// --wrap-alpha (a smaller alpha follows the input more closely) and
+  /// --max-wrap-distance (this limit). A wrap that closes holes or tunnels
+  /// lies about their radius away.
   double max_wrap_distance = 0.03;
 };
 
@@ -85,6 +87,9 @@ struct RepairReport {
   int wrap_cause = 0;
   double wrap_alpha = 0.0;     ///< alpha used, fraction of the diagonal
   double wrap_distance = 0.0;  ///< largest distance wrap -> input / diagonal (approximate)
+  /// Volume the input encloses when it was wrapped and is a closed, consistently
+  /// oriented surface (model units^3, as `volume`); else 0 (not known).
+  double input_volume = 0.0;
   int components = 0;                   ///< connected components of the output
   int output_vertices = 0, output_faces = 0;
   double volume = 0.0;  ///< enclosed volume of the output (model units^3)

@@ -366,12 +366,42 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
     s << "tetrahedralize: the mesher failed in all " << res.passes << " pass(es)";
     for (const std::string& f : failures) s << "; " << f;
     if (failures.empty() && !last_cause.empty()) s << ": " << last_cause;
+    if (res.over_refined_passes > 0 && res.over_refined_passes == res.failed_passes) {
+      // Every pass ran into its vertex cap: walls or gaps thinner than any
+      // cell of this size. Measured on the corpus' cheese (walls between its
+      // holes down to 0.04 % of the diagonal): more tets (10,000, 20,000),
+      // another cell size and a longer --time-limit over-refine too, so the
+      // refusal names only what closes the thin parts.
+      s << ". Cause: every pass over-refined: parts of the surface lie closer to each other "
+           "than the cell size (thin walls between holes or tunnels, near-contact gaps, thin "
+           "sheets), which other cell sizes, more tets or longer limits do not resolve. ";
+      const double alpha = o.wrap_alpha > 0.0 ? std::min(1.0, 10.0 * o.wrap_alpha) : 0.0;
+      const std::string a = alpha > 0.0 ? fmt(alpha) : "A";
+      const std::string coarser =
+          "a coarser alpha wrap, which closes the holes, tunnels and gaps narrower than alpha so "
+          "that no thin wall is left: --wrap always --wrap-alpha " +
+          a + " --max-wrap-distance " + a + " (alpha" +
+          (alpha > 0.0 ? (o.wrapped_surface ? " 10 x this wrap's" : " 10 x --wrap-alpha") : "") +
+          ", a fraction of the "
+          "diagonal; such a wrap lies farther from the input than the default limit, 3 % of the "
+          "diagonal, and fills the holes: the summary gives its distance and the volume it adds; "
+          "a smaller alpha keeps more holes but may over-refine again)";
+      if (o.wrapped_surface)
+        s << "The option that fixes this: " << coarser;
+      else
+        s << "The options that fix this: --wrap always (mesh an alpha-wrapped surface instead: "
+             "gaps narrower than --wrap-alpha are closed); when its mesher over-refines too "
+             "(thin walls between holes or tunnels wider than alpha, which the wrap follows), "
+          << coarser;
+      throw InputError(s.str());
+    }
     s << ". Options that change this: --coarse-tets N or --cell-size H (other sizes), "
          "--time-limit S and --memory-limit MB (the stage's limits), ";
     if (o.wrapped_surface)
       s << "--wrap-alpha A (this surface is already an alpha wrap: a larger alpha, a fraction "
            "of the diagonal, closes wider gaps and thickens the wrap of thin sheets, which "
-           "stall the mesher; the wrap must stay within 3 % of the diagonal of the input)";
+           "stall the mesher; --max-wrap-distance F accepts a wrap up to F of the diagonal from "
+           "the input, default 0.03)";
     else
       s << "--wrap always (mesh an alpha-wrapped surface instead: near-contact gaps narrower "
            "than --wrap-alpha, which can stall the mesher, are closed)";

@@ -73,6 +73,9 @@ struct TetrahedralizeOptions {
   /// The surface is already an alpha wrap (repair's or the automatic wrap
   /// retry's): a refusal names --wrap-alpha instead of --wrap always.
   bool wrapped_surface = false;
+  /// The repair's --wrap-alpha (fraction of the diagonal; 0: unknown): a
+  /// refusal after every pass over-refined suggests a wrap at 10 x it.
+  double wrap_alpha = 0.0;
 };
 
 /// Result of tetrahedralize_surface().

@@ -103,6 +103,36 @@ TEST(PreprocessCli, RefusesContradictoryOptionsNamingBoth) {
   }
   fs::remove_all(dir);
 }
+
+// --max-wrap-distance: a fraction of the diagonal in (0, 1]; anything else is
+// refused naming the option, before any work.
+TEST(PreprocessCli, MaxWrapDistanceIsValidated) {
+  const fs::path dir = fs::temp_directory_path() / "icd_test_preprocess_cli_wrap_distance";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  icd::write_off(dir / "sphere.off", icd::make_icosphere(1));
+  const std::string head = (dir / "sphere.off").string() + " -o " + (dir / "bundle").string();
+  for (const char* bad : {"0", "-0.1", "1.5", "nan", "abc"}) {
+    const ProgramRun run = run_preprocess(head + " --max-wrap-distance " + bad, dir);
+    EXPECT_EQ(run.status, 2) << bad << ": " << run.output;
+    EXPECT_NE(run.output.find("--max-wrap-distance "), std::string::npos) << run.output;
+    EXPECT_TRUE(run.output.find(std::string("must be in (0, 1], got '") + bad + "'") !=
+                    std::string::npos ||
+                run.output.find(std::string("expects a finite number, got '") + bad + "'") !=
+                    std::string::npos)
+        << run.output;
+    EXPECT_FALSE(fs::exists(dir / "bundle")) << bad;
+  }
+  // A valid value is taken: a wrap of the sphere at alpha 0.3 lies more than
+  // 1e-3 of the diagonal from it, so that limit refuses it, naming the option.
+  const ProgramRun strict = run_preprocess(
+      head + " --wrap always --wrap-alpha 0.3 --max-wrap-distance 0.001 --no-spheres", dir);
+  EXPECT_EQ(strict.status, 1) << strict.output;
+  EXPECT_NE(strict.output.find("(limit 0.1 %, --max-wrap-distance 0.001)"), std::string::npos)
+      << strict.output;
+  EXPECT_FALSE(fs::exists(dir / "bundle"));
+  fs::remove_all(dir);
+}
 #endif
 
 }  // namespace

@@ -186,7 +186,8 @@ TEST(Repair, NonManifoldEdgeIsWrappedByDefault) {
   // A wrap limit below what the wrap achieves refuses it, naming --wrap-alpha.
   RepairOptions strict = o;
   strict.max_wrap_distance = 1e-6;
-  expect_refused(m, {"non-manifold edge", "alpha wrapping", "--wrap-alpha"}, strict);
+  expect_refused(m, {"non-manifold edge", "alpha wrapping", "--wrap-alpha", "--max-wrap-distance"},
+                 strict);
 }
 
 TEST(Repair, SplitsNonManifoldVertex) {

@@ -70,20 +70,40 @@ TEST(Tetrahedralize, NearContactGapFailsFastNamingTheCause) {
   }
 }
 
-TEST(Tetrahedralize, RefusalOfAWrappedSurfaceNamesTheWrapAlphaNotWrapAlways) {
+TEST(Tetrahedralize, RefusalOfAWrappedSurfaceNamesACoarserWrap) {
   // The same failing gap on a surface marked as an alpha wrap already (the
-  // automatic wrap retry's or --wrap always's): --wrap always would change
-  // nothing, so the refusal names --wrap-alpha (and the sizes and limits).
+  // automatic wrap retry's or --wrap always's): every pass over-refined, so
+  // the refusal names a coarser wrap (10 x its alpha, and the distance limit
+  // such a wrap needs), not other sizes or limits, which do not help.
   TetrahedralizeOptions o = small_options();
   o.wrapped_surface = true;
+  o.wrap_alpha = 0.02;
   try {
     tetrahedralize_surface(two_boxes(1e-3), o);
     FAIL() << "a gap of 1e-3 meshed at 500 tets";
   } catch (const InputError& e) {
     const std::string m = e.what();
     EXPECT_EQ(count(m, "the mesher over-refined"), 2) << m;
+    EXPECT_NE(m.find("Cause: every pass over-refined"), std::string::npos) << m;
+    EXPECT_NE(m.find("--wrap always --wrap-alpha 0.2 --max-wrap-distance 0.2 (alpha 10 x this "
+                     "wrap's"),
+              std::string::npos)
+        << m;
+    EXPECT_EQ(m.find("--coarse-tets"), std::string::npos) << m;
+    EXPECT_EQ(m.find("--time-limit"), std::string::npos) << m;
+  }
+  // A wrapped surface that failed otherwise (here: no CPU left for a pass):
+  // the sizes, the limits and --wrap-alpha with --max-wrap-distance.
+  o.cpu_budget = 0.4;
+  try {
+    tetrahedralize_surface(two_boxes(0.3), o);
+    FAIL() << "meshed within a budget of 0.4 s";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find("Cause: every pass over-refined"), std::string::npos) << m;
     EXPECT_EQ(m.find("--wrap always"), std::string::npos) << m;
     EXPECT_NE(m.find("--wrap-alpha A (this surface is already an alpha wrap"), std::string::npos) << m;
+    EXPECT_NE(m.find("--max-wrap-distance F accepts"), std::string::npos) << m;
     EXPECT_NE(m.find("--coarse-tets N"), std::string::npos) << m;
     EXPECT_NE(m.find("--time-limit S"), std::string::npos) << m;
   }
