@@ -31,7 +31,13 @@ def row(out, mesh):
          "outcome": "ok" if rc == 0 else ("refused" if rc == 1 else f"exit {rc}")}
     err = num(r"^icd-preprocess: (.*)$", log, default="") if rc else ""
     m = re.search(r"^icd-preprocess: (.*)$", log, re.M)
-    r["message"] = (m.group(1)[:160] + ("..." if len(m.group(1)) > 160 else "")) if (m and rc) else ""
+    text = m.group(1) if (m and rc) else ""
+    # A refusal's stated cause and fix (the part from "Cause:"), else its start.
+    cause = text.find("Cause:")
+    if cause > 0:
+        fix = text.find(" (", text.find("The option that fixes this", cause))
+        text = "... " + text[cause:fix if fix > cause else None]
+    r["message"] = text[:600] + ("..." if len(text) > 600 else "")
     q = re.search(r"(\d+) vertices \((\d+) on the surface\), (\d+) tets", log)
     if q:
         nv, ns, nt = map(int, q.groups())
