@@ -5,9 +5,9 @@
 #include <CGAL/AABB_triangle_primitive.h>
 
 #include <algorithm>
-#include <numeric>
 #include <vector>
 
+#include <icd/mesh/core/union_find.hpp>
 #include <icd/mesh/pipeline/cgal_convert.hpp>
 
 namespace icd::mesh {
@@ -19,33 +19,20 @@ using Triangle = Kernel::Triangle_3;
 using Primitive = CGAL::AABB_triangle_primitive<Kernel, std::vector<Triangle>::const_iterator>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
 
-int find(std::vector<int>& parent, int a) {
-  while (parent[static_cast<std::size_t>(a)] != a) {
-    int& p = parent[static_cast<std::size_t>(a)];
-    p = parent[static_cast<std::size_t>(p)];
-    a = p;
-  }
-  return a;
-}
-
 }  // namespace
 
 ComponentGap closest_component_gap(const SurfaceMesh& surface, double within) {
   ComponentGap gap;
   const int nv = static_cast<int>(surface.V.rows()), nf = static_cast<int>(surface.F.rows());
-  std::vector<int> parent(static_cast<std::size_t>(nv));
-  std::iota(parent.begin(), parent.end(), 0);
+  UnionFind parts(nv);
   for (int f = 0; f < nf; ++f)
-    for (int k = 1; k < 3; ++k) {
-      const int a = find(parent, surface.F(f, 0)), b = find(parent, surface.F(f, k));
-      if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-    }
+    for (int k = 1; k < 3; ++k) parts.unite(surface.F(f, 0), surface.F(f, k));
   // Components numbered in the order of their first face; each with its
   // faces, vertices and bounding box.
   std::vector<int> id(static_cast<std::size_t>(nv), -1);
   std::vector<std::vector<int>> faces, verts;
   for (int f = 0; f < nf; ++f) {
-    int& c = id[static_cast<std::size_t>(find(parent, surface.F(f, 0)))];
+    int& c = id[static_cast<std::size_t>(parts.find(surface.F(f, 0)))];
     if (c < 0) {
       c = static_cast<int>(faces.size());
       faces.emplace_back();
@@ -54,7 +41,7 @@ ComponentGap closest_component_gap(const SurfaceMesh& surface, double within) {
     faces[static_cast<std::size_t>(c)].push_back(f);
   }
   for (int v = 0; v < nv; ++v) {
-    const int c = id[static_cast<std::size_t>(find(parent, v))];
+    const int c = id[static_cast<std::size_t>(parts.find(v))];
     if (c >= 0) verts[static_cast<std::size_t>(c)].push_back(v);
   }
   gap.components = static_cast<int>(faces.size());
