@@ -10,6 +10,7 @@
 #include <utility>
 
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/mesh_stats.hpp>
 #include <icd/mesh/core/primitives.hpp>
 #include <icd/mesh/pipeline/canonical.hpp>
 #include <icd/mesh/pipeline/hausdorff.hpp>
@@ -273,15 +274,10 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       ByteReader in(run_bounded(
           "tetrahedralize", limits,
           [&] {
-            double volume = 0.0;
-            for (int f = 0; f < simplified.F.rows(); ++f) {
-              const Eigen::Vector3d p0 = simplified.V.row(simplified.F(f, 0)),
-                                    p1 = simplified.V.row(simplified.F(f, 1)),
-                                    p2 = simplified.V.row(simplified.F(f, 2));
-              volume += p0.dot(p1.cross(p2)) / 6.0;
-            }
             const double size =
-                to.cell_size > 0.0 ? to.cell_size : initial_cell_size(volume, to.target_tets);
+                to.cell_size > 0.0
+                    ? to.cell_size
+                    : initial_cell_size(compute_surface_stats(simplified).volume, to.target_tets);
             ByteWriter w;
             w.pod(size);
             w.pod(check_gap ? closest_component_gap(simplified, to.facet_distance_factor * size)

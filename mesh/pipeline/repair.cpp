@@ -30,6 +30,7 @@
 #include <vector>
 
 #include <icd/mesh/core/error.hpp>
+#include <icd/mesh/core/mesh_stats.hpp>
 #include <icd/mesh/pipeline/cgal_convert.hpp>
 #include <icd/mesh/pipeline/hausdorff.hpp>
 
@@ -544,25 +545,20 @@ RepairResult repair_surface(const SurfaceMesh& input, const RepairOptions& optio
   }
   if (rep.wrap_cause != 0) {
     // The input's enclosed volume, when it is a closed, consistently oriented
-    // surface (each directed edge once, its reverse once): the summary gives
-    // the volume the wrap adds.
+    // surface (every edge in two faces that cross it in opposite directions):
+    // the summary gives the volume the wrap adds.
     {
-      std::map<std::pair<int, int>, int> directed;
-      for (const auto& t : faces)
-        for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
-      bool closed = true;
-      for (const auto& [e, n] : directed) {
-        const auto rev = directed.find({e.second, e.first});
-        closed = closed && n == 1 && rev != directed.end() && rev->second == 1;
-      }
-      double v = 0.0;
-      for (const auto& t : faces) {
-        const Eigen::Vector3d a(points[t[0]].x(), points[t[0]].y(), points[t[0]].z()),
-            b(points[t[1]].x(), points[t[1]].y(), points[t[1]].z()),
-            c(points[t[2]].x(), points[t[2]].y(), points[t[2]].z());
-        v += a.dot(b.cross(c)) / 6.0;
-      }
-      rep.input_volume = closed ? std::abs(v) : 0.0;
+      SurfaceMesh soup;
+      soup.V.resize(static_cast<Eigen::Index>(points.size()), 3);
+      for (std::size_t v = 0; v < points.size(); ++v)
+        soup.V.row(static_cast<Eigen::Index>(v)) << points[v].x(), points[v].y(), points[v].z();
+      soup.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+      for (std::size_t f = 0; f < faces.size(); ++f)
+        soup.F.row(static_cast<Eigen::Index>(f)) << faces[f][0], faces[f][1], faces[f][2];
+      const SurfaceStats st = compute_surface_stats(soup);
+      const bool closed =
+          st.boundary_edges == 0 && st.nonmanifold_edges == 0 && st.inconsistent_edges == 0;
+      rep.input_volume = closed ? std::abs(st.volume) : 0.0;
     }
     const double alpha = options.wrap_alpha * diag;
     const double offset = (options.wrap_offset > 0.0 ? options.wrap_offset : options.wrap_alpha / 30.0) * diag;
