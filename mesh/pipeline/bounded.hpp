@@ -6,6 +6,7 @@
 /// names the stage and the option that changes the limit; nothing CGAL prints
 /// or writes (assertion text, dump-bug files) reaches the user or the working
 /// folder. Plain POSIX (fork, pipe, setrlimit, wait4); Linux /proc for progress.
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -34,6 +35,14 @@ struct StageUsage {
   double cpu_seconds = 0.0;
   double wall_seconds = 0.0;
   double peak_mb = 0.0;
+
+  /// Adds the use of a later run: its times add up, the peak is the larger.
+  StageUsage& operator+=(const StageUsage& other) {
+    cpu_seconds += other.cpu_seconds;
+    wall_seconds += other.wall_seconds;
+    peak_mb = std::max(peak_mb, other.peak_mb);
+    return *this;
+  }
 };
 
 /// Thrown when a stage exceeded a limit (CPU time, memory) or failed inside a

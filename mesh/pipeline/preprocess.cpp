@@ -374,9 +374,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
           } catch (const ParameterError&) {
             throw;
           } catch (const InputError& w) {
-            ru.cpu_seconds += u.cpu_seconds;
-            ru.wall_seconds += u.wall_seconds;
-            ru.peak_mb = std::max(ru.peak_mb, u.peak_mb);
+            ru += u;
             if (!(ro.wrap_alpha > o.repair.wrap_alpha)) throw;
             refused += (refused.empty() ? "" : ", ") + fmt(ro.wrap_alpha);
             if (beat)
@@ -386,9 +384,7 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
             require(rl.cpu_seconds);
             continue;
           }
-          ru.cpu_seconds += u.cpu_seconds;
-          ru.wall_seconds += u.wall_seconds;
-          ru.peak_mb = std::max(ru.peak_mb, u.peak_mb);
+          ru += u;
           break;
         }
         if (scaled > o.repair.wrap_alpha)
@@ -509,18 +505,13 @@ PreprocessResult preprocess(const SurfaceMesh& dense, const PreprocessOptions& o
       if (o.sphere_builder != SphereBuilder::medial_axis ||
           (e.kind() != StageError::Kind::cpu_limit && e.kind() != StageError::Kind::memory_limit))
         throw;
-      StageUsage first;
-      first.cpu_seconds = t.usage().cpu_seconds;
-      first.wall_seconds = t.usage().wall_seconds;
-      first.peak_mb = t.usage().peak_mb;
+      const StageUsage first = t.usage();
       if (const HeartbeatFn beat = t.heartbeat())
         beat("the medial-axis builder went beyond the stage's limits; building the octree tree "
              "instead");
       bytes = t.run(limits, build(SphereBuilder::octree));
       StageUsage sum = t.usage();
-      sum.cpu_seconds += first.cpu_seconds;
-      sum.wall_seconds += first.wall_seconds;
-      sum.peak_mb = std::max(sum.peak_mb, first.peak_mb);
+      sum += first;
       t.set_usage(sum);
       r.sphere_fallback = std::string(e.what()) + " (" + fmt(first.cpu_seconds) + " s CPU)";
       r.notes.push_back("WARNING: sphere tree: " + r.sphere_fallback +

@@ -295,9 +295,7 @@ TetrahedralizeResult tetrahedralize_surface(const SurfaceMesh& surface,
       last_cause = "stage 'tetrahedralize' failed inside CGAL (an internal check did not hold)";
     }
     spent += u.cpu_seconds;
-    res.usage.cpu_seconds += u.cpu_seconds;
-    res.usage.wall_seconds += u.wall_seconds;
-    res.usage.peak_mb = std::max(res.usage.peak_mb, u.peak_mb);
+    res.usage += u;
     if (out.T.rows() > 0) return true;
     ++res.failed_passes;
     if (last_over_refined) ++res.over_refined_passes;
